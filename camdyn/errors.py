@@ -1,0 +1,89 @@
+"""Exceptions raised by camdyn.
+
+Every exception camdyn raises on purpose derives from :class:`CamdynError`. The concrete
+ones are also :class:`ValueError`, so ``except ValueError`` keeps working for callers that
+do not know camdyn. All of them can be pickled (for process pools).
+"""
+
+from __future__ import annotations
+
+import functools
+from numbers import Real
+from typing import Any
+
+__all__ = [
+    "CamdynError",
+    "ParameterError",
+    "RigFileError",
+    "GeometryError",
+    "EquilibriumError",
+    "SceneError",
+]
+
+
+class CamdynError(Exception):
+    """Base class of all camdyn errors (a plain mixin base; catch this to catch them all)."""
+
+
+class ParameterError(CamdynError, ValueError):
+    """A model parameter is not given, not a real number, or outside its valid range.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name in the paper's notation, e.g. ``"k_s"``.
+    value : object
+        The offending value; ``None`` when the parameter was not given.
+    valid : str
+        What the value must be, e.g. ``"> 0"``, or why it is needed, e.g.
+        ``"required by damping model D"`` when ``value`` is ``None``.
+    reason : str, optional
+        Appended in parentheses: the parameter's meaning and unit, and the likely mistake.
+
+    Example message: ``k_s = -5.0 is out of range: must be > 0 (follower spring stiffness, N/m)``.
+    """
+
+    def __init__(self, name: str, value: Any, valid: str, *, reason: str | None = None):
+        self.name, self.value, self.valid, self.reason = name, value, valid, reason
+        if value is None:
+            message = f"{name} is not given: {valid}"
+        elif isinstance(value, Real) and not isinstance(value, bool):
+            message = f"{name} = {value} is out of range: must be {valid}"
+        else:
+            kind = type(value).__name__
+            message = f"{name} = {value!r} is not a real number ({kind}): must be {valid}"
+        if reason:
+            message += f" ({reason})"
+        super().__init__(message)
+
+    def __reduce__(self):
+        rebuild = functools.partial(type(self), reason=self.reason)
+        return rebuild, (self.name, self.value, self.valid)
+
+
+class RigFileError(CamdynError, ValueError):
+    """A rig description cannot be used: a TOML file that is unreadable or not valid TOML,
+    or a file, dict or keyword set with unknown, missing or wrongly typed keys.
+
+    ``source`` names the file (or ``"<dict>"``, ``"Rig.replace()"``...), ``key`` the
+    offending key when there is one. The message is ``"<source>: <problem>"``.
+    """
+
+    def __init__(self, source: str, problem: str, *, key: str | None = None):
+        self.source, self.problem, self.key = str(source), problem, key
+        super().__init__(f"{source}: {problem}")
+
+    def __reduce__(self):
+        return functools.partial(type(self), key=self.key), (self.source, self.problem)
+
+
+class GeometryError(CamdynError, ValueError):
+    """The rig's geometry is impossible, e.g. the follower cannot touch the cam (Sec. 3.1)."""
+
+
+class EquilibriumError(CamdynError, ValueError):
+    """No static equilibrium of the follower exists or it cannot be found (Sec. 3.3)."""
+
+
+class SceneError(CamdynError, ValueError):
+    """A scene (simulation set-up) option is invalid or inconsistent with the rig."""

@@ -1,0 +1,160 @@
+"""Kinematics, forces and equations of motion of the follower (Sections 3.1-3.2, 7.2).
+
+The equation of motion is the moment balance about the pivot P of the force
+vectors acting on the follower (Eqs. 10 and 15 follow from it, not the other
+way round): the spring force at horizontal distance d_x, the normal contact
+force -F_n n and the friction force at O_b.  The friction force opposes the
+sliding velocity of the follower's material point relative to the cam's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy as sp
+from sympy.physics.vector import Point, Vector
+
+from . import laws
+from . import symbols as S
+from .geometry import N, E_to_Gc, P_to_Ob, chi, follower_frame, psi_i_conditioned, psi_j_conditioned
+from .symbols import Theta, alpha, t
+
+B = follower_frame(alpha)
+SLIDING_VELOCITY_FORMS = ("kinematic", "printed")
+
+
+@lru_cache(maxsize=None)
+def gap() -> sp.Expr:
+    """psi_i(alpha(t), Theta(t)) (Eq. 6, cancellation-free form)."""
+    return psi_i_conditioned(alpha, Theta)
+
+
+@lru_cache(maxsize=None)
+def psi_j() -> sp.Expr:
+    return psi_j_conditioned(alpha, Theta)
+
+
+@lru_cache(maxsize=None)
+def gap_rate() -> sp.Expr:
+    """psi_i_dot (Eq. 8), the time derivative of the gap."""
+    return gap().diff(t)
+
+
+@lru_cache(maxsize=None)
+def psi_j_rate() -> sp.Expr:
+    """psi_j_dot (Eq. 9)."""
+    return psi_j().diff(t)
+
+
+def material_point_velocities() -> tuple[Vector, Vector]:
+    """Velocities of the follower's and the cam's material points at the contact.
+
+    The follower turns about the fixed P at -alpha_dot (clockwise); the cam
+    about the fixed E at Theta_dot.  The cam's point is on its surface,
+    O_c = G_c - r_c n; the follower's is O_b on the bar's surface.
+    """
+    P, E = Point("P"), Point("E")
+    P.set_vel(N, 0)
+    E.set_vel(N, 0)
+    Ob = P.locatenew("O_b", P_to_Ob(B, chi()))
+    Oc = E.locatenew("O_c", E_to_Gc(Theta) - S.r_c * B.y)
+    follower = N.orientnew("follower_body", "Axis", (-alpha, N.z))
+    cam = N.orientnew("cam_body", "Axis", (Theta, N.z))
+    v_b = Ob.v2pt_theory(P, N, follower)
+    v_c = Oc.v2pt_theory(E, N, cam)
+    return v_b, v_c
+
+
+@lru_cache(maxsize=None)
+def sliding_velocity(form: str = "kinematic") -> sp.Expr:
+    """v_r, the velocity of the follower relative to the cam along the bar (u).
+
+    "kinematic": from the material points' velocities (rigid-body kinematics).
+    "printed":   the paper's v_r = psi_j_dot - (r_c + e sin(alpha+Theta))(alpha_dot + Theta_dot),
+                 which counts the e sin(alpha+Theta) term twice (misprint 8); kept so
+                 Figs. 12-15 can be reproduced.  The sign convention is the paper's:
+                 v_r > 0 for a cam turning clockwise (self-energizing).
+    """
+    if form == "kinematic":
+        v_b, v_c = material_point_velocities()
+        return sp.simplify((v_b - v_c).dot(B.x))
+    if form == "printed":
+        return psi_j_rate() - (S.r_c + S.e * sp.sin(alpha + Theta)) * (alpha.diff(t) + Theta.diff(t))
+    raise ValueError(f"sliding velocity form {form!r} is not one of {SLIDING_VELOCITY_FORMS}")
+
+
+@dataclass(frozen=True)
+class ContactRegime:
+    """The physics of one contact regime: which laws, which discrete phase and direction."""
+
+    contact: str = "line"            # "line" | "point"
+    damping: str = "none"            # "none" | "A".."E"
+    phase: str = "loading"           # D/E only: "loading" | "unloading"
+    friction: str = "none"           # "none" | "coulomb" | "tanh"
+    direction: int = 0               # Coulomb only: sign of v_r, +1 | -1
+    damping_sign: str = "dissipative"
+    sliding_velocity: str = "kinematic"
+
+
+@dataclass(frozen=True)
+class Forces:
+    """Force magnitudes on the follower, as functions of alpha(t), Theta(t)."""
+
+    F_s: sp.Expr   # spring (Eq. 11)
+    F_n: sp.Expr   # normal contact force (Eq. 12), positive when pressing
+    F_f: sp.Expr   # friction force, F_f = mu F_n
+    v_r: sp.Expr   # sliding velocity used by the friction law
+
+
+def forces(regime: ContactRegime | None) -> Forces:
+    """Forces in a contact regime, or with no contact (``regime=None``, Eq. 15)."""
+    F_s = laws.spring_force(alpha)
+    if regime is None:
+        zero = sp.Integer(0)
+        return Forces(F_s, zero, zero, sliding_velocity("kinematic"))
+    psi_i = gap()
+    k = laws.contact_stiffness(regime.contact, psi_i)
+    c = laws.damping_coefficient(regime.damping, regime.phase, k, psi_i, regime.damping_sign)
+    F_n = -k * psi_i - c * gap_rate()
+    v_r = sliding_velocity(regime.sliding_velocity) if regime.friction != "none" else \
+        sliding_velocity("kinematic")
+    mu = laws.friction_coefficient(regime.friction, v_r, regime.direction)
+    return Forces(F_s, F_n, mu * F_n, v_r)
+
+
+def applied_forces(f: Forces) -> list[tuple[Vector, Vector]]:
+    """(point relative to P, force vector on the follower) pairs.
+
+    Spring: vertical, at horizontal distance d_x (Eq. 11 acts as a vertical force).
+    Normal force: -F_n n at O_b (the cam pushes the bar away from itself).
+    Friction: -F_f u at O_b, opposing the follower's sliding velocity v_r u
+    relative to the cam (F_f = mu F_n with mu of the sign of v_r).
+    """
+    r_Ob = P_to_Ob(B, chi())
+    r_spring = S.d_x * N.x + (-S.d_x * sp.tan(alpha)) * N.y
+    return [
+        (r_spring, f.F_s * N.y),
+        (r_Ob, -f.F_n * B.y),
+        (r_Ob, -f.F_f * B.x),
+    ]
+
+
+def moment_about_P(f: Forces) -> sp.Expr:
+    """Clockwise moment about P of the applied forces (alpha is clockwise)."""
+    total = sum((r.cross(F) for r, F in applied_forces(f)), Vector(0))
+    return -total.dot(N.z)
+
+
+def bearing_force_x(f: Forces) -> sp.Expr:
+    """N_x (Eq. 35): horizontal force of the bearing at P on the follower.
+
+    The follower's centre of gravity P is fixed, so the bearing balances the
+    horizontal components of the applied forces.
+    """
+    total = sum((F for _, F in applied_forces(f)), Vector(0))
+    return -total.dot(N.x)
+
+
+def angular_acceleration(regime: ContactRegime | None) -> sp.Expr:
+    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free)."""
+    return moment_about_P(forces(regime)) / S.I_Pb

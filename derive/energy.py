@@ -1,0 +1,80 @@
+"""Energy of the follower, power flows, and the energy balance of Section 5 (Eqs. 30-33).
+
+The mechanical energy is E = T + V_s + V_c.  The spring's moment in Eq. 10,
+-F_s(alpha) d_x, depends on alpha only, so it has the potential
+
+    V_s(alpha) = integral of k_s d_x L(a) da,
+
+which is what the equation of motion conserves.  The paper's Eq. 33 uses a
+different one, Delta V = integral of k_s L L' da = (k_s/2)[L^2] (the spring's own
+strain energy); both are generated, and the printed one serves Figs. 7-8.
+
+Power flows (all >= 0 when the laws are dissipative):
+  D_c = -F_d psi_i_dot       dissipated by contact damping (F_d = -c psi_i_dot),
+  D_f = F_f v_r              dissipated by friction,
+  P_in                       delivered by the cam drive,
+with dE/dt = P_in - D_c - D_f, an identity checked symbolically in the tests.
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from . import dynamics, laws
+from . import symbols as S
+from .symbols import Theta, alpha, t
+
+
+def kinetic() -> sp.Expr:
+    return S.I_Pb * alpha.diff(t) ** 2 / 2
+
+
+def spring_potential() -> sp.Expr:
+    """V_s(alpha), the potential of the spring moment of Eq. 10 (zero at alpha = 0)."""
+    a = sp.Symbol("a", real=True)
+    integrand = S.k_s * S.d_x * laws.spring_compression(a)
+    return sp.integrate(integrand, (a, 0, alpha))
+
+
+def spring_potential_printed() -> sp.Expr:
+    """(k_s/2) L(alpha)^2, whose differences are Delta V of Eq. 33 in closed form."""
+    return S.k_s * laws.spring_compression(alpha) ** 2 / 2
+
+
+def contact_potential(contact: str) -> sp.Expr:
+    return laws.contact_potential(contact, dynamics.gap())
+
+
+def power_flows(regime: dynamics.ContactRegime) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+    """(P_in, D_c, D_f) in a contact regime.
+
+    P_in is the rate at which the contact forces do work on the follower's
+    energy minus what they dissipate, i.e. the power the cam delivers:
+    P_in = dE/dt + D_c + D_f with dE/dt from the equation of motion.
+    """
+    f = dynamics.forces(regime)
+    k = laws.contact_stiffness(regime.contact, dynamics.gap())
+    F_elastic = -k * dynamics.gap()
+    F_damping = f.F_n - F_elastic
+    D_c = -F_damping * dynamics.gap_rate()
+    D_f = f.F_f * f.v_r
+    alpha_ddot = dynamics.moment_about_P(f) / S.I_Pb
+    energy = kinetic() + spring_potential() + contact_potential(regime.contact)
+    dE_dt = energy.diff(t).subs(alpha.diff(t, 2), alpha_ddot)
+    return dE_dt + D_c + D_f, D_c, D_f
+
+
+def drive_power(regime: dynamics.ContactRegime) -> sp.Expr:
+    """Power of the cam drive from the forces on the cam: -(F_n n + F_f u) . v_c.
+
+    The follower pushes the cam with +F_n n + F_f u at its contact point; the
+    drive supplies the opposite power to keep the prescribed motion.
+    """
+    f = dynamics.forces(regime)
+    _, v_c = dynamics.material_point_velocities()
+    B = dynamics.B
+    return -(f.F_n * B.y + f.F_f * B.x).dot(v_c)
+
+
+def impact_kinetic_energy(xi: sp.Expr) -> sp.Expr:
+    """T_b of Eq. 32: the follower leaves the impact at (1 + xi) e Omega_c / chi* (Eq. 31)."""
+    return S.I_Pb * ((1 + xi) * S.e * S.Omega_c / S.chi_star) ** 2 / 2

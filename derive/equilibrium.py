@@ -1,0 +1,39 @@
+"""Static equilibrium (Eqs. 16-18) and the state-space Jacobian (Eqs. 19-22).
+
+At rest the cam stands at Theta = Theta0 and every rate is zero.  Eqs. 16-17
+are the loop (Eqs. 6-7) there; Eq. 18 is the moment balance, Eq. 10, with no
+rates: -F_s d_x + F_n chi = 0.  With psi_i* and psi_j* written as functions
+of alpha*, the three equations reduce to one, M(alpha*) = 0, which the runtime
+solves with M and dM/dalpha from here.  Friction is absent at rest (v_r = 0),
+as in the paper's Eq. 18.  Misprint 1: the printed Eq. 18 has the contact term
+with the wrong sign; ``tests/test_derive_equilibrium.py`` shows the derived one.
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from . import dynamics
+from . import symbols as S
+from .symbols import Theta, alpha, t
+
+
+def at_rest(expr: sp.Expr) -> sp.Expr:
+    """Set the cam to Theta0 and every time derivative to zero."""
+    return expr.subs({alpha.diff(t): 0, Theta.diff(t): 0}).subs(Theta, S.theta0)
+
+
+def static_gap() -> tuple[sp.Expr, sp.Expr]:
+    """(psi_i*, psi_j*) as functions of alpha: Eqs. 16 and 17."""
+    return at_rest(dynamics.gap()), at_rest(dynamics.psi_j())
+
+
+def static_moment(contact: str) -> sp.Expr:
+    """M(alpha) at rest, undamped and frictionless: Eq. 18 is M(alpha*) = 0."""
+    regime = dynamics.ContactRegime(contact=contact)
+    return at_rest(dynamics.moment_about_P(dynamics.forces(regime)))
+
+
+def state_jacobian(alpha_ddot: sp.Expr) -> sp.Matrix:
+    """J = d(alpha_dot, alpha_ddot)/d(alpha, alpha_dot), Eqs. 21-22, in plain symbols."""
+    h2 = S.to_plain(alpha_ddot)
+    return sp.Matrix([[0, 1], [h2.diff(S.alpha_s), h2.diff(S.alpha_dot)]])

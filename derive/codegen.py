@@ -34,7 +34,7 @@ OUTPUT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "psi_i": "m", "psi_j": "m", "psi_i_dot": "m/s", "F_s": "N", "F_n": "N", "F_f": "N",
                 "v_r": "m/s", "N_x": "N", "alpha_i": "rad", "energy": "J", "P_in": "W", "D_c": "W",
                 "D_f": "W", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2", "M": "N m",
-                "dM_dalpha": "N m/rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
+                "dM_dalpha": "N m/rad", "k_lambda": "N/m", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "reach_margin": "m", "V_s": "J", "V_s_printed": "J"}
 
 
@@ -45,10 +45,18 @@ class _Scalar(PythonCodePrinter):
     def _print_Abs(self, expr):
         return f"abs({self._print(expr.args[0])})"
 
+    def _print_SignedPow32(self, expr):
+        x = self._print(expr.args[0])
+        return f"({x})*sqrt(abs({x}))"
+
 
 class _Vector(NumPyPrinter):
     def __init__(self):
         super().__init__({"fully_qualified_modules": True})
+
+    def _print_SignedPow32(self, expr):
+        x = self._print(expr.args[0])
+        return f"({x})*numpy.sqrt(numpy.abs({x}))"
 
 
 def _param_names(exprs) -> list[str]:

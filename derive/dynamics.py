@@ -115,7 +115,7 @@ def forces(regime: ContactRegime | None) -> Forces:
     psi_i = gap()
     k = laws.contact_stiffness(regime.contact, psi_i)
     c = laws.damping_coefficient(regime.damping, regime.phase, k, psi_i, regime.damping_sign)
-    F_n = -k * psi_i - c * gap_rate()
+    F_n = laws.elastic_force(regime.contact, psi_i) - c * gap_rate()
     v_r = sliding_velocity(regime.sliding_velocity) if regime.friction != "none" else \
         sliding_velocity("kinematic")
     mu = laws.friction_coefficient(regime.friction, v_r, regime.direction)

@@ -52,8 +52,7 @@ def power_flows(regime: dynamics.ContactRegime) -> tuple[sp.Expr, sp.Expr, sp.Ex
     P_in = dE/dt + D_c + D_f with dE/dt from the equation of motion.
     """
     f = dynamics.forces(regime)
-    k = laws.contact_stiffness(regime.contact, dynamics.gap())
-    F_elastic = -k * dynamics.gap()
+    F_elastic = laws.elastic_force(regime.contact, dynamics.gap())
     F_damping = f.F_n - F_elastic
     D_c = -F_damping * dynamics.gap_rate()
     D_f = f.F_f * f.v_r

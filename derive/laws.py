@@ -54,6 +54,24 @@ def contact_stiffness(law: str, psi_i: sp.Expr) -> sp.Expr:
     raise ValueError(f"contact law {law!r} is not one of {CONTACT_LAWS}")
 
 
+class SignedPow32(sp.Function):
+    """x |x|^(1/2): the Hertz point-contact force shape, odd and C1.
+
+    Its derivative is written out, 1.5 |x|^(1/2), so generated Jacobians have no
+    0/0 at x = 0 (SymPy's product rule on k(x) x with k ~ |x|^(1/2) would).
+    """
+
+    def fdiff(self, argindex=1):
+        return sp.Rational(3, 2) * sp.sqrt(sp.Abs(self.args[0]))
+
+
+def elastic_force(law: str, psi_i: sp.Expr) -> sp.Expr:
+    """-k_lambda(psi_i) psi_i, the elastic part of F_n in Eq. 12."""
+    if law == "point":
+        return -sp.Rational(4, 3) * Y_e * sp.sqrt(S.r_c) * SignedPow32(psi_i)
+    return -contact_stiffness(law, psi_i) * psi_i
+
+
 def contact_potential(law: str, psi_i: sp.Expr) -> sp.Expr:
     """Elastic energy stored in the contact at deflection |psi_i| (psi_i <= 0).
 

@@ -226,9 +226,11 @@ def build(spec: SceneSpec) -> tuple[Function, ...]:
     M = equilibrium.static_moment(spec.contact)
     Mp = S.to_plain(M)
     psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap())
-    fns.append(Function("static_moment", ("alpha", "p"), ("M", "dM_dalpha", "psi_i", "psi_j"),
-                        (Mp, Mp.diff(S.alpha_s), psi_i_star, psi_j_star),
-                        "Static moment about P (N m) at Theta0, its slope, and psi_i*, psi_j* (Eqs. 16-18)."))
+    fns.append(Function("static_moment", ("alpha", "p"), ("M", "dM_dalpha", "psi_i", "psi_j", "k_lambda"),
+                        (Mp, Mp.diff(S.alpha_s), psi_i_star, psi_j_star,
+                         laws.contact_stiffness(spec.contact, psi_i_star)),
+                        "Static moment about P (N m) at Theta0, its slope, psi_i*, psi_j* (Eqs. 16-18) "
+                        "and the contact stiffness k_lambda(psi_i) (Eq. 13 or 34, secant)."))
     a_i = S.to_plain(geometry.rigid_contact_angle(S.Theta))
     a_i_th = a_i.diff(S.Theta_s)
     F_s_at = laws.spring_force(S.alpha_s).subs(S.alpha_s, a_i) * S.d_x

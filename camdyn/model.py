@@ -1,0 +1,154 @@
+"""A scene's generated kernels bound to one rig and one cam motion.
+
+:class:`Model` checks that the rig has every parameter the scene needs, that
+the geometry is possible, solves the static equilibrium (Eqs. 16-18), and
+packs the parameter vector once.  Nothing here is recomputed per kernel call.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from types import ModuleType
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import generated
+from .cam import CamMotion, ConstantSpeed
+from .errors import EquilibriumError, GeometryError, SceneError
+from .rig import Rig
+from .scene import Scene
+
+#: |alpha| beyond this is treated as the singular 90 degrees of Eq. 11 (tan, sec).
+ANGLE_LIMIT = math.pi / 2 - 0.02
+_DERIVED = ("alpha_star", "chi_star", "vartheta")
+_CAM = ("Omega_c", "Theta_p", "omega_c")
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """Static equilibrium at Theta = Theta0, all rates zero (Eqs. 16-18, 23)."""
+
+    alpha: float             # alpha* (rad)
+    psi_i: float             # psi_i* (m), negative: the contact deflection
+    psi_j: float             # psi_j* (m)
+    chi: float               # chi* = chi0 - psi_j* (m)
+    stiffness: float         # -dM/dalpha at alpha* (N m/rad): undamped, frictionless
+    contact_stiffness: float  # k_lambda(psi_i*) (N/m), the secant stiffness (misprint 5)
+    vartheta: float          # sqrt(stiffness / I_Pb) (rad/s), Eq. 23 with misprint 4 and 7
+
+    @property
+    def frequency_Hz(self) -> float:
+        return self.vartheta / (2 * math.pi)
+
+
+def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
+    """alpha* from M(alpha*) = 0 near the 0-state, with M from the generated ``static_moment``.
+
+    At alpha0 the gap is zero at Theta0, so M(alpha0) = -F_s d_x: the spring must
+    press the follower onto the cam (F_s > 0), else there is no contact at rest.
+    The contact moment grows as alpha turns into the cam (alpha < alpha0), so the
+    root is bracketed by stepping down from alpha0.
+    """
+    values = {**rig.to_dict(), **{k: 1.0 for k in _DERIVED + _CAM}}  # static_moment reads none of these
+    p = kernels.pack({k: values[k] for k in kernels.INPUTS if values.get(k) is not None})
+
+    def moment(a):
+        return kernels.static_moment(a, p)[0]
+
+    M0 = moment(rig.alpha0)
+    if not M0 < 0:
+        raise EquilibriumError(
+            f"no static equilibrium in contact: at the 0-state (alpha0 = {rig.alpha0:g} rad) the spring "
+            f"moment is {-M0:g} N m, so the spring does not press the follower onto the cam. "
+            "It needs F_s > 0 there (Eq. 11): increase L_us or lower d_y.")
+    step, lo = 1e-9, rig.alpha0
+    while moment(lo) <= 0:
+        lo = rig.alpha0 - step
+        step *= 4
+        if rig.alpha0 - lo > 0.5:
+            raise EquilibriumError("no static equilibrium within 0.5 rad of alpha0: the contact "
+                                   "cannot balance the spring moment (check l_lambda, Y_c, Y_b, k_s)")
+    a_star = brentq(moment, lo, rig.alpha0, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+    _, dM, psi_i, psi_j, k_lambda = kernels.static_moment(a_star, p)
+    if abs(a_star) > ANGLE_LIMIT:
+        raise GeometryError(f"static equilibrium alpha* = {a_star:g} rad is within "
+                            f"{math.pi / 2 - abs(a_star):.3g} rad of 90 degrees, where Eq. 11 is singular")
+    if not dM < 0:
+        raise EquilibriumError(f"the static equilibrium alpha* = {a_star:g} rad is unstable (dM/dalpha = {dM:g})")
+    return Equilibrium(float(a_star), float(psi_i), float(psi_j), float(rig.chi0 - psi_j), float(-dM),
+                       float(k_lambda), math.sqrt(-dM / rig.I_Pb))
+
+
+class Model:
+    """Scene kernels + rig + cam motion, ready to integrate."""
+
+    def __init__(self, rig: Rig, scene: Scene, cam: CamMotion):
+        if not isinstance(rig, Rig):
+            raise TypeError(f"rig must be a camdyn.Rig, got {type(rig).__name__}")
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a camdyn.Scene, got {type(scene).__name__}")
+        if getattr(cam, "kind", None) != scene.motion:
+            raise SceneError(f"the scene's motion is {scene.motion!r} but the cam given is "
+                             f"{type(cam).__name__} ({getattr(cam, 'kind', '?')!r})")
+        self.rig, self.scene, self.cam = rig, scene, cam
+        self.kernels = scene.kernels()
+        optional = [n for n in self.kernels.INPUTS if n not in _DERIVED + _CAM and getattr(rig, n) is None]
+        if optional:
+            rig.require(*optional, why=f"scene {scene.slug}")
+        self.equilibrium = solve_equilibrium(rig, self.kernels)
+        if scene.friction != "none" and self.equilibrium.chi <= rig.mu_m * rig.w_b / 2:
+            raise GeometryError(f"chi* = {self.equilibrium.chi:g} m <= mu_m w_b / 2: friction would lock "
+                                "the follower (the moment arm of Eq. 10 changes sign)")
+        self._check_reach()
+        eq = self.equilibrium
+        values = {**rig.to_dict(), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta,
+                  **cam.values()}
+        self.p = self.kernels.pack({k: values[k] for k in self.kernels.INPUTS})
+        self.flags = self.kernels.FLAGS
+        self.regimes = self.kernels.REGIMES
+
+    def _check_reach(self):
+        """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""
+        thetas = self.rig.theta0 + np.linspace(0, 2 * math.pi, 721)
+        p = self.kernels.pack({k: getattr(self.rig, k, None) or 1.0 for k in self.kernels.INPUTS})
+        margins = [self.kernels.rigid_contact(th, p)[4] for th in thetas]
+        worst = int(np.argmin(margins))
+        if not margins[worst] > 0:
+            raise GeometryError(
+                f"at cam angle Theta = {thetas[worst]:.4g} rad the cam centre is {-margins[worst]:.3g} m "
+                "too close to the pivot P: no follower angle touches the cam there (|PG_c| < r_c + w_b/2); "
+                "check e, r_c, w_b, chi0 and alpha0")
+
+    @cached_property
+    def period(self) -> float:
+        return self.cam.period
+
+    def regime_functions(self, name: str):
+        K = self.kernels
+        return getattr(K, f"rhs_{name}"), getattr(K, f"jac_{name}"), getattr(K, f"out_{name}_v")
+
+    def cam_state(self, t):
+        """(Theta, Theta_dot, Theta_ddot) at t (scalar or array)."""
+        if self.scene.motion == "user":
+            return self.cam(t)
+        return self.kernels.cam(t, self.p)
+
+    def bind(self, fn):
+        """A kernel f(t, alpha, alpha_dot, p[, cam]) as g(t, alpha, alpha_dot)."""
+        p = self.p
+        if self.scene.motion == "user":
+            cam = self.cam
+            return lambda t, a, ad: fn(t, a, ad, p, cam(t))
+        return lambda t, a, ad: fn(t, a, ad, p)
+
+    def static_state(self) -> np.ndarray:
+        return np.array([self.equilibrium.alpha, 0.0])
+
+
+def at_rest(rig: Rig, scene: Scene) -> Model:
+    """The model with the cam held still at Theta0 (for equilibrium-based analyses)."""
+    if scene.motion != "constant":
+        scene = Scene(**{**scene.__dict__, "motion": "constant"})
+    return Model(rig, scene, ConstantSpeed(0.0))

@@ -1,0 +1,25 @@
+"""How a simulation ended: an enum of actionable messages (after diffrax's RESULTS)."""
+from __future__ import annotations
+
+import enum
+
+
+class Outcome(enum.Enum):
+    SUCCESS = "the run reached t_end"
+    STEP_FAILED = ("the ODE solver could not take a step (step size underflow); tighten or loosen "
+                   "rtol/atol, or try method='Radau' for a very stiff contact")
+    MAX_EVENTS = ("more regime switches than EventSettings.max_events; the run may be chattering "
+                  "(Zeno-like impacts or Coulomb stick): raise max_events or use friction='tanh'")
+    CHATTER = ("a switching surface was crossed back and forth with no progress in time "
+               "(Coulomb stick or grazing); use friction='tanh' or a stick-slip treatment")
+    NONFINITE = "the state became NaN or infinite; check the rig parameters and tolerances"
+    ANGLE_LIMIT = ("the follower angle approached 90 degrees, where tan(alpha) and sec(alpha) of "
+                   "Eq. 11 blow up; the follower has left the cam for good")
+
+    @property
+    def ok(self) -> bool:
+        return self is Outcome.SUCCESS
+
+    @property
+    def message(self) -> str:
+        return self.value

@@ -1,0 +1,75 @@
+"""The result of a simulation: time histories, regimes, switches, outcome."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .integrate import Switch
+from .outcome import Outcome
+
+
+@dataclass
+class Result:
+    """Time histories of one run (SI units), sampled uniformly at ``t``.
+
+    Arrays: t, alpha, alpha_dot, Theta, alpha_i (rigid-contact angle, Eq. 29),
+    alpha_r = alpha - alpha_i (residual response, Section 4), psi_i, psi_j,
+    psi_i_dot, F_s, F_n, F_f, v_r, N_x, energy, P_in, D_c, D_f, and ``regime``
+    (the name of the regime active at each sample).  ``switches`` lists every
+    regime switch; ``outcome`` says how the run ended (check ``result.ok``).
+    """
+
+    t: np.ndarray
+    alpha: np.ndarray
+    alpha_dot: np.ndarray
+    Theta: np.ndarray
+    regime: np.ndarray
+    outputs: dict[str, np.ndarray]
+    switches: list[Switch]
+    outcome: Outcome
+    stats: dict
+    period: float
+    scene: str
+    alpha_star: float
+    meta: dict = field(default_factory=dict)
+
+    def __getattr__(self, name):
+        outputs = self.__dict__.get("outputs", {})
+        if name in outputs:
+            return outputs[name]
+        raise AttributeError(f"Result has no attribute {name!r}")
+
+    @property
+    def ok(self) -> bool:
+        return self.outcome.ok
+
+    @property
+    def alpha_r(self) -> np.ndarray:
+        return self.alpha - self.outputs["alpha_i"]
+
+    @property
+    def in_contact(self) -> np.ndarray:
+        return self.regime != "free"
+
+    def impacts(self) -> np.ndarray:
+        """Times at which contact starts (the gap closes)."""
+        return np.array([s.t for s in self.switches if s.surface == "contact" and s.before == "free"])
+
+    def separations(self) -> np.ndarray:
+        return np.array([s.t for s in self.switches if s.surface == "contact" and s.after == "free"])
+
+    def after(self, t0: float) -> "Result":
+        """The samples at t >= t0 (e.g. to drop a transient)."""
+        keep = self.t >= t0
+        return Result(self.t[keep], self.alpha[keep], self.alpha_dot[keep], self.Theta[keep],
+                      self.regime[keep], {k: v[keep] for k, v in self.outputs.items()},
+                      [s for s in self.switches if s.t >= t0], self.outcome, self.stats,
+                      self.period, self.scene, self.alpha_star, self.meta)
+
+    def summary(self) -> str:
+        lines = [f"scene {self.scene}: {self.outcome.name} ({self.outcome.message})",
+                 f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {self.t.size} samples" if self.t.size else "  no samples",
+                 f"  {len(self.switches)} regime switches, {self.impacts().size} impacts, "
+                 f"{self.stats.get('steps', 0)} steps, {self.stats.get('nfev', 0)} RHS evaluations"]
+        return "\n".join(lines)

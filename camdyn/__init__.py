@@ -26,7 +26,7 @@ _EXPORTS = {
     "Oscillating": "camdyn.cam",
     "UserMotion": "camdyn.cam",
     "Model": "camdyn.model",
-    "simulate": "camdyn.simulate",
+    "simulate": "camdyn.simulation",
     "Result": "camdyn.result",
     "Outcome": "camdyn.outcome",
     "static_equilibrium": "camdyn.analysis",

@@ -54,6 +54,8 @@ class Switch:
     surface: str
     before: str
     after: str
+    alpha: float
+    alpha_dot: float
 
 
 @dataclass
@@ -113,12 +115,11 @@ class _Regimes:
 
 
 def _fixed_regime(model: Model, t, y) -> tuple:
-    """Linear models: sliding contact throughout, Coulomb sign fixed by v_r at the start."""
-    names = list(model.regimes.values())
-    if len(names) == 1:
-        return ()
-    slip = model.bind(model.kernels.out_contact_fwd)(t, y[0], y[1])
-    return ("fwd",) if slip[6] >= 0 else ("bwd",)
+    """Linear models: sliding contact throughout; a Coulomb sign fixed by v_r at the start."""
+    if len(model.regimes) == 1:
+        return next(iter(model.regimes))
+    v_r = model.bind(model.kernels.out_contact_fwd)(t, y[0], y[1])[6]
+    return (bool(v_r >= 0),)
 
 
 def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
@@ -128,13 +129,8 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     y = np.asarray(y0, dtype=float)
     regimes = _Regimes(model)
     linear = not regimes.flags
-    if linear:
-        direction = _fixed_regime(model, t, y)
-        name_of = {(): "contact" + ("_" + direction[0] if direction else "")}
-        key = ()
-    else:
-        name_of = model.regimes
-        key = regimes.initial(t, y)
+    name_of = model.regimes
+    key = _fixed_regime(model, t, y) if linear else regimes.initial(t, y)
     method = METHODS[options.method]
     ts, ys, names, switches = [], [], [], []
     t_eval = np.asarray(t_eval, dtype=float)
@@ -188,7 +184,7 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
             if crossing:
                 t, y = crossing.t, np.asarray(crossing.y, dtype=float)
                 new_key = regimes.after(key, crossing.event.name, t, y)
-                switches.append(Switch(t, crossing.event.name, name, name_of[new_key]))
+                switches.append(Switch(t, crossing.event.name, name, name_of[new_key], float(y[0]), float(y[1])))
                 key = new_key
                 switched = True
                 recent = [s for s in recent if t - s < 1e-9 * max(1.0, abs(t))] + [t]

@@ -133,7 +133,7 @@ class Model:
         """(Theta, Theta_dot, Theta_ddot) at t (scalar or array)."""
         if self.scene.motion == "user":
             return self.cam(t)
-        return self.kernels.cam(t, self.p)
+        return self.kernels.cam_v(t, self.p) if np.ndim(t) else self.kernels.cam(t, self.p)
 
     def bind(self, fn):
         """A kernel f(t, alpha, alpha_dot, p[, cam]) as g(t, alpha, alpha_dot)."""

@@ -97,7 +97,8 @@ def _function_code(f: Function, params: list[str]) -> str:
     lines += [f"    {n} = p[{params.index(n)}]" for n in used]
     lines += [f"    {sym} = {printer.doprint(val)}" for sym, val in replacements]
     if f.vectorised:
-        lines.append("    _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)")
+        arrays = ", ".join(a for a in f.args if a in ("t", "alpha", "alpha_dot", "Theta"))
+        lines.append(f"    _zero = numpy.zeros(numpy.broadcast({arrays}).shape)")
         values = [f"{printer.doprint(r)} + _zero" for r in reduced]
     else:
         values = [printer.doprint(r) for r in reduced]

@@ -73,14 +73,14 @@ def elastic_force(law: str, psi_i: sp.Expr) -> sp.Expr:
 
 
 def contact_potential(law: str, psi_i: sp.Expr) -> sp.Expr:
-    """Elastic energy stored in the contact at deflection |psi_i| (psi_i <= 0).
+    """Elastic energy stored in the contact at deflection |psi_i| (psi_i <= 0 in contact).
 
     Built as the integral of the elastic normal force -k_lambda(psi) psi over the
     deflection, so that its derivative is the force of Eq. 12 by construction.
     """
     x, delta = sp.symbols("x delta", nonnegative=True)  # deflection, its final value
     energy = sp.integrate(contact_stiffness(law, -x) * x, (x, 0, delta))
-    return energy.subs(delta, -psi_i)
+    return energy.subs(delta, sp.Abs(psi_i))  # even in psi_i: finite on stage overshoot
 
 
 def viscous_coefficient(zeta: sp.Expr) -> sp.Expr:

@@ -125,8 +125,7 @@ def regimes(spec: SceneSpec) -> list[Regime]:
                 key.append(phase == "loading")
             if direction:
                 name += "_fwd" if direction > 0 else "_bwd"
-                if spec.model == "nonlinear":
-                    key.append(direction > 0)
+                key.append(direction > 0)  # linear models: fixed for the run, chosen at the start
             out.append(Regime(name, tuple(key), dynamics.ContactRegime(
                 contact=spec.contact, damping=spec.damping, phase=phase or "loading",
                 friction=spec.friction, direction=direction, damping_sign=spec.damping_sign,
@@ -196,9 +195,11 @@ def build(spec: SceneSpec) -> tuple[Function, ...]:
     fns: list[Function] = []
     if spec.motion != "user":
         sub = motion_substitution(spec.motion)
-        fns.append(Function("cam", ("t", "p"), ("Theta", "Theta_dot", "Theta_ddot"),
-                            tuple(sp.sympify(sub[k]) for k in (S.Theta_s, S.Theta_dot, S.Theta_ddot)),
-                            f"Cam angle (rad) and its rates at time t (s): {spec.motion} motion."))
+        for vec in (False, True):
+            fns.append(Function("cam" + ("_v" if vec else ""), ("t", "p"), ("Theta", "Theta_dot", "Theta_ddot"),
+                                tuple(sp.sympify(sub[k]) for k in (S.Theta_s, S.Theta_dot, S.Theta_ddot)),
+                                f"Cam angle (rad) and its rates at time t (s): {spec.motion} motion"
+                                + (", on arrays." if vec else "."), vectorised=vec))
     for regime in regimes(spec):
         h2 = _alpha_ddot(spec, regime)
         h2m = h2.subs(motion_substitution(spec.motion))

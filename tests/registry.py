@@ -1,0 +1,33 @@
+"""One registry of scenes and solvers, fed to pytest.mark.parametrize across the suite."""
+from __future__ import annotations
+
+import math
+
+import camdyn
+from camdyn import generated
+
+RIG = camdyn.example_rig()
+
+
+def scene_from_slug(slug: str) -> camdyn.Scene:
+    """Rebuild a Scene from a generated module's SCENE table."""
+    import importlib
+    mod = importlib.import_module(f"camdyn.generated.{generated.SCENES[slug]}")
+    return camdyn.Scene(**mod.SCENE)
+
+
+def cam_for(scene: camdyn.Scene, speed_rpm: float = 300.0):
+    if scene.motion == "constant":
+        return camdyn.ConstantSpeed(speed_rpm)
+    if scene.motion == "oscillating":
+        return camdyn.Oscillating(amplitude_pp=math.pi, frequency_rpm=40.0)
+    omega = speed_rpm * camdyn.cam.RPM
+    th0 = RIG.theta0
+    return camdyn.UserMotion(lambda t: th0 + omega * t, lambda t: omega + 0 * t, lambda t: 0 * t,
+                             period=2 * math.pi / omega)
+
+
+#: every generated scene, by slug
+SCENES = sorted(generated.SCENES)
+#: SciPy methods the reference backend supports with events
+METHODS = ["DOP853", "RK45", "Radau", "BDF", "LSODA"]

@@ -1,0 +1,174 @@
+"""The SciPy reference backend: physics checks with bounds from tolerance and FFT resolution."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import camdyn
+from camdyn import analysis, signal
+from registry import METHODS, RIG, SCENES, cam_for, scene_from_slug
+
+FRICTIONLESS = camdyn.Scene(damping="none", friction="none")
+
+
+@pytest.fixture(scope="module")
+def eq():
+    return analysis.static_equilibrium(RIG)
+
+
+def test_free_vibration_peak_is_the_jacobian_natural_frequency(eq):
+    """Cam at rest, small push off equilibrium: the FFT peak of alpha equals vartheta/2pi
+    (Eq. 23, misprint 4: |Im eig J| without the square root) within one FFT bin."""
+    r = camdyn.simulate(RIG, FRICTIONLESS, speed_rpm=0, t_end=0.1, y0=(eq.alpha + 2e-7, 0.0),
+                        sample_rate_Hz=50_000, rtol=1e-9, atol=1e-16)
+    assert r.ok and not r.switches  # stays in contact: the push is below the static deflection
+    f, amp = signal.spectrum(r.t, r.alpha)
+    peak = signal.peak_frequency(f, amp)
+    nf = analysis.natural_frequency(RIG, FRICTIONLESS)
+    assert abs(peak - nf.Hz) < signal.frequency_resolution(r.t)
+    # the printed |Im|^0.5 would be ~118 rad^0.5/s, nowhere near the peak
+    assert abs(peak - math.sqrt(nf.damped_rad_s) / (2 * math.pi)) > 1000
+
+
+@pytest.mark.parametrize("push", [2e-7, None], ids=["sliding", "bouncing"])
+def test_undamped_frictionless_conserves_energy(eq, push):
+    """No damping, no friction, cam at rest: E = T + V_s + V_c is constant, across impacts too.
+
+    Bound: 1e3 * rtol of the motion's energy scale (DOP853's global error over ~200
+    contact periods; measured 1.5e-6 at rtol 1e-8); tightening rtol by 100 must shrink it.
+    """
+    y0 = (eq.alpha + push, 0.0) if push else (eq.alpha, -0.5)
+    scale = 0.5 * eq.stiffness * push**2 if push else 0.5 * RIG.I_Pb * 0.5**2
+    drift = {}
+    for rtol in (1e-8, 1e-10):
+        r = camdyn.simulate(RIG, FRICTIONLESS, speed_rpm=0, t_end=0.1, y0=y0, sample_rate_Hz=20_000,
+                            rtol=rtol, atol=1e-16 if push else 1e-14)
+        assert r.ok
+        drift[rtol] = np.ptp(r.energy) / scale
+    if not push:
+        assert r.impacts().size > 10
+    assert drift[1e-8] < 1e3 * 1e-8
+    assert drift[1e-10] < drift[1e-8] / 5
+
+
+@pytest.fixture(scope="module")
+def impacting():
+    scene = camdyn.Scene(damping="D", friction="coulomb")
+    return camdyn.simulate(RIG, scene, speed_rpm=1100, revolutions=2, sample_rate_Hz=50_000, rtol=1e-9)
+
+
+def test_impacts_alternate_and_switch_on_the_surface(impacting):
+    r = impacting
+    assert r.ok and r.impacts().size >= 5
+    K = camdyn.Scene(damping="D", friction="coulomb").kernels()
+    from camdyn.model import Model
+    m = Model(RIG, camdyn.Scene(damping="D", friction="coulomb"), camdyn.ConstantSpeed(1100))
+    contact = [s for s in r.switches if s.surface == "contact"]
+    for a, b in zip(contact, contact[1:]):
+        assert (a.after == "free") != (b.after == "free")
+    gap = m.bind(K.gap)
+    for s in contact:  # located on the far side, within the root tolerance (xtol ~1e-14 s)
+        g = gap(s.t, s.alpha, s.alpha_dot)
+        assert abs(g) < 1e-12
+        assert (g >= 0) if s.after == "free" else (g <= 0)
+
+
+def test_regime_agrees_with_gap_and_gap_rate(impacting):
+    r = impacting
+    contact = r.regime != "free"
+    tol = 1e-12  # m: samples within this of the surface may be on either side
+    assert np.all(r.psi_i[contact] < tol) and np.all(r.psi_i[~contact] > -tol)
+    loading = np.char.find(r.regime.astype(str), "_loading") >= 0
+    unloading = np.char.find(r.regime.astype(str), "_unloading") >= 0
+    assert loading.any() and unloading.any()
+    rate_tol = 1e-9  # m/s
+    assert np.all(r.psi_i_dot[loading] < rate_tol) and np.all(r.psi_i_dot[unloading] > -rate_tol)
+    # Coulomb direction follows the sign of v_r
+    fwd = np.char.endswith(r.regime.astype(str), "_fwd")
+    assert np.all(r.v_r[fwd] > -1e-9)
+
+
+def test_D_force_is_continuous_at_maximum_compression(impacting):
+    """At psi_i_dot = 0 both laws of model D give the same force, so the switch needs no jump."""
+    switches = [s for s in impacting.switches if s.surface == "loading"]
+    assert switches
+    from camdyn.model import Model
+    scene = camdyn.Scene(damping="D", friction="coulomb")
+    m = Model(RIG, scene, camdyn.ConstantSpeed(1100))
+    for s in switches[:10]:
+        out_before = m.bind(getattr(m.kernels, f"out_{s.before}_v"))(s.t, s.alpha, s.alpha_dot)
+        out_after = m.bind(getattr(m.kernels, f"out_{s.after}_v"))(s.t, s.alpha, s.alpha_dot)
+        F_before, F_after = out_before[4], out_after[4]
+        assert abs(F_before - F_after) <= 1e-6 * max(1.0, abs(F_before))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_methods_agree_on_impact_times(method):
+    """Every SciPy method finds the same impacts as DOP853 at tight tolerance.
+
+    Bound 2e-6 s: both runs at rtol 1e-10; impact times are sensitive to the
+    state at a grazing-free crossing at about |dgap/dt|^-1 * state error."""
+    scene = camdyn.Scene(damping="D", friction="none")
+    kw = dict(speed_rpm=1100, revolutions=0.5, sample_rate_Hz=2000, rtol=1e-10, atol=1e-13)
+    ref = camdyn.simulate(RIG, scene, **kw).impacts()
+    r = camdyn.simulate(RIG, scene, method=method, **kw)
+    assert r.ok, r.outcome
+    assert r.impacts().size == ref.size > 2
+    np.testing.assert_allclose(r.impacts(), ref, rtol=0, atol=2e-6)
+
+
+@pytest.mark.parametrize("slug", SCENES)
+def test_every_generated_scene_runs(slug):
+    scene = scene_from_slug(slug)
+    r = camdyn.simulate(RIG, scene, cam_for(scene), t_end=0.03, sample_rate_Hz=10_000)
+    assert r.ok, r.outcome
+    for name in ("alpha", "alpha_dot", "Theta"):
+        assert np.all(np.isfinite(getattr(r, name)))
+    for name, v in r.outputs.items():
+        assert np.all(np.isfinite(v)), name
+
+
+def test_user_motion_equals_the_builtin_constant_speed():
+    base = camdyn.Scene(damping="D", friction="tanh")
+    user = camdyn.Scene(damping="D", friction="tanh", motion="user")
+    a = camdyn.simulate(RIG, base, speed_rpm=300, t_end=0.05, rtol=1e-10)
+    b = camdyn.simulate(RIG, user, cam_for(user, 300), t_end=0.05, rtol=1e-10)
+    np.testing.assert_allclose(b.alpha, a.alpha, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b.F_n, a.F_n, rtol=1e-6)
+
+
+def test_contact_loss_speed_separates_sliding_from_impacting():
+    """Inverse kinematics (Section 6) against simulation: 10% below the predicted speed the
+    follower never leaves the cam after the start-up transient; 10% above it does.
+
+    Starting from rest at equilibrium, the required contact force steps at t = 0 and the
+    lightly damped contact mode (zeta_D = 0.01) overshoots, so the first revolution may bounce.
+    """
+    loss = analysis.contact_loss_speed(RIG)
+    scene = camdyn.Scene(damping="D", friction="coulomb")
+    below = camdyn.simulate(RIG, scene, speed_rpm=0.9 * loss, revolutions=3, sample_rate_Hz=5000)
+    above = camdyn.simulate(RIG, scene, speed_rpm=1.1 * loss, revolutions=3, sample_rate_Hz=5000)
+    assert below.ok and above.ok
+    assert below.after(below.period).impacts().size == 0
+    assert above.after(above.period).impacts().size > 0
+
+
+@pytest.mark.parametrize("sign, loses", [("dissipative", True), ("printed", False)])
+def test_misprint_2_damping_B_sign_by_energy_over_an_impact(eq, sign, loses):
+    """Misprint 2: c = beta k psi_i as printed is negative in contact and adds energy over an
+    impact; the dissipative c = beta k |psi_i| removes it.  Cam at rest, no friction: the
+    energy in free flight after the first impact is compared with that before it."""
+    scene = camdyn.Scene(damping="B", friction="none", damping_sign=sign)
+    r = camdyn.simulate(RIG, scene, speed_rpm=0, t_end=0.05, y0=(eq.alpha + 1e-5, -1.0),
+                        sample_rate_Hz=200_000, rtol=1e-10, atol=1e-14)
+    # the printed sign pumps energy in at every impact until the follower swings to 90 degrees
+    assert r.ok if loses else r.outcome in (camdyn.Outcome.SUCCESS, camdyn.Outcome.ANGLE_LIMIT)
+    assert r.impacts().size >= 1 and r.separations().size >= 1
+    t_in, t_out = r.impacts()[0], r.separations()[0]
+    E_before = r.energy[(r.t < t_in)][-1]
+    E_after = r.energy[(r.t > t_out) & (r.regime == "free")][0]
+    change = (E_after - E_before) / E_before
+    assert abs(change) > 1e-3  # far above the solver's ~1e-8 energy error
+    assert (change < 0) == loses

@@ -83,6 +83,8 @@ def rigid_contact_angle(rig: Rig, theta, contact: str = "line") -> np.ndarray:
     K = _static_scene(contact).kernels()
     p = K.pack({k: (getattr(rig, k, None) if getattr(rig, k, None) is not None else 1.0) for k in K.INPUTS})
     theta = np.asarray(theta, dtype=float)
+    if np.any(np.vectorize(lambda th: K.reach(th, p))(theta) <= 0):
+        raise GeometryError("the follower cannot reach the cam at some of these cam angles")
     return np.vectorize(lambda th: K.rigid_contact(th, p)[0], otypes=[float])(theta)
 
 
@@ -100,10 +102,10 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     K = _static_scene("line").kernels()
     p = K.pack({k: (getattr(rig, k, None) if getattr(rig, k, None) is not None else 1.0) for k in K.INPUTS})
     thetas = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
-    rows = np.array([K.rigid_contact(th, p) for th in thetas])
-    alpha_i, _, curvature, spring_moment, margin = rows.T
+    margin = np.array([K.reach(th, p) for th in thetas])
     if np.any(margin <= 0):
         raise GeometryError("the follower cannot reach the cam at some cam angle (|PG_c| < r_c + w_b/2)")
+    alpha_i, _, curvature, spring_moment = np.array([K.rigid_contact(th, p) for th in thetas]).T
     if np.any(np.abs(alpha_i) > ANGLE_LIMIT):
         raise GeometryError("in rigid contact the follower would pass 90 degrees over a revolution")
     if np.any(spring_moment <= 0):
@@ -113,7 +115,7 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
         return math.inf
 
     def ratio(th):
-        _, _, c, m, _ = K.rigid_contact(th, p)
+        _, _, c, m = K.rigid_contact(th, p)
         return m / (-rig.I_Pb * c) if c < 0 else math.inf
 
     i = int(np.argmin(np.where(pulling, spring_moment / (-rig.I_Pb * np.where(pulling, curvature, -1)), np.inf)))
@@ -132,7 +134,8 @@ def energy_balance_peak(rig: Rig, speed_rpm: float, xi: float, *, potential: str
     The follower leaves the impact with kinetic energy T_b = 0.5 I_Pb ((1+xi) e Omega_c / chi*)^2
     and swings away from the cam until the spring has taken it: V(alpha_p) - V(alpha*) = T_b.
     ``potential="printed"`` uses Eq. 33 ((k_s/2) L^2); "consistent" the potential of
-    Eq. 10's spring moment.  Returns alpha_p - alpha*, saturating at 90 degrees.
+    Eq. 10's spring moment.  Returns alpha_p - alpha*.  Both potentials grow without
+    bound towards 90 degrees (tan, sec in L), so alpha_p approaches but never reaches it.
     """
     if not (isinstance(xi, (int, float)) and 0 <= xi <= 1):
         raise ParameterError("xi", xi, "0 <= xi <= 1 (coefficient of restitution)")

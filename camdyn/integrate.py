@@ -17,7 +17,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from .errors import ParameterError
-from .events import Event, EventSettings, first_crossing
+from .events import Crossing, Event, EventSettings, first_crossing
 from .model import ANGLE_LIMIT, Model
 from .outcome import Outcome
 
@@ -122,6 +122,20 @@ def _fixed_regime(model: Model, t, y) -> tuple:
     return (bool(v_r >= 0),)
 
 
+def _left_the_surface(events, t0, y0, t1, y1) -> Crossing | None:
+    """A step that starts exactly on a watched surface (g = 0: the initial state, or a
+    restart at a root located exactly) and ends strictly on the leaving side has left the
+    regime at its start.  ``first_crossing`` does not count g0 = 0 as a crossing (so a
+    restart cannot re-trigger itself); this catches the genuine case, e.g. a follower
+    starting on the cam and moving away, which would otherwise stay in contact with a
+    tensile force.  The switch happens at t0, before any sample of the step is kept.
+    """
+    for index, ev in enumerate(events):
+        if ev.fn(t0, y0) == 0 and ev.direction * ev.fn(t1, y1) > 0:
+            return Crossing(ev, index, t0, np.array(y0, dtype=float))
+    return None
+
+
 def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
               options: SolverOptions = SolverOptions()) -> Trajectory:
     """Integrate the hybrid model from y0 = (alpha, alpha_dot) over t_span, sampling at t_eval."""
@@ -172,6 +186,7 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
                 break
             dense = solver.dense_output()
             crossing = first_crossing(events, dense, t_old, t_new, y, y_new, options.events) if events else None
+            crossing = crossing or _left_the_surface(events, t_old, y, t_new, y_new)
             t_stop = crossing.t if crossing else t_new
             hi = np.searchsorted(t_eval, t_stop, side="right")
             if hi > next_sample:

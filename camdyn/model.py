@@ -113,7 +113,7 @@ class Model:
         """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""
         thetas = self.rig.theta0 + np.linspace(0, 2 * math.pi, 721)
         p = self.kernels.pack({k: getattr(self.rig, k, None) or 1.0 for k in self.kernels.INPUTS})
-        margins = [self.kernels.rigid_contact(th, p)[4] for th in thetas]
+        margins = [self.kernels.reach(th, p) for th in thetas]
         worst = int(np.argmin(margins))
         if not margins[worst] > 0:
             raise GeometryError(

@@ -235,11 +235,15 @@ def build(spec: SceneSpec) -> tuple[Function, ...]:
     a_i = S.to_plain(geometry.rigid_contact_angle(S.Theta))
     a_i_th = a_i.diff(S.Theta_s)
     F_s_at = laws.spring_force(S.alpha_s).subs(S.alpha_s, a_i) * S.d_x
+    fns.append(Function("reach", ("Theta", "p"), ("reach_margin",),
+                        (S.to_plain(geometry.reach_margin(S.Theta)),),
+                        "|PG_c| - (r_c + w_b/2): where negative, no follower angle touches the cam "
+                        "(check it before rigid_contact, whose arcsine needs it positive)."))
     fns.append(Function("rigid_contact", ("Theta", "p"),
-                        ("alpha_i", "dalpha_i_dTheta", "d2alpha_i_dTheta2", "spring_moment", "reach_margin"),
-                        (a_i, a_i_th, a_i_th.diff(S.Theta_s), F_s_at, S.to_plain(geometry.reach_margin(S.Theta))),
+                        ("alpha_i", "dalpha_i_dTheta", "d2alpha_i_dTheta2", "spring_moment"),
+                        (a_i, a_i_th, a_i_th.diff(S.Theta_s), F_s_at),
                         "Follower angle in rigid contact alpha_i(Theta) (Eq. 29, misprint 10), its "
-                        "derivatives in Theta, the spring moment F_s d_x there, and |PG_c| - (r_c + w_b/2)."))
+                        "derivatives in Theta, and the spring moment F_s d_x there."))
     fns.append(Function("spring_potential", ("alpha", "p"), ("V_s", "V_s_printed"),
                         (S.to_plain(energy.spring_potential()), S.to_plain(energy.spring_potential_printed())),
                         "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33."))

@@ -172,3 +172,15 @@ def test_misprint_2_damping_B_sign_by_energy_over_an_impact(eq, sign, loses):
     change = (E_after - E_before) / E_before
     assert abs(change) > 1e-3  # far above the solver's ~1e-8 energy error
     assert (change < 0) == loses
+
+
+@pytest.mark.parametrize("speed", [0.0, 1.0])
+def test_start_exactly_on_the_cam_moving_away_separates(speed):
+    """Regression: a start with gap psi_i = 0 exactly and the follower moving away must
+    switch to free flight at once, not stay in contact pulled by a tensile force."""
+    r = camdyn.simulate(RIG, camdyn.Scene(damping="D", friction="none"), speed_rpm=speed,
+                        t_end=0.002, y0=(RIG.alpha0, 5.0), sample_rate_Hz=100_000)
+    assert r.ok
+    assert np.all(r.regime[1:] == "free") and np.all(r.psi_i[1:] > 0)
+    assert np.all(r.F_n == 0)
+    assert r.switches and r.switches[0].t == 0.0

@@ -1,0 +1,155 @@
+"""Model setup, analyses, and bad input: every error names the parameter and the valid range."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import camdyn
+from camdyn import analysis
+from camdyn.errors import EquilibriumError, GeometryError, ParameterError, SceneError
+from camdyn.model import Model
+from registry import RIG
+
+
+def test_equilibrium_satisfies_eqs_16_to_18():
+    eq = analysis.static_equilibrium(RIG)
+    K = camdyn.Scene(damping="none", friction="none").kernels()
+    from camdyn.model import _DERIVED, _CAM  # noqa: F401
+    m = Model(RIG, camdyn.Scene(damping="none", friction="none"), camdyn.ConstantSpeed(0))
+    M, dM, psi_i, psi_j, k = K.static_moment(eq.alpha, m.p)
+    scale = k * abs(eq.psi_i) * eq.chi  # the contact moment being balanced
+    assert abs(M) < 1e-9 * scale
+    assert psi_i < 0 and psi_i == eq.psi_i and eq.chi == pytest.approx(RIG.chi0 - psi_j, abs=0)
+    # Eq. 18 derived (misprint 1): -F_s d_x - k psi_i* chi* = 0, evaluated independently
+    L = RIG.L_us - RIG.d_y + RIG.d_x * math.tan(eq.alpha) - 0.5 * RIG.w_b / math.cos(eq.alpha)
+    assert -RIG.k_s * L * RIG.d_x - k * psi_i * eq.chi == pytest.approx(0, abs=1e-8 * scale)
+
+
+def test_line_contact_stiffness_is_the_papers_138_MN_per_m():
+    """Eq. 13 with steel (200 GPa, 0.3) and l = 1.6 mm: the paper quotes 138 MN/m (3 digits)."""
+    eq = analysis.static_equilibrium(RIG)
+    assert eq.contact_stiffness == pytest.approx(138e6, rel=5e-3)  # paper's rounding
+    Ye = 200e9 / (2 * (1 - 0.3**2))
+    assert eq.contact_stiffness == pytest.approx(math.pi / 4 * Ye * 0.0016, rel=1e-12)
+
+
+def test_point_contact_tangent_is_1_5_times_secant():
+    """Misprint 5: the quoted point stiffness is the secant k(psi*); the dynamics see 1.5x it."""
+    eq = analysis.static_equilibrium(RIG, "point")
+    tangent = eq.stiffness / eq.chi**2  # -dM/dalpha / chi^2, up to spring and geometric terms
+    spring = RIG.k_s * RIG.d_x**2  # spring's share of -dM/dalpha at alpha ~ 0
+    assert (eq.stiffness - spring) / eq.chi**2 == pytest.approx(1.5 * eq.contact_stiffness, rel=2e-3)
+    assert tangent > eq.contact_stiffness
+
+
+def test_friction_direction_orders_the_natural_frequencies():
+    """Section 7.1: de-energizing (cam counter-clockwise) above frictionless above self-energizing."""
+    scene = camdyn.Scene(damping="D", friction="coulomb")
+    de = analysis.natural_frequency(RIG, scene, camdyn.ConstantSpeed(300)).Hz
+    self_ = analysis.natural_frequency(RIG, scene, camdyn.ConstantSpeed(-300)).Hz
+    none = analysis.natural_frequency(RIG).Hz
+    assert de > none > self_
+    # the paper's ratio 2182/2125 comes from (chi* +/- 0.5 mu w_b); check that form
+    ratio = (RIG.chi0 + 0.5 * RIG.mu_m * RIG.w_b) / (RIG.chi0 - 0.5 * RIG.mu_m * RIG.w_b)
+    assert (de / self_) ** 2 == pytest.approx(ratio, rel=2e-3)
+
+
+def test_rigid_contact_angle_is_alpha0_at_theta0_and_continuous():
+    rig = RIG.replace(theta0=0.0)  # the 0-state mid-stroke, so alpha_i takes both signs
+    th = rig.theta0 + np.linspace(0, 2 * math.pi, 2001)
+    a = analysis.rigid_contact_angle(rig, th)
+    assert a[0] == pytest.approx(rig.alpha0, abs=1e-15)
+    assert np.max(np.abs(np.diff(a))) < 1e-3
+    assert a.min() < 0 < a.max()  # both signs: the printed arccos would lose one (misprint 10)
+
+
+def test_energy_balance_grows_with_speed_towards_90_degrees():
+    """Eqs. 31-33: alpha_p rises with speed and xi, and stays below 90 degrees (L ~ sec alpha)."""
+    eq = analysis.static_equilibrium(RIG)
+    peaks = [analysis.energy_balance_peak(RIG, speed, 1.0) for speed in (150, 1e3, 1e4, 1e5)]
+    assert 0 < peaks[0] and np.all(np.diff(peaks) > 0)
+    assert peaks[-1] < math.pi / 2 - eq.alpha and peaks[-1] > 1.4
+    assert analysis.energy_balance_peak(RIG, 150, 0.2) > analysis.energy_balance_peak(RIG, 150, 0.05)
+
+
+# --- bad input ---------------------------------------------------------------------
+
+def _message(excinfo):
+    return str(excinfo.value)
+
+
+def test_spring_that_does_not_press_the_follower_has_no_equilibrium():
+    rig = RIG.replace(L_us=RIG.d_y - 0.05)
+    with pytest.raises(EquilibriumError, match="does not press the follower"):
+        analysis.static_equilibrium(rig)
+
+
+def test_cam_that_the_follower_cannot_reach():
+    rig = RIG.replace(chi0=0.01, e=0.02, r_c=0.025)
+    with pytest.raises(GeometryError, match="cannot|too close"):
+        Model(rig, camdyn.Scene(), camdyn.ConstantSpeed(100))
+
+
+def test_alpha_near_90_degrees_is_refused_early():
+    with pytest.raises(ParameterError, match="alpha0"):
+        RIG.replace(alpha0=math.pi / 2 - 0.01)
+
+
+def test_missing_parameter_for_the_scene_names_it():
+    rig = RIG.replace(beta_D=None)
+    with pytest.raises(ParameterError, match="beta_D"):
+        camdyn.simulate(rig, camdyn.Scene(damping="D"), speed_rpm=100, t_end=0.01)
+    camdyn.simulate(rig, camdyn.Scene(damping="none", friction="none"), speed_rpm=100, t_end=0.001)
+
+
+@pytest.mark.parametrize("options, text", [
+    ({"damping": "F"}, "damping='F' is not one of"),
+    ({"contact": "edge"}, "contact='edge'"),
+    ({"damping": "C", "friction": "tanh", "motion": "oscillating"}, "is not generated"),
+])
+def test_scene_errors(options, text):
+    with pytest.raises(SceneError, match=text):
+        camdyn.Scene(**options)
+
+
+def test_unknown_scene_says_how_to_generate_it():
+    with pytest.raises(SceneError) as info:
+        camdyn.Scene(damping="C", friction="tanh")
+    assert "derive/catalog.py" in _message(info) and "python -m camdyn.derive" in _message(info)
+
+
+def test_cam_kind_must_match_the_scene():
+    with pytest.raises(SceneError, match="motion"):
+        camdyn.simulate(RIG, camdyn.Scene(), camdyn.Oscillating(math.pi, 40), t_end=0.01)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"speed_rpm": float("nan"), "t_end": 0.1}, "speed_rpm"),
+    ({"speed_rpm": 100, "t_end": -1.0}, "t_end"),
+    ({"speed_rpm": 100, "t_end": 0.1, "revolutions": 2}, "t_end"),
+    ({"speed_rpm": 100, "t_end": 0.1, "rtol": 0.5}, "rtol"),
+    ({"speed_rpm": 100, "t_end": 0.1, "atol": 0.0}, "atol"),
+    ({"speed_rpm": 100, "t_end": 0.1, "method": "Euler"}, "method"),
+    ({"speed_rpm": 100, "t_end": 0.1, "sample_rate_Hz": 0}, "sample_rate_Hz"),
+    ({"speed_rpm": 100, "t_end": 1e6, "sample_rate_Hz": 1e6}, "sample_rate_Hz"),
+    ({"speed_rpm": 100, "t_end": 0.1, "y0": (0.1,)}, "y0"),
+    ({"speed_rpm": 0, "revolutions": 2}, "revolutions"),
+    ({"t_end": 0.1}, "cam"),
+])
+def test_simulate_rejects_bad_arguments_by_name(kwargs, name):
+    with pytest.raises(ParameterError) as info:
+        camdyn.simulate(RIG, camdyn.Scene(), **kwargs)
+    assert info.value.name == name
+    assert name in _message(info)
+
+
+def test_follower_leaving_for_good_stops_with_a_clear_outcome():
+    """A violent start (300 rad/s away from the cam) swings the follower towards 90 degrees:
+    the run stops with ANGLE_LIMIT and says why, instead of overflowing tan/sec."""
+    r = camdyn.simulate(RIG, camdyn.Scene(damping="D", friction="none"), speed_rpm=100, t_end=1.0,
+                        y0=(0.0, 300.0))
+    assert r.outcome is camdyn.Outcome.ANGLE_LIMIT and not r.ok
+    assert "90 degrees" in r.outcome.message
+    assert np.all(np.isfinite(r.alpha)) and np.all(np.abs(r.alpha) < math.pi / 2)

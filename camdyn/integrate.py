@@ -81,9 +81,17 @@ class _Regimes:
                          for f in self.flags}
 
     def _side(self, flag, t, y, default=True) -> bool:
+        """Whether the state is on the flag's side; on the surface itself, where it is heading.
+
+        The look-ahead moves alpha by its rate over a tiny time (exact to first order for
+        the gap, which depends on t and alpha only; a fair guess for the other surfaces).
+        """
         g, true_sign = self.surfaces[flag]
         value = g(t, y[0], y[1])
-        return default if value == 0 else (np.sign(value) == true_sign)
+        if value == 0:
+            h = 1e-9 * max(1.0, abs(t))
+            value = g(t + h, y[0] + h * y[1], y[1])
+        return default if value == 0 else bool(np.sign(value) == true_sign)
 
     def initial(self, t, y) -> tuple:
         if not self.flags:

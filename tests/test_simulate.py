@@ -181,6 +181,5 @@ def test_start_exactly_on_the_cam_moving_away_separates(speed):
     r = camdyn.simulate(RIG, camdyn.Scene(damping="D", friction="none"), speed_rpm=speed,
                         t_end=0.002, y0=(RIG.alpha0, 5.0), sample_rate_Hz=100_000)
     assert r.ok
-    assert np.all(r.regime[1:] == "free") and np.all(r.psi_i[1:] > 0)
-    assert np.all(r.F_n == 0)
-    assert r.switches and r.switches[0].t == 0.0
+    assert np.all(r.regime == "free") and np.all(r.psi_i[1:] > 0)
+    assert np.all(r.F_n == 0)  # the viscous law of D would give tension at psi_i = 0 here

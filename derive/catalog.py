@@ -19,6 +19,7 @@ CATALOG: tuple[SceneSpec, ...] = tuple(_IMPACT + [
     SceneSpec(damping="D", friction="none"),
     SceneSpec(damping="B", friction="none"),
     SceneSpec(damping="B", friction="none", damping_sign="printed"),
+    SceneSpec(damping="D", friction="none", damping_sign="printed"),
     # Section 6: point contact
     SceneSpec(contact="point", damping="D", friction="coulomb"),
     SceneSpec(contact="point", damping="none", friction="none"),

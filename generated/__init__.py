@@ -25,6 +25,7 @@ SCENES = {
     'line_d_coulomb_oscillating_nonlinear': 'scene_line_d_coulomb_oscillating_nonlinear',
     'line_d_coulomb_oscillating_nonlinear_vrprinted': 'scene_line_d_coulomb_oscillating_nonlinear_vrprinted',
     'line_d_none_constant_nonlinear': 'scene_line_d_none_constant_nonlinear',
+    'line_d_none_constant_nonlinear_printedsign': 'scene_line_d_none_constant_nonlinear_printedsign',
     'line_d_tanh_constant_nonlinear': 'scene_line_d_tanh_constant_nonlinear',
     'line_d_tanh_constant_nonlinear_vrprinted': 'scene_line_d_tanh_constant_nonlinear_vrprinted',
     'line_d_tanh_oscillating_nonlinear': 'scene_line_d_tanh_oscillating_nonlinear',

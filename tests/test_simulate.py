@@ -183,3 +183,18 @@ def test_start_exactly_on_the_cam_moving_away_separates(speed):
     assert r.ok
     assert np.all(r.regime == "free") and np.all(r.psi_i[1:] > 0)
     assert np.all(r.F_n == 0)  # the viscous law of D would give tension at psi_i = 0 here
+
+
+@pytest.mark.parametrize("damping", ["B", "D"])
+@pytest.mark.parametrize("sign", ["dissipative", "printed"])
+def test_misprint_2_damping_power_sign_during_approach(eq, damping, sign):
+    """Misprint 2, power view: while the gap closes (t_a..t_b), the impact law of B and D
+    dissipates (D_c = c psi_i_dot^2 >= 0) with |psi_i|, and feeds energy in (D_c <= 0) as printed."""
+    scene = camdyn.Scene(damping=damping, friction="none", damping_sign=sign)
+    r = camdyn.simulate(RIG, scene, speed_rpm=0, t_end=0.004, y0=(eq.alpha + 1e-5, -1.0),
+                        sample_rate_Hz=1_000_000, rtol=1e-10, atol=1e-14)
+    approach = (r.regime != "free") & (r.psi_i_dot < 0)
+    assert approach.sum() > 20
+    D_c = r.D_c[approach]
+    assert np.all(D_c >= 0) if sign == "dissipative" else np.all(D_c <= 0)
+    assert np.abs(D_c).max() > 0

@@ -1,0 +1,1 @@
+"""Rig files shipped with camdyn (TOML)."""

@@ -11,7 +11,8 @@ strain energy); both are generated, and the printed one serves Figs. 7-8.
 
 Power flows (all >= 0 when the laws are dissipative):
   D_c = -F_d psi_i_dot       dissipated by contact damping (F_d = -c psi_i_dot),
-  D_f = F_f v_r              dissipated by friction,
+  D_f = F_f v_r              dissipated by friction (kinematic v_r, even when the
+                             law's sign follows the printed v_r),
   P_in                       delivered by the cam drive,
 with dE/dt = P_in - D_c - D_f, an identity checked symbolically in the tests.
 """
@@ -55,7 +56,9 @@ def power_flows(regime: dynamics.ContactRegime) -> tuple[sp.Expr, sp.Expr, sp.Ex
     F_elastic = laws.elastic_force(regime.contact, dynamics.gap())
     F_damping = f.F_n - F_elastic
     D_c = -F_damping * dynamics.gap_rate()
-    D_f = f.F_f * f.v_r
+    # the friction force does work through the true relative velocity of the contact
+    # points, whatever v_r its law uses for its sign (misprint 8's printed form)
+    D_f = f.F_f * dynamics.sliding_velocity("kinematic")
     alpha_ddot = dynamics.moment_about_P(f) / S.I_Pb
     energy = kinetic() + spring_potential() + contact_potential(regime.contact)
     dE_dt = energy.diff(t).subs(alpha.diff(t, 2), alpha_ddot)

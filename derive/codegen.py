@@ -35,7 +35,8 @@ OUTPUT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "v_r": "m/s", "N_x": "N", "alpha_i": "rad", "energy": "J", "P_in": "W", "D_c": "W",
                 "D_f": "W", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2", "M": "N m",
                 "dM_dalpha": "N m/rad", "k_lambda": "N/m", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
-                "spring_moment": "N m", "reach_margin": "m", "V_s": "J", "V_s_printed": "J"}
+                "spring_moment": "N m", "reach_margin": "m", "dv_r_dt": "m/s^2", "dv_r_dalpha": "m/s/rad", "dv_r_dalpha_dot": "m/rad", "V_s": "J", "V_s_printed": "J",
+                "surface": "m or m/s"}
 
 
 class _Scalar(PythonCodePrinter):
@@ -83,15 +84,21 @@ class _Module:
 
 
 def _function_code(f: Function, params: list[str]) -> str:
-    printer = _Vector() if f.vectorised else _Scalar()
-    replacements, reduced = sp.cse(list(f.exprs), symbols=sp.numbered_symbols("x"), order="canonical")
-    used = _param_names(list(f.exprs))
     lines = [f"def {f.name}({', '.join(f.args)}):"]
     doc = [f.doc, "", "Arguments:"]
     doc += [f"    {a}: {STATE_ARGS[a]}" for a in f.args]
     doc += ["Returns" + (" (a tuple):" if len(f.outputs) > 1 else ":")]
     doc += [f"    {o} ({OUTPUT_UNITS[o]})" for o in f.outputs]
     lines.append(textwrap.indent('"""' + "\n".join(doc) + '\n"""', "    "))
+    return "\n".join(lines + _body_lines(f, params))
+
+
+def _body_lines(f: Function, params: list[str]) -> list[str]:
+    """The statements of a function (parameter unpacking, CSE, return), indented once."""
+    printer = _Vector() if f.vectorised else _Scalar()
+    replacements, reduced = sp.cse(list(f.exprs), symbols=sp.numbered_symbols("x"), order="canonical")
+    used = _param_names(list(f.exprs))
+    lines = []
     if "cam" in f.args:
         lines.append("    Theta, Theta_dot, Theta_ddot = cam")
     lines += [f"    {n} = p[{params.index(n)}]" for n in used]
@@ -103,7 +110,48 @@ def _function_code(f: Function, params: list[str]) -> str:
     else:
         values = [printer.doprint(r) for r in reduced]
     lines.append("    return " + (values[0] if len(values) == 1 else "(" + ", ".join(values) + ")"))
+    return lines
+
+
+#: Index-dispatched kernels for compiled engines (numba): one self-contained function
+#: per family, selecting a branch by an integer, with no call to another kernel.
+INDEX_ARGS = {"r": "regime index, position in REGIME_NAMES", "k": "flag index, position in FLAGS"}
+
+
+def _index_function_code(name: str, selector: str, branches: list[tuple[str, Function]], doc: str,
+                         output: str, params: list[str]) -> str:
+    """``name(selector, t, alpha, alpha_dot, p)``: the scalar body of ``branches[i]`` where
+    ``selector == i``; NaN for an index out of range.  Plain ``math``, so numba can compile it
+    (e.g. as a ``cfunc``) with the parameter vector passed as an array."""
+    args = (selector, "t", "alpha", "alpha_dot", "p")
+    lines = [f"def {name}({', '.join(args)}):"]
+    text = [doc, "", "Arguments:", f"    {selector}: {INDEX_ARGS[selector]}"]
+    text += [f"    {a}: {STATE_ARGS[a]}" for a in args[1:]]
+    text += ["Branches:"] + [f"    {i}: {label}" for i, (label, _) in enumerate(branches)]
+    text += ["Returns:", f"    {output} ({OUTPUT_UNITS[output]}); nan for an index out of range"]
+    lines.append(textwrap.indent('"""' + "\n".join(text) + '\n"""', "    "))
+    for i, (_, f) in enumerate(branches):
+        lines.append(f"    {'if' if i == 0 else 'elif'} {selector} == {i}:")
+        lines += ["    " + line for line in _body_lines(f, params)]
+    lines.append("    return nan")
     return "\n".join(lines)
+
+
+def _index_functions(spec: SceneSpec, functions: tuple[Function, ...], params: list[str]) -> list[str]:
+    """rhs_index over the regimes and, with flags, surface_index over the flags' surfaces."""
+    if spec.motion == "user":  # its kernels need the user's Python callables: not compilable
+        return []
+    by_name = {f.name: f for f in functions}
+    names = [r.name for r in regimes(spec)]
+    out = [_index_function_code("rhs_index", "r", [(n, by_name[f"rhs_{n}"]) for n in names],
+                                "Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> "
+                                "by index.", "alpha_ddot", params)]
+    if spec.flags:
+        surfaces = [(f"{flag}: {FLAG_SURFACES[flag][0]}", by_name[FLAG_SURFACES[flag][0]]) for flag in spec.flags]
+        out.append(_index_function_code("surface_index", "k", surfaces,
+                                        "Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate "
+                                        "or slip by index.", "surface", params))
+    return out
 
 
 def _pack_code(params: list[str]) -> tuple[str, list[str]]:
@@ -164,8 +212,9 @@ def module_source(spec: SceneSpec) -> str:
         "FLAG_SURFACES = " + repr({f: FLAG_SURFACES[f] for f in flags}),
         "REGIMES = " + repr(regime_table),
         "OUTPUTS = " + repr(OUTPUTS),
+        "REGIME_NAMES = " + repr(tuple(regime_table.values())),
     ]
-    body = [_function_code(f, params) for f in mod.functions]
+    body = [_function_code(f, params) for f in mod.functions] + _index_functions(spec, mod.functions, params)
     imports = ["from math import *  # noqa: F401,F403  (sin, cos, sqrt, ... on floats)", "", "import numpy"]
     parts = ["\n".join(header), "\n".join(doc), "\n".join(imports), "\n".join(data), pack] + body
     return "\n\n\n".join(parts[:3]) + "\n\n" + parts[3] + "\n\n\n" + "\n\n\n".join(parts[4:]) + "\n"

@@ -32,7 +32,7 @@ def kinetic() -> sp.Expr:
 def spring_potential() -> sp.Expr:
     """V_s(alpha), the potential of the spring moment of Eq. 10 (zero at alpha = 0)."""
     a = sp.Symbol("a", real=True)
-    integrand = S.k_s * S.d_x * laws.spring_compression(a)
+    integrand = S.d_x * laws.spring_force(a)  # follows an edited spring law
     return sp.integrate(integrand, (a, 0, alpha))
 
 

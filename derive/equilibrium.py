@@ -6,7 +6,7 @@ rates: -F_s d_x + F_n chi = 0.  With psi_i* and psi_j* written as functions
 of alpha*, the three equations reduce to one, M(alpha*) = 0, which the runtime
 solves with M and dM/dalpha from here.  Friction is absent at rest (v_r = 0),
 as in the paper's Eq. 18.  Misprint 1: the printed Eq. 18 has the contact term
-with the wrong sign; ``tests/test_derive_equilibrium.py`` shows the derived one.
+with the wrong sign; ``tests/test_derive_equations.py`` (Eq. 18) shows the derived one.
 """
 from __future__ import annotations
 

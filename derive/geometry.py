@@ -78,7 +78,7 @@ def psi_i_conditioned(a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> sp.Expr
     contact deflection (1e-7 m against 1e-2 m).  Using
     cos(x) - 1 = -2 sin^2(x/2) and sin(a) - sin(b) = 2 cos((a+b)/2) sin((a-b)/2)
     keeps every term proportional to the small differences.
-    ``tests/test_derive_geometry.py`` proves it equals the loop solution.
+    ``tests/test_derive_equations.py`` (Eqs. 6-7) proves it equals the loop solution.
     """
     d = a - alpha0
     return (chi0 * sp.sin(d) - 2 * (r_c + w_b / 2) * sp.sin(d / 2) ** 2

@@ -94,7 +94,7 @@ def impact_coefficient_k(beta: sp.Expr, k_lambda: sp.Expr, psi_i: sp.Expr, sign:
     Misprint 2: with psi_i < 0 in contact the printed coefficient is negative, so
     F_n = k|psi_i|(1 + beta psi_i_dot) adds energy on approach.  The dissipative
     reading is the Hunt-Crossley law F_n = k|psi_i|(1 - beta psi_i_dot);
-    ``tests/test_derive_energy.py`` proves which one loses energy over an impact.
+    ``tests/test_simulate.py`` (misprint 2) proves which one loses energy over an impact.
     """
     if sign == "dissipative":
         return beta * k_lambda * sp.Abs(psi_i)

@@ -217,13 +217,18 @@ def build(spec: SceneSpec) -> tuple[Function, ...]:
     if spec.model == "nonlinear":
         fns.append(Function("gap", state, ("psi_i",), (_plain(dynamics.gap(), spec.motion),),
                             "Gap psi_i (m), Eq. 6: contact where negative."))
-        if "loading" in spec.flags:
-            fns.append(Function("gap_rate", state, ("psi_i_dot",), (_plain(dynamics.gap_rate(), spec.motion),),
-                                "Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression."))
+        fns.append(Function("gap_rate", state, ("psi_i_dot",), (_plain(dynamics.gap_rate(), spec.motion),),
+                            "Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression, and "
+                            "the slope that finds a micro-hop hidden inside one step."))
         if "forward" in spec.flags:
             v_r = dynamics.sliding_velocity(spec.sliding_velocity)
             fns.append(Function("slip", state, ("v_r",), (_plain(v_r, spec.motion),),
                                 f"Sliding velocity v_r (m/s), {spec.sliding_velocity} form."))
+            v = _plain(v_r, spec.motion)
+            fns.append(Function("slip_partials", state, ("dv_r_dt", "dv_r_dalpha", "dv_r_dalpha_dot"),
+                                (v.diff(S.t_s), v.diff(S.alpha_s), v.diff(S.alpha_dot)),
+                                "Partial derivatives of v_r: the Filippov sliding mode on v_r = 0 "
+                                "(Coulomb stick) keeps dv_r/dt = 0 with them."))
     M = equilibrium.static_moment(spec.contact)
     Mp = S.to_plain(M)
     psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap())

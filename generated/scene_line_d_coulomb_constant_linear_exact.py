@@ -32,6 +32,7 @@ FLAGS = ()
 FLAG_SURFACES = {}
 REGIMES = {(True,): 'contact_fwd', (False,): 'contact_bwd'}
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
+REGIME_NAMES = ('contact_fwd', 'contact_bwd')
 
 
 def pack(values):
@@ -861,3 +862,132 @@ def spring_potential(alpha, p):
     x1 = (1/cos(alpha))
     x2 = (1/2)*w_b
     return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+
+
+def rhs_index(r, t, alpha, alpha_dot, p):
+    """Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.
+
+    Arguments:
+        r: regime index, position in REGIME_NAMES
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: contact_fwd
+        1: contact_bwd
+    Returns:
+        alpha_ddot (rad/s^2); nan for an index out of range
+    """
+    if r == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        alpha_star = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = 1/I_Pb
+        x1 = -alpha_star
+        x2 = alpha0 + x1
+        x3 = cos(x2)
+        x4 = (1/2)*Omega_c*t
+        x5 = alpha_star + theta0 + x4
+        x6 = sin(x5)
+        x7 = e*sin(x4)
+        x8 = 2*x7
+        x9 = x6*x8
+        x10 = 2*r_c + w_b
+        x11 = (1/2)*alpha0 - 1/2*alpha_star
+        x12 = sin(x11)
+        x13 = x12*cos(x11)
+        x14 = chi0*x3 + x10*x13 + x9
+        x15 = I_Pb*vartheta*zeta_D/chi_star**2
+        x16 = (1/2)*w_b
+        x17 = r_c + x16
+        x18 = sin(x2)
+        x19 = x12**2
+        x20 = 2*chi0
+        x21 = chi0 + x17*x18 - x19*x20 + x9
+        x22 = 2*x15
+        x23 = tan(alpha_star)
+        x24 = x16*(1/cos(alpha_star))
+        x25 = d_x*k_s
+        x26 = Omega_c*x6
+        x27 = e*cos(x4)
+        x28 = cos(x5)
+        x29 = Omega_c*x28
+        x30 = x28*x8
+        x31 = (1/4)*pi*Y_e*l_lambda
+        x32 = x22*(x26*x7 - x27*x29) + x31*(-chi0*x18 - x10*x19 - x30)
+        x33 = mu_m*x16
+        x34 = x14*x31 + x22*(x26*x27 + x29*x7)
+        return alpha_dot*x0*(mu_m*w_b*x14*x15 - x14*x21*x22) + x0*(alpha + x1)*(-x21*x34 - x25*(d_x*(x23**2 + 1) - x23*x24) - x32*(x13*x20 - x17*x3 + x30) + x33*x34) + x0*(-x21*x32 - x25*(L_us + d_x*x23 - d_y - x24) + x32*x33)
+    elif r == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        alpha_star = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = 1/I_Pb
+        x1 = -alpha_star
+        x2 = alpha0 + x1
+        x3 = cos(x2)
+        x4 = (1/2)*Omega_c*t
+        x5 = alpha_star + theta0 + x4
+        x6 = sin(x5)
+        x7 = e*sin(x4)
+        x8 = 2*x7
+        x9 = x6*x8
+        x10 = 2*r_c + w_b
+        x11 = (1/2)*alpha0 - 1/2*alpha_star
+        x12 = sin(x11)
+        x13 = x12*cos(x11)
+        x14 = chi0*x3 + x10*x13 + x9
+        x15 = I_Pb*vartheta*zeta_D/chi_star**2
+        x16 = (1/2)*w_b
+        x17 = r_c + x16
+        x18 = sin(x2)
+        x19 = x12**2
+        x20 = 2*chi0
+        x21 = chi0 + x17*x18 - x19*x20 + x9
+        x22 = 2*x15
+        x23 = tan(alpha_star)
+        x24 = x16*(1/cos(alpha_star))
+        x25 = d_x*k_s
+        x26 = Omega_c*x6
+        x27 = e*cos(x4)
+        x28 = cos(x5)
+        x29 = Omega_c*x28
+        x30 = x28*x8
+        x31 = (1/4)*pi*Y_e*l_lambda
+        x32 = x22*(x26*x7 - x27*x29) + x31*(-chi0*x18 - x10*x19 - x30)
+        x33 = x14*x31 + x22*(x26*x27 + x29*x7)
+        return alpha_dot*x0*(-mu_m*w_b*x14*x15 - x14*x21*x22) + x0*(alpha + x1)*(-1/2*mu_m*w_b*x33 - x21*x33 - x25*(d_x*(x23**2 + 1) - x23*x24) - x32*(x13*x20 - x17*x3 + x30)) + x0*(-1/2*mu_m*w_b*x32 - x21*x32 - x25*(L_us + d_x*x23 - d_y - x24))
+    return nan

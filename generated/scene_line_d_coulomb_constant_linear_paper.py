@@ -32,6 +32,7 @@ FLAGS = ()
 FLAG_SURFACES = {}
 REGIMES = {(True,): 'contact_fwd', (False,): 'contact_bwd'}
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
+REGIME_NAMES = ('contact_fwd', 'contact_bwd')
 
 
 def pack(values):
@@ -756,3 +757,83 @@ def spring_potential(alpha, p):
     x1 = (1/cos(alpha))
     x2 = (1/2)*w_b
     return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+
+
+def rhs_index(r, t, alpha, alpha_dot, p):
+    """Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.
+
+    Arguments:
+        r: regime index, position in REGIME_NAMES
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: contact_fwd
+        1: contact_bwd
+    Returns:
+        alpha_ddot (rad/s^2); nan for an index out of range
+    """
+    if r == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        alpha_star = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*w_b
+        x1 = d_x*k_s
+        x2 = mu_m*w_b
+        x3 = alpha_star + theta0
+        x4 = -alpha_star
+        x5 = alpha0 + x4
+        x6 = sin(x5)
+        x7 = cos(x5)
+        x8 = (2*chi_star - x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
+        x9 = pi*Y_e*l_lambda
+        return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 - 1/2*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+    elif r == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        alpha_star = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*w_b
+        x1 = d_x*k_s
+        x2 = mu_m*w_b
+        x3 = alpha_star + theta0
+        x4 = -alpha_star
+        x5 = alpha0 + x4
+        x6 = sin(x5)
+        x7 = cos(x5)
+        x8 = (2*chi_star + x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
+        x9 = pi*Y_e*l_lambda
+        return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 + (1/2)*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+    return nan

@@ -32,6 +32,7 @@ FLAGS = ('contact', 'loading')
 FLAG_SURFACES = {'contact': ('gap', -1), 'loading': ('gap_rate', -1)}
 REGIMES = {(False, None): 'free', (True, True): 'contact_loading', (True, False): 'contact_unloading'}
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
+REGIME_NAMES = ('free', 'contact_loading', 'contact_unloading')
 
 
 def pack(values):
@@ -843,7 +844,7 @@ def gap(t, alpha, alpha_dot, p):
 
 
 def gap_rate(t, alpha, alpha_dot, p):
-    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression.
+    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression, and the slope that finds a micro-hop hidden inside one step.
 
     Arguments:
         t: time (s)
@@ -1001,3 +1002,134 @@ def spring_potential(alpha, p):
     x1 = (1/cos(alpha))
     x2 = (1/2)*w_b
     return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+
+
+def rhs_index(r, t, alpha, alpha_dot, p):
+    """Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.
+
+    Arguments:
+        r: regime index, position in REGIME_NAMES
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free
+        1: contact_loading
+        2: contact_unloading
+    Returns:
+        alpha_ddot (rad/s^2); nan for an index out of range
+    """
+    if r == 0:
+        w_b = p[2]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    elif r == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = (1/2)*w_b
+        x1 = alpha - alpha0
+        x2 = sin(x1)
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = sin(x7)
+        x9 = alpha + theta0 + x7
+        x10 = sin(x9)
+        x11 = 2*r_c + w_b
+        x12 = e*cos(x9)
+        x13 = (1/4)*pi*Y_e*l_lambda*(chi0*x2 - x11*x5 - 2*x12*x8)
+        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - (beta_D*x13*(-Omega_c*x12*cos(x7) + alpha_dot*chi0*cos(x1) - alpha_dot*x11*x4*cos(x3) + 2*e*x10*x8*(alpha_dot + x6)) + x13)*(-2*chi0*x5 + chi0 + 2*e*x10*x8 - x2*(r_c + x0)))/I_Pb
+    elif r == 2:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        zeta_D = p[12]
+        Y_e = p[14]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = (1/2)*w_b
+        x1 = alpha - alpha0
+        x2 = sin(x1)
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = sin(x7)
+        x9 = alpha + theta0 + x7
+        x10 = sin(x9)
+        x11 = 2*r_c + w_b
+        x12 = e*cos(x9)
+        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - (2*I_Pb*vartheta*zeta_D*(-Omega_c*x12*cos(x7) + alpha_dot*chi0*cos(x1) - alpha_dot*x11*x4*cos(x3) + 2*e*x10*x8*(alpha_dot + x6))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - x11*x5 - 2*x12*x8))*(-2*chi0*x5 + chi0 + 2*e*x10*x8 - x2*(r_c + x0)))/I_Pb
+    return nan
+
+
+def surface_index(k, t, alpha, alpha_dot, p):
+    """Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate or slip by index.
+
+    Arguments:
+        k: flag index, position in FLAGS
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: contact: gap
+        1: loading: gap_rate
+    Returns:
+        surface (m or m/s); nan for an index out of range
+    """
+    if k == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[17]
+        x0 = (1/2)*Omega_c*t
+        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    elif k == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[17]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan

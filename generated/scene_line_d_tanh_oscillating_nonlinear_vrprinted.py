@@ -32,6 +32,7 @@ FLAGS = ('contact', 'loading')
 FLAG_SURFACES = {'contact': ('gap', -1), 'loading': ('gap_rate', -1)}
 REGIMES = {(False, None): 'free', (True, True): 'contact_loading', (True, False): 'contact_unloading'}
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
+REGIME_NAMES = ('free', 'contact_loading', 'contact_unloading')
 
 
 def pack(values):
@@ -982,7 +983,7 @@ def gap(t, alpha, alpha_dot, p):
 
 
 def gap_rate(t, alpha, alpha_dot, p):
-    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression.
+    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression, and the slope that finds a micro-hop hidden inside one step.
 
     Arguments:
         t: time (s)
@@ -1143,3 +1144,167 @@ def spring_potential(alpha, p):
     x1 = (1/cos(alpha))
     x2 = (1/2)*w_b
     return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+
+
+def rhs_index(r, t, alpha, alpha_dot, p):
+    """Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.
+
+    Arguments:
+        r: regime index, position in REGIME_NAMES
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free
+        1: contact_loading
+        2: contact_unloading
+    Returns:
+        alpha_ddot (rad/s^2); nan for an index out of range
+    """
+    if r == 0:
+        w_b = p[2]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    elif r == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*w_b
+        x1 = r_c + x0
+        x2 = alpha - alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = omega_c*t
+        x8 = Theta_p*sin(x7)
+        x9 = (1/4)*x8
+        x10 = sin(x9)
+        x11 = alpha + theta0
+        x12 = x11 + x9
+        x13 = sin(x12)
+        x14 = 2*r_c + w_b
+        x15 = e*cos(x12)
+        x16 = 2*x10*x15
+        x17 = -chi0*x3 + x14*x6 + x16
+        x18 = (1/4)*pi*Y_e*l_lambda
+        x19 = cos(x2)
+        x20 = cos(x4)
+        x21 = Theta_p*omega_c*cos(x7)
+        x22 = (1/2)*x21
+        x23 = x22*cos(x9)
+        x24 = alpha_dot + (1/4)*x21
+        x25 = beta_D*x18*(alpha_dot*chi0*x19 - alpha_dot*x14*x20*x5 + 2*e*x10*x13*x24 - x15*x23)*abs(x17) - x17*x18
+        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x25*tanh(s*(2*alpha_dot*chi0*x20*x5 + alpha_dot*x1*x19 - e*x13*x23 - x16*x24 - (alpha_dot + x22)*(e*sin(x11 + (1/2)*x8) + r_c))) - x25*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+    elif r == 2:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*w_b
+        x1 = r_c + x0
+        x2 = alpha - alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = omega_c*t
+        x8 = Theta_p*sin(x7)
+        x9 = (1/4)*x8
+        x10 = sin(x9)
+        x11 = alpha + theta0
+        x12 = x11 + x9
+        x13 = sin(x12)
+        x14 = 2*r_c + w_b
+        x15 = e*cos(x12)
+        x16 = 2*x10*x15
+        x17 = cos(x2)
+        x18 = cos(x4)
+        x19 = Theta_p*omega_c*cos(x7)
+        x20 = (1/2)*x19
+        x21 = x20*cos(x9)
+        x22 = alpha_dot + (1/4)*x19
+        x23 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x17 - alpha_dot*x14*x18*x5 + 2*e*x10*x13*x22 - x15*x21)/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x3 - x14*x6 - x16)
+        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x23*tanh(s*(2*alpha_dot*chi0*x18*x5 + alpha_dot*x1*x17 - e*x13*x21 - x16*x22 - (alpha_dot + x20)*(e*sin(x11 + (1/2)*x8) + r_c))) - x23*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+    return nan
+
+
+def surface_index(k, t, alpha, alpha_dot, p):
+    """Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate or slip by index.
+
+    Arguments:
+        k: flag index, position in FLAGS
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: contact: gap
+        1: loading: gap_rate
+    Returns:
+        surface (m or m/s); nan for an index out of range
+    """
+    if k == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/4)*Theta_p*sin(omega_c*t)
+        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    elif k == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+    return nan

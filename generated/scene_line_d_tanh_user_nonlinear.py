@@ -32,6 +32,7 @@ FLAGS = ('contact', 'loading')
 FLAG_SURFACES = {'contact': ('gap', -1), 'loading': ('gap_rate', -1)}
 REGIMES = {(False, None): 'free', (True, True): 'contact_loading', (True, False): 'contact_unloading'}
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
+REGIME_NAMES = ('free', 'contact_loading', 'contact_unloading')
 
 
 def pack(values):
@@ -884,7 +885,7 @@ def gap(t, alpha, alpha_dot, p, cam):
 
 
 def gap_rate(t, alpha, alpha_dot, p, cam):
-    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression.
+    """Gap rate psi_i_dot (m/s), Eq. 8: the D/E switch at maximum compression, and the slope that finds a micro-hop hidden inside one step.
 
     Arguments:
         t: time (s)

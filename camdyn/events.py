@@ -38,15 +38,22 @@ class Event:
 
     ``direction``: +1 fires only on crossings from ``g < 0`` to ``g >= 0``,
     -1 only from ``g > 0`` to ``g <= 0``, 0 on both.
+    ``rate``: optionally dg/dt(t, y).  With it, a sub-interval whose ends are on
+    the same side but where the rate changes sign is searched for its extremum,
+    so an excursion across the surface and back between two samples (a hop
+    shorter than the sample spacing) is still found.
     """
 
     name: str
     fn: Callable[[float, np.ndarray], float]
     direction: int = 0
+    rate: Callable[[float, np.ndarray], float] | None = None
 
     def __post_init__(self) -> None:
         if not callable(self.fn):
             raise TypeError(f"Event {self.name!r}: fn must be callable, got {type(self.fn).__name__}")
+        if self.rate is not None and not callable(self.rate):
+            raise TypeError(f"Event {self.name!r}: rate must be callable or None")
         if isinstance(self.direction, bool) or self.direction not in (-1, 0, 1):
             raise ValueError(
                 f"Event {self.name!r}: direction must be one of {{-1, 0, +1}}, got {self.direction!r}"
@@ -166,6 +173,26 @@ def locate(
     return float(hi)
 
 
+def _hidden_excursion(event: Event, dense, ta: float, tb: float, ga: float, ra: float, rb: float):
+    """(t_ext, ga, g_ext) if g crosses the surface and comes back inside (ta, tb), else None.
+
+    Both ends lie on the watched side (no sign change).  If the rate turns from moving
+    towards the surface to moving away (a maximum for an upward watch, a minimum for a
+    downward one), the extremum is located on the interpolant; when g there is across
+    the surface, [ta, t_ext] brackets the first crossing.
+    """
+    up = event.direction >= 0 and ga < 0 and ra > 0 > rb
+    down = event.direction <= 0 and ga > 0 and ra < 0 < rb
+    if not (up or down):
+        return None
+    t_ext, _ = brentq(lambda s: event.rate(s, dense(s)), ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
+                      maxiter=100, full_output=True, disp=False)
+    g_ext = float(event.fn(t_ext, dense(t_ext)))
+    if (up and g_ext >= 0) or (down and g_ext <= 0):
+        return t_ext, ga, g_ext
+    return None
+
+
 def first_crossing(
     events: Sequence[Event],
     dense: Callable[[float], np.ndarray],
@@ -194,10 +221,16 @@ def first_crossing(
         g = [float(event.fn(t, y)) for t, y in zip(times, states)]
         if not np.all(np.isfinite(g)):
             raise ValueError(f"event {event.name!r}: g is not finite at samples {times} (values {g})")
+        rates = [float(event.rate(t, y)) for t, y in zip(times, states)] if event.rate else None
         for k in range(n + 1):
             if crossed(g[k], g[k + 1], event.direction):
                 candidates.append((times[k], index, times[k + 1], g[k], g[k + 1]))
                 break
+            if rates is not None:
+                hidden = _hidden_excursion(event, dense, times[k], times[k + 1], g[k], rates[k], rates[k + 1])
+                if hidden is not None:
+                    candidates.append((times[k], index) + hidden)
+                    break
 
     best: tuple[float, int] | None = None
     for ta, index, tb, ga, gb in sorted(candidates, key=lambda c: (c[0], c[1])):

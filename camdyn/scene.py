@@ -45,8 +45,9 @@ class Scene:
         if self.slug not in generated.SCENES:
             near = [s for s in generated.SCENES if s.startswith(f"{self.contact}_{self.damping.lower()}_")]
             raise SceneError(
-                f"scene {self.slug!r} is not generated. Add SceneSpec({self._options()}) to "
-                f"derive/catalog.py and run 'python -m camdyn.derive'"
+                f"scene {self.slug!r} is not generated. To generate it, add SceneSpec({self._options()}) "
+                f"to derive/catalog.py and run 'python -m camdyn.derive' (derive refuses combinations "
+                f"that make no sense, e.g. a linear model with impact damping)"
                 + (f"; generated scenes with this contact and damping: {', '.join(sorted(near))}" if near else ""))
 
     def _options(self) -> str:

@@ -266,3 +266,24 @@ def test_settings_defaults_valid():
     s = EventSettings()
     assert (s.xtol, s.interior_points, s.max_events) == (1e-14, 3, 1_000_000)
     EventSettings(xtol=1e-6, interior_points=0, max_events=1)
+
+
+def test_rate_finds_an_excursion_between_samples():
+    """A hop narrower than the sample spacing: g = 1e-6 - (t - 0.3)^2 is positive only on
+    (0.299, 0.301), between samples at 0.25 and 0.5 (interior_points=3).  Without the rate
+    it is invisible; with dg/dt the maximum is located and the up-crossing found at 0.299."""
+    from camdyn.events import Event, EventSettings, first_crossing
+
+    def dense(t):
+        return np.array([t])
+
+    g = lambda t, y: 1e-6 - (y[0] - 0.3) ** 2  # noqa: E731
+    rate = lambda t, y: -2 * (y[0] - 0.3)  # noqa: E731
+    settings = EventSettings(interior_points=3)
+    y0, y1 = np.array([0.0]), np.array([1.0])
+    assert first_crossing((Event("gap", g, +1),), dense, 0.0, 1.0, y0, y1, settings) is None
+    hit = first_crossing((Event("gap", g, +1, rate),), dense, 0.0, 1.0, y0, y1, settings)
+    assert hit is not None and hit.t == pytest.approx(0.299, abs=1e-12) and g(hit.t, hit.y) >= 0
+    # a maximum that stays below the surface is no crossing
+    low = lambda t, y: -1e-6 - (y[0] - 0.3) ** 2  # noqa: E731
+    assert first_crossing((Event("gap", low, +1, rate),), dense, 0.0, 1.0, y0, y1, settings) is None

@@ -1,0 +1,106 @@
+"""Hostile input to the public API and the CLI: the only outcomes allowed are a valid result
+(finite numbers) or a camdyn error naming what is wrong; never a traceback from inside NumPy or
+SciPy, a NaN in a result, or a hang (runs are kept short, so a hang would show as a timeout)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import camdyn
+from camdyn.cli import main as cli_main
+from camdyn.errors import CamdynError
+from camdyn.rig import PARAMETERS
+from registry import RIG
+
+hostile_numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(min_value=-10**12, max_value=10**12),
+    st.sampled_from([0, -0.0, 1e-300, 1e300, -1, True, False]),
+    st.text(max_size=5), st.none(), st.lists(st.floats(), max_size=2),
+)
+SLOW = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def _check_result(r):
+    assert isinstance(r.outcome, camdyn.Outcome)
+    for name in ("t", "alpha", "alpha_dot", "Theta"):
+        assert np.all(np.isfinite(getattr(r, name))), name
+    for name, values in r.outputs.items():
+        assert np.all(np.isfinite(values)), name
+
+
+@SLOW
+@given(name=st.sampled_from([p.name for p in PARAMETERS]), value=hostile_numbers)
+def test_one_hostile_rig_parameter(name, value):
+    """Any one parameter replaced by anything: a valid rig that simulates, or a camdyn error."""
+    try:
+        rig = RIG.replace(**{name: value})
+        r = camdyn.simulate(rig, camdyn.Scene(), speed_rpm=300, t_end=0.002, sample_rate_Hz=5000)
+    except CamdynError as exc:
+        assert str(exc)
+        return
+    _check_result(r)
+
+
+@SLOW
+@given(factors=st.lists(st.floats(0.2, 5.0), min_size=6, max_size=6),
+       speed=st.floats(-3000, 3000), scene=st.sampled_from(camdyn.Scene.available()))
+def test_random_plausible_rigs_and_scenes(factors, speed, scene):
+    """Geometry scaled at random (some impossible): valid result or a named camdyn error."""
+    names = ["r_c", "e", "chi0", "d_x", "L_us", "k_s"]
+    from registry import cam_for, scene_from_slug
+    sc = scene_from_slug(scene)
+    try:
+        rig = RIG.replace(**{n: getattr(RIG, n) * f for n, f in zip(names, factors)})
+        r = camdyn.simulate(rig, sc, cam_for(sc, speed), t_end=0.002, sample_rate_Hz=5000)
+    except CamdynError as exc:
+        assert str(exc)
+        return
+    _check_result(r)
+
+
+@SLOW
+@given(kwargs=st.fixed_dictionaries({}, optional={
+    "speed_rpm": hostile_numbers, "t_end": hostile_numbers, "revolutions": hostile_numbers,
+    "sample_rate_Hz": hostile_numbers, "rtol": hostile_numbers, "atol": hostile_numbers,
+    "max_step": hostile_numbers, "t_start": hostile_numbers, "method": st.text(max_size=8),
+    "y0": st.one_of(hostile_numbers, st.tuples(st.floats(-2, 2), st.floats(-50, 50))),
+}))
+def test_hostile_simulate_arguments(kwargs):
+    try:
+        r = camdyn.simulate(RIG, camdyn.Scene(), **kwargs)
+    except CamdynError as exc:
+        assert str(exc)
+        return
+    _check_result(r)
+
+
+@SLOW
+@given(text=st.text(max_size=200))
+def test_hostile_rig_files(tmp_path_factory, text):
+    path = tmp_path_factory.mktemp("rig") / "rig.toml"
+    path.write_text(text)
+    with pytest.raises(CamdynError):
+        camdyn.Rig.from_toml(path)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(argv=st.lists(st.sampled_from(["simulate", "equilibrium", "contact-loss", "--speed-rpm", "--rig",
+                                      "--damping", "nan", "0", "1e9", "3000", "-3000", "X", "example",
+                                      "--contact", "point", "--friction", "tanh", "--sample-rate-Hz"]),
+                     max_size=6))
+def test_hostile_command_lines(argv, capsys):
+    """The CLI answers with exit code 0, 2 (bad input, one line) or 3 (a run that stopped early);
+    argparse's own usage errors exit with 2 too.  Never a traceback.  (The vocabulary keeps
+    every run short: |speed| 3000 rev/min over the default 3 revolutions.)"""
+    try:
+        code = cli_main(argv)
+    except SystemExit as exc:  # argparse usage errors
+        code = exc.code
+    out = capsys.readouterr()
+    assert code in (0, 2, 3)
+    assert "Traceback" not in out.err

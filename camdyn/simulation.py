@@ -8,6 +8,7 @@ import numpy as np
 from .cam import CamMotion, ConstantSpeed
 from .errors import ParameterError
 from .events import EventSettings
+from .hybrid import Hybrid
 from .integrate import SolverOptions, integrate
 from .model import Model
 from .result import Result
@@ -15,6 +16,7 @@ from .rig import Rig
 from .scene import Scene
 
 MAX_SAMPLES = 50_000_000
+BACKENDS = ("scipy", "compiled")
 
 
 def _positive(name, value, valid):
@@ -29,7 +31,8 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              revolutions: float | None = None, sample_rate_Hz: float = 20_000.0,
              y0=None, t_start: float = 0.0, method: str = "DOP853", rtol: float = 1e-8,
              atol: float = 1e-12, max_step: float = math.inf,
-             events: EventSettings | None = None) -> Result:
+             events: EventSettings | None = None, energy_ledger: bool = False,
+             backend: str = "scipy") -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -39,7 +42,15 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     The outputs are sampled at ``sample_rate_Hz``.  SciPy's ``method`` (DOP853,
     RK45, Radau, BDF, LSODA) integrates each regime; switches are located on
     its dense output.  Check ``result.ok``: a run that could not finish says why.
+    ``energy_ledger=True`` also integrates the work of the cam drive and the energy
+    dissipated by contact damping and by friction (``result.work_in``,
+    ``result.dissipated_contact``, ``result.dissipated_friction``), so that
+    energy(t) - energy(0) = work_in - dissipated_contact - dissipated_friction.
+    ``backend="compiled"`` runs the whole hybrid loop in numba (:mod:`camdyn.compiled`;
+    method DOP853 or RK45, built-in cam motions); ``"scipy"`` is the accuracy reference.
     """
+    if backend not in BACKENDS:
+        raise ParameterError("backend", backend, f"one of {BACKENDS}")
     scene = scene if scene is not None else Scene()
     if cam is None:
         if speed_rpm is None:
@@ -66,19 +77,32 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     if y0.shape != (2,) or not np.all(np.isfinite(y0)):
         raise ParameterError("y0", y0, "two finite numbers (alpha rad, alpha_dot rad/s)")
-    options = SolverOptions(method, rtol, atol, max_step, events or EventSettings())
+    options = SolverOptions(method, rtol, atol, max_step, events or EventSettings(), bool(energy_ledger))
     t_eval = t_start + np.arange(n) / fs
-    traj = integrate(model, (t_start, t_start + duration), y0, t_eval, options)
+    traj = _integrator(backend, options)(model, (t_start, t_start + duration), y0, t_eval, options)
     return _result(model, traj)
 
 
+def _integrator(backend: str, options: SolverOptions):
+    """The integrate() of a backend: camdyn.integrate (SciPy) or camdyn.compiled."""
+    if backend == "scipy":
+        return integrate
+    if getattr(options, "energy_ledger", False):
+        raise ParameterError("energy_ledger", True, "False with backend='compiled' (use backend='scipy')")
+    from .compiled import integrate as compiled
+    return compiled
+
+
 def _result(model: Model, traj) -> Result:
-    t, (alpha, alpha_dot) = traj.t, traj.y
+    t, alpha, alpha_dot = traj.t, traj.y[0], traj.y[1]
     outputs = {name: np.empty(t.size) for name in model.kernels.OUTPUTS}
+    if traj.y.shape[0] == 5:
+        for i, name in enumerate(("work_in", "dissipated_contact", "dissipated_friction")):
+            outputs[name] = traj.y[2 + i].copy()
+    hybrid = Hybrid(model)
     for name in dict.fromkeys(traj.regime):
         mask = traj.regime == name
-        _, _, out = model.regime_functions(name)
-        values = model.bind(out)(t[mask], alpha[mask], alpha_dot[mask])
+        values = hybrid.outputs(traj.keys[name], t[mask], alpha[mask], alpha_dot[mask])
         for key, v in zip(model.kernels.OUTPUTS, values):
             outputs[key][mask] = v
     theta = np.broadcast_to(model.cam_state(t)[0], t.shape).astype(float) if t.size else t.copy()

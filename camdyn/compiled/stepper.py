@@ -1,0 +1,191 @@
+"""The compiled explicit Runge-Kutta stepper with dense output (numba), SciPy's algorithm.
+
+The state is the follower's ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot,
+rhs(r, t, alpha, alpha_dot, p))``, with ``rhs`` a compiled function of the regime index
+``r`` (a generated ``rhs_index`` compiled as a numba ``cfunc``) and ``p`` the parameter
+vector.  Everything is a small ``njit`` function, in the same split as SciPy's
+``RungeKutta``: :func:`step_impl` computes one attempt (stages, solution), :func:`error_norm`
+its error, and :func:`step` does the bookkeeping (accept or reject, the next step size)
+exactly as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's.
+:func:`dense_coefficients` and :func:`dense_eval` are the interpolant (``RkDenseOutput`` /
+``Dop853DenseOutput`` in power form).  The method is the tuple of arrays from
+:func:`camdyn.compiled.tableau.arrays`; the stage buffer ``K`` has one row per stage, the
+FSAL stage and the extra dense-output stages.
+
+One deliberate difference from SciPy: an attempt whose error is not finite (a stage that
+overshot into a region where a law is undefined) is rejected and retried with a step five
+times smaller, instead of poisoning the step size with NaN.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+
+#: step() status codes
+ACCEPTED, TOO_SMALL = 0, 1
+
+
+@njit(cache=True)
+def _norm(x0, x1):
+    """SciPy's RMS norm of a 2-vector."""
+    return math.sqrt(0.5 * (x0 * x0 + x1 * x1))
+
+
+@njit(cache=True)
+def stages(rhs, r, t, y0, y1, h, A, C, p, K, first, last):
+    """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y))."""
+    for s in range(first, last):
+        d0 = 0.0
+        d1 = 0.0
+        for j in range(s):
+            a = A[s, j]
+            d0 += K[j, 0] * a
+            d1 += K[j, 1] * a
+        z1 = y1 + d1 * h
+        K[s, 0] = z1
+        K[s, 1] = rhs(r, t + C[s] * h, y0 + d0 * h, z1, p)
+
+
+@njit(cache=True)
+def step_impl(rhs, r, t, y0, y1, h, method, p, K):
+    """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
+    A, C, B, n = method[0], method[1], method[2], method[6]
+    stages(rhs, r, t, y0, y1, h, A, C, p, K, 1, n)
+    d0 = 0.0
+    d1 = 0.0
+    for j in range(n):
+        d0 += K[j, 0] * B[j]
+        d1 += K[j, 1] * B[j]
+    n0 = y0 + h * d0
+    n1 = y1 + h * d1
+    K[n, 0] = n1
+    K[n, 1] = rhs(r, t + h, n0, n1, p)
+    return n0, n1
+
+
+@njit(cache=True)
+def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
+    """SciPy's error norm of the attempt (RK45: embedded difference; DOP853: 5th/3rd blend)."""
+    E, E3, n, kind = method[3], method[4], method[6], method[8]
+    s0 = atol + max(abs(y0), abs(n0)) * rtol
+    s1 = atol + max(abs(y1), abs(n1)) * rtol
+    e0 = 0.0
+    e1 = 0.0
+    for j in range(n + 1):
+        e0 += K[j, 0] * E[j]
+        e1 += K[j, 1] * E[j]
+    if kind == 0:
+        return _norm(e0 * h / s0, e1 * h / s1)
+    f0 = 0.0
+    f1 = 0.0
+    for j in range(n + 1):
+        f0 += K[j, 0] * E3[j]
+        f1 += K[j, 1] * E3[j]
+    e5 = (e0 / s0) ** 2 + (e1 / s1) ** 2
+    e3 = (f0 / s0) ** 2 + (f1 / s1) ** 2
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 2.0)
+
+
+@njit(cache=True)
+def step(rhs, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
+    """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
+
+    Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections);
+    K then holds the accepted attempt's stages with f(t_new, y_new) in row n_stages.
+    """
+    n, exponent = method[6], method[9]
+    min_step = 10.0 * abs(np.nextafter(t, math.inf) - t)
+    if h_abs > max_step:
+        h_abs = max_step
+    elif h_abs < min_step:
+        h_abs = min_step
+    nfev = 0
+    rejected = 0
+    while True:
+        if h_abs < min_step:
+            return TOO_SMALL, t, y0, y1, h_abs, nfev, rejected
+        t_new = t + h_abs
+        if t_new - t_bound > 0:
+            t_new = t_bound
+        h = t_new - t
+        h_abs = abs(h)
+        n0, n1 = step_impl(rhs, r, t, y0, y1, h, method, p, K)
+        nfev += n
+        err = error_norm(K, h, y0, y1, n0, n1, rtol, atol, method)
+        if err < 1.0:
+            factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** exponent)
+            if rejected:
+                factor = min(1.0, factor)
+            return ACCEPTED, t_new, n0, n1, h_abs * factor, nfev, rejected
+        if math.isfinite(err):
+            h_abs *= max(MIN_FACTOR, SAFETY * err ** exponent)
+        else:  # a stage left the domain of a law (NaN/inf): retry smaller
+            h_abs *= MIN_FACTOR
+        rejected += 1
+
+
+@njit(cache=True)
+def initial_step(rhs, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, atol, p):
+    """SciPy's ``select_initial_step`` (Hairer, Norsett & Wanner II.4), one RHS evaluation."""
+    length = abs(t_bound - t)
+    if length == 0.0:
+        return 0.0
+    s0 = atol + abs(y0) * rtol
+    s1 = atol + abs(y1) * rtol
+    d0 = _norm(y0 / s0, y1 / s1)
+    d1 = _norm(y1 / s0, f1 / s1)
+    if d0 < 1e-5 or d1 < 1e-5:
+        h0 = 1e-6
+    else:
+        h0 = 0.01 * d0 / d1
+    h0 = min(h0, length)
+    z0 = y0 + h0 * y1
+    z1 = y1 + h0 * f1
+    g1 = rhs(r, t + h0, z0, z1, p)
+    d2 = _norm((z1 - y1) / s0, (g1 - f1) / s1) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (error_order + 1))
+    return min(100.0 * h0, h1, length, max_step)
+
+
+@njit(cache=True)
+def dense_coefficients(rhs, r, t, y0, y1, h, method, p, K, Q):
+    """Q = K^T P after computing the extra stages (DOP853): y(t + theta h) = y + h theta (Q0 + Q1 theta + ...).
+
+    Returns the number of RHS evaluations spent (the extra stages)."""
+    A, C, P, n, n_extra = method[0], method[1], method[5], method[6], method[7]
+    if n_extra:
+        stages(rhs, r, t, y0, y1, h, A, C, p, K, n + 1, n + 1 + n_extra)
+    rows, deg = P.shape
+    for k in range(deg):
+        q0 = 0.0
+        q1 = 0.0
+        for j in range(rows):
+            q0 += K[j, 0] * P[j, k]
+            q1 += K[j, 1] * P[j, k]
+        Q[0, k] = q0
+        Q[1, k] = q1
+    return n_extra
+
+
+@njit(cache=True)
+def dense_eval(tt, t, h, y0, y1, Q):
+    """The interpolant at time tt of the step [t, t + h] (Horner in theta)."""
+    theta = (tt - t) / h
+    deg = Q.shape[1]
+    v0 = Q[0, deg - 1]
+    v1 = Q[1, deg - 1]
+    for k in range(deg - 2, -1, -1):
+        v0 = v0 * theta + Q[0, k]
+        v1 = v1 * theta + Q[1, k]
+    return y0 + h * theta * v0, y1 + h * theta * v1

@@ -1,0 +1,146 @@
+"""The paper's studies: each runs in fast mode and produces its figure and its report section;
+the shipped reference rig reproduces the paper's numbers to the paper's rounding."""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+import camdyn
+from camdyn import studies
+from camdyn.analysis import contact_loss_speed, natural_frequency, static_equilibrium
+from camdyn.studies import common, reference_rig
+
+pytest.importorskip("matplotlib")
+
+FIGURES = {
+    "fig4-5": ["repro_fig4-5.png"], "fig6": ["repro_fig6.png"], "fig7-8": ["repro_fig7-8.png"],
+    "fig9": ["repro_fig9.png"], "fig10": ["repro_fig10.png"], "fig11": ["repro_fig11.png"],
+    "fig12-15": ["repro_fig12-13.png", "repro_fig14-15.png"], "fig16": ["repro_fig16.png"],
+}
+
+
+@pytest.fixture(scope="module")
+def report_dir(tmp_path_factory):
+    return tmp_path_factory.mktemp("repro")
+
+
+# ---------------------------------------------------------------- the reference rig
+
+REF = camdyn.load_rig("reference")
+EXP = camdyn.load_rig("reference-experiment")
+LINE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
+POINT = camdyn.Scene(contact="point", damping="D", friction="coulomb")
+
+TARGETS = {  # computed on the shipped presets; tolerance: the paper's rounding (half a unit of the last digit)
+    "k_line": lambda: static_equilibrium(REF, "line").contact_stiffness,
+    "k_point": lambda: static_equilibrium(REF, "point").contact_stiffness,
+    "f_line_de": lambda: natural_frequency(REF, LINE, camdyn.ConstantSpeed(300)).Hz,
+    "f_line_se": lambda: natural_frequency(REF, LINE, camdyn.ConstantSpeed(-300)).Hz,
+    "f_point_de": lambda: natural_frequency(REF, POINT, camdyn.ConstantSpeed(300)).Hz,
+    "contact_loss": lambda: contact_loss_speed(EXP),
+    "alpha_rp_saturation": lambda: math.pi / 2 - static_equilibrium(EXP).alpha,
+}
+
+
+@pytest.mark.parametrize("key", TARGETS)
+def test_reference_rig_reproduces_the_reported_number_to_the_papers_rounding(key):
+    paper = common.PAPER[key]
+    sigma = camdyn.calibrate.rounding_sigma(paper["value"], paper["digits"])
+    assert abs(TARGETS[key]() - paper["value"]) <= sigma * (1 + 1e-9), (key, TARGETS[key](), paper["value"])
+
+
+def test_reference_rig_settings_are_the_papers():
+    """Sections 6-8: k_s = 2000 N/m, e = 0.1 r_c, line 1.6 mm, zeta_D = 0.01; the experiment variant
+    differs only in k_s, l_lambda and zeta_D; sliding contact at 300 rev/min and at e = 0.7 r_c, 50 rev/min."""
+    assert REF.k_s == 2000.0 and REF.l_lambda == 0.0016 and REF.zeta_D == 0.01 and REF.beta_D == 4.25
+    assert REF.e == pytest.approx(0.1 * REF.r_c)
+    assert EXP.l_lambda == 0.016 and EXP.zeta_D == 0.119
+    diff = {k for k, v in REF.to_dict().items() if EXP.to_dict()[k] != v}
+    assert diff == {"k_s", "l_lambda", "zeta_D", "name", "description"}
+    assert contact_loss_speed(REF) > 300.0
+    assert contact_loss_speed(REF.replace(e=0.7 * REF.r_c)) > 50.0
+
+
+def test_reference_rig_study_regenerates_the_shipped_presets(tmp_path):
+    """The calibration, started from the shipped values, lands on them (the presets are its output)."""
+    out = studies.run("reference-rig", fast=True, out=tmp_path, data_dir=tmp_path / "data", log=lambda *a: None)
+    fitted = camdyn.Rig.from_toml(tmp_path / "data" / "reference.toml")
+    for name in ("I_Pb", "w_b", "L_us", "alpha0", "theta0"):
+        assert getattr(fitted, name) == pytest.approx(getattr(REF, name), rel=1e-6, abs=1e-9), name
+    exp = camdyn.Rig.from_toml(tmp_path / "data" / "reference-experiment.toml")
+    assert exp.k_s == pytest.approx(EXP.k_s, rel=1e-6)
+    assert all(v["within_rounding"] for k, v in out.numbers.items() if isinstance(v, dict) and "within_rounding" in v)
+    doc = (tmp_path / "reference-rig.md").read_text()
+    for word in ("reported", "inferred", "assumed", "Degrees of freedom", "residual / σ"):
+        assert word in doc
+    for name in ("r_c", "chi0", "d_x", "d_y", "theta0", "I_Pb", "w_b", "L_us", "alpha0", "k_s"):
+        assert f"| {name} |" in doc
+
+
+# ---------------------------------------------------------------- each study, fast
+
+@pytest.mark.parametrize("name", list(FIGURES))
+def test_study_runs_fast_and_writes_its_figure_and_section(name, report_dir):
+    out = studies.run(name, fast=True, out=report_dir, log=lambda *a: None)
+    for png in FIGURES[name]:
+        path = report_dir / "img" / png
+        assert path.exists() and path.stat().st_size > 10_000, png
+        assert path in out.figures
+    text = (report_dir / "reproduction.md").read_text()
+    begin, end = common._markers(name)
+    assert text.count(begin) == 1 and text.count(end) == 1
+    section = text[text.index(begin):text.index(end)]
+    assert f"python -m camdyn.studies {name} --fast" in section
+    assert "The paper" in section or "the paper" in section
+    json.dumps(out.numbers, default=common._json_default)      # the numbers are JSON-able
+    assert common.recorded_numbers(report_dir / "reproduction.md")[name] is not None
+
+
+def test_numbers_study_lists_every_reported_number(report_dir):
+    out = studies.run("numbers", fast=True, out=report_dir, log=lambda *a: None)
+    entries = {e["quantity"]: e for e in out.numbers["numbers"]}
+    for key, paper in common.PAPER.items():
+        e = entries[key]
+        assert e["paper"] == paper["value"] and e["camdyn"] is not None
+        assert abs(e["relative_difference"]) < 2e-3
+    assert "f_line_de_spectrum" in entries
+
+
+def test_report_sections_are_replaced_in_place_and_kept_in_order(tmp_path):
+    path = tmp_path / "reproduction.md"
+    common.update_report(path, common.StudyOutput("fig9", "Nine", "first", {"a": 1}), "cmd9")
+    common.update_report(path, common.StudyOutput("fig6", "Six", "six", {}), "cmd6")
+    common.update_report(path, common.StudyOutput("fig9", "Nine", "second", {"a": 2}), "cmd9")
+    text = path.read_text()
+    assert "first" not in text and "second" in text
+    assert text.index("## Six") < text.index("## Nine")
+    assert text.startswith("# The paper's results, reproduced")
+    assert common.recorded_numbers(path)["fig9"] == {"a": 2}
+
+
+def test_poincare_classification():
+    assert common.classify([1.0, 2.0] * 20, scale=1.0) == "P2"
+    assert common.classify([0.5] * 30, scale=1.0) == "P1"
+    assert common.classify([math.sin(k * k) for k in range(40)], scale=1.0) == "aperiodic"
+    assert common.classify([1.0] * 5, scale=1.0) == "too short"
+
+
+def test_command_line(tmp_path):
+    run = [sys.executable, "-m", "camdyn.studies"]
+    listed = subprocess.run(run + ["list"], capture_output=True, text=True, check=True).stdout
+    assert all(name in listed for name in studies.STUDIES)
+    bad = subprocess.run(run + ["fig99"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "no study 'fig99'" in bad.stderr
+    out = subprocess.run(run + ["numbers", "--fast", "--out", str(tmp_path)], capture_output=True, text=True,
+                         check=True).stdout
+    entries = json.loads(out)["numbers"]
+    assert {e["quantity"] for e in entries} >= set(common.PAPER)
+
+
+def test_unknown_study_name_suggests():
+    with pytest.raises(KeyError, match="did you mean 'fig10'"):
+        studies.run("fig_10", fast=True)

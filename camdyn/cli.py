@@ -1,119 +1,953 @@
-"""The ``camdyn`` command: simulate, equilibrium, contact-loss speed, regenerate.
+"""The ``camdyn`` command: simulate, analyse, sweep, regenerate and reproduce from a shell.
 
-Errors print as one line (``camdyn: error: ...``) with exit code 2; a simulation
-that stops early (see ``Outcome``) exits with 3.  ``camdyn <command> --help``
-lists each command's options.
+Run ``camdyn --help`` for the commands and ``camdyn <command> --help`` for each one's
+options and examples.  Everything is SI except where an option's name says otherwise
+(``--speed-rpm``, ``--sample-rate-Hz``).
+
+Errors print as one line, ``camdyn: error: ...``, never a traceback (``--traceback``
+shows it).  Exit codes, for scripts:
+
+  0  success
+  1  a check failed (``regenerate --check``: generated/ differs from what derive/ produces)
+  2  bad input: an unknown option or value, an invalid rig or parameter, an unreadable
+     or unwritable file, a scene that is not generated
+  3  a simulation stopped before the end (see its outcome: chatter, angle limit, ...);
+     whatever was computed is still written
+  4  an optional part is missing: matplotlib for plots (``pip install "camdyn[plot]"``),
+     SymPy for regenerate (``camdyn[derive]``), or a module not installed in this version
+  5  internal error (a bug in camdyn: please report it with ``--traceback``)
+  130 interrupted (Ctrl-C); 141 the output pipe was closed (e.g. ``| head``)
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
+import importlib
+import inspect
 import json
+import math
+import os
 import subprocess
 import sys
+import threading
+import time
+from pathlib import Path
 
 from .errors import CamdynError
 
+EXIT_OK, EXIT_CHECK_FAILED, EXIT_USAGE, EXIT_INCOMPLETE, EXIT_MISSING, EXIT_INTERNAL = 0, 1, 2, 3, 4, 5
+EXIT_INTERRUPTED, EXIT_BROKEN_PIPE = 130, 141
 
-def _rig(name):
+EXIT_CODES_HELP = """exit codes:
+  0 success; 1 a check failed (regenerate --check); 2 bad input; 3 a simulation stopped
+  early (outputs still written); 4 an optional part is missing (matplotlib, SymPy, ...);
+  5 internal error (please report, with --traceback); 130 interrupted; 141 output pipe closed"""
+
+
+class UsageError(CamdynError, ValueError):
+    """Bad command-line input (exit code 2)."""
+
+
+class MissingPart(CamdynError):
+    """An optional dependency or module is not available (exit code 4)."""
+
+
+# --------------------------------------------------------------------------- helpers
+def _progress_enabled(args) -> bool | None:
+    """tqdm's ``disable``: None shows bars only on a terminal; --no-progress hides them."""
+    return True if getattr(args, "no_progress", False) else None
+
+
+@contextlib.contextmanager
+def _busy(description: str, args, after: float = 1.0):
+    """An elapsed-time bar for one long call: shown once it has taken ``after`` seconds, on a
+    terminal only (and never with --no-progress)."""
+    from tqdm import tqdm
+
+    stop = threading.Event()
+    disable = _progress_enabled(args)
+
+    def tick():
+        if stop.wait(after):
+            return
+        started = time.monotonic() - after
+        bar = tqdm(total=None, bar_format="{desc}", disable=disable, file=sys.stderr, leave=False)
+        while True:
+            bar.set_description_str(f"{description}: {time.monotonic() - started:.0f} s")
+            if stop.wait(0.5):
+                break
+        bar.close()
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+
+
+def _parse_values(text: str, name: str) -> list[float]:
+    """'a:b:n' (n values from a to b, inclusive), 'a:b:n:log' (geometric) or 'v1,v2,...'."""
+    import numpy as np
+
+    try:
+        if ":" in text:
+            parts = text.split(":")
+            if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] != "log"):
+                raise ValueError
+            a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+            if n < 1:
+                raise ValueError
+            if len(parts) == 4:
+                if a <= 0 or b <= 0:
+                    raise UsageError(f"{name}: a log range needs positive ends, got {text!r}")
+                return [float(v) for v in np.geomspace(a, b, n)]
+            return [float(v) for v in np.linspace(a, b, n)]
+        values = [float(v) for v in text.split(",") if v.strip()]
+        if not values:
+            raise ValueError
+        return values
+    except UsageError:
+        raise
+    except ValueError:
+        raise UsageError(f"{name}: expected 'start:stop:count', 'start:stop:count:log' or 'v1,v2,...', "
+                         f"got {text!r}") from None
+
+
+def _rig(args):
     from .presets import load_rig
-    return load_rig(name)
+
+    return load_rig(args.rig)
 
 
-def _scene(args):
+def _cam(args):
+    from .cam import ConstantSpeed, Oscillating
+
+    if getattr(args, "oscillating_rpm", None) is not None:
+        if args.speed_rpm is not None:
+            raise UsageError("give either --speed-rpm or --oscillating-rpm, not both")
+        return Oscillating(args.amplitude_pp, args.oscillating_rpm)
+    if args.speed_rpm is None:
+        raise UsageError("a cam motion is needed: --speed-rpm S (constant speed) or --oscillating-rpm F")
+    return ConstantSpeed(args.speed_rpm)
+
+
+def _scene(args, motion: str = "constant"):
     from .scene import Scene
-    return Scene(contact=args.contact, damping=args.damping, friction=args.friction)
+
+    return Scene(contact=getattr(args, "contact", "line"), damping=args.damping, friction=args.friction,
+                 motion=motion, model=getattr(args, "model", "nonlinear"),
+                 sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
+                 damping_sign=getattr(args, "damping_sign", "dissipative"))
 
 
+def _backend_kwargs(args) -> dict:
+    """``backend=`` for simulate() when asked for and supported by this camdyn."""
+    backend = getattr(args, "backend", None)
+    if backend is None:
+        return {}
+    from .simulation import simulate
+
+    params = inspect.signature(simulate).parameters
+    if "backend" not in params and not any(p.kind is p.VAR_KEYWORD for p in params.values()):
+        if backend == "scipy":
+            return {}
+        raise MissingPart(f"backend {backend!r} is not available in this version of camdyn "
+                          "(only the SciPy backend is)")
+    return {"backend": backend}
+
+
+def _simulate(args):
+    """One run from the command-line options (cam, scene, run length, solver)."""
+    from .simulation import simulate
+
+    cam = _cam(args)
+    scene = _scene(args, cam.kind)
+    kwargs = dict(sample_rate_Hz=args.sample_rate_Hz, method=args.method, rtol=args.rtol, atol=args.atol,
+                  **_backend_kwargs(args))
+    if args.t_end is not None:
+        kwargs["t_end"] = args.t_end
+    else:
+        kwargs["revolutions"] = args.revolutions
+    rig = _rig(args)
+    with _busy(f"simulating {scene.slug}", args):
+        return simulate(rig, scene, cam, **kwargs)
+
+
+def _plot_modules():
+    """camdyn.plots with a non-interactive backend (files only), or MissingPart."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise MissingPart("plots need matplotlib, which is not installed: pip install \"camdyn[plot]\"") from None
+    matplotlib.use("Agg")
+    from . import plots
+
+    return plots
+
+
+def _save_figure(fig, path: str) -> None:
+    fig.savefig(path)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    print(f"  wrote {path}")
+
+
+def _check_outputs(args, *names: str) -> None:
+    """Fail before a long run, not after it: output folders must exist, plots need matplotlib."""
+    for name in names:
+        path = getattr(args, name, None)
+        if not path:
+            continue
+        folder = Path(path).resolve().parent
+        if not folder.is_dir():
+            raise UsageError(f"--{name.replace('_', '-')} {path}: folder {folder} does not exist")
+        if not os.access(folder, os.W_OK):
+            raise UsageError(f"--{name.replace('_', '-')} {path}: folder {folder} is not writable")
+    if getattr(args, "plot", None):
+        _plot_modules()
+
+
+def _columns(result) -> list[str]:
+    return ["t", "alpha", "alpha_dot", "Theta", "alpha_r"] + list(result.outputs)
+
+
+def write_csv(result, path: str) -> None:
+    """Time histories as CSV: one column per quantity (SI units) and the regime name."""
+    columns = _columns(result)
+    data = [getattr(result, c) for c in columns]
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(columns + ["regime"])
+        for i in range(result.t.size):
+            writer.writerow([repr(float(col[i])) for col in data] + [result.regime[i]])
+
+
+def _units():
+    from .plots import QUANTITIES
+
+    return {name: unit for name, (_, unit) in QUANTITIES.items()}
+
+
+def write_netcdf(result, path: str, attrs: dict | None = None) -> None:
+    """Time histories as NetCDF (netCDF3 through SciPy), with units, the regime as
+    integer codes (``flag_values``/``flag_meanings``) and the impact times."""
+    import numpy as np
+    import xarray as xr
+
+    units = _units()
+    regimes = sorted(set(result.regime.tolist()))
+    codes = np.array([regimes.index(r) for r in result.regime], dtype=np.int8)
+    data = {c: ("t", np.asarray(getattr(result, c), dtype=float), {"units": units.get(c, "")})
+            for c in _columns(result) if c != "t"}
+    data["regime"] = ("t", codes, {"flag_values": np.arange(len(regimes), dtype=np.int8),
+                                   "flag_meanings": " ".join(regimes)})
+    data["impact_t"] = ("impact", np.asarray(result.impacts(), dtype=float), {"units": "s"})
+    cam = result.meta.get("cam")
+    meta = {"scene": result.scene, "rig": str(result.meta.get("rig")), "outcome": result.outcome.name,
+            "period_s": float(result.period) if math.isfinite(result.period) else -1.0,
+            "alpha_star_rad": float(result.alpha_star), "cam": repr(cam),
+            "source": "camdyn " + _version(), **(attrs or {})}
+    ds = xr.Dataset(data, coords={"t": ("t", np.asarray(result.t, dtype=float), {"units": "s"})}, attrs=meta)
+    ds.to_netcdf(path, engine="scipy")
+
+
+def _version() -> str:
+    from . import __version__
+
+    return __version__
+
+
+# --------------------------------------------------------------------------- commands
 def cmd_simulate(args) -> int:
     from .analysis import residual_stats
-    from .simulation import simulate
-    result = simulate(_rig(args.rig), _scene(args), speed_rpm=args.speed_rpm, revolutions=args.revolutions,
-                      sample_rate_Hz=args.sample_rate_Hz, rtol=args.rtol)
+
+    _check_outputs(args, "csv", "netcdf", "plot")
+    result = _simulate(args)
     print(result.summary())
-    if result.ok and result.t.size > 1:
-        stats = residual_stats(result)
-        print(f"  alpha_r: rms {stats.rms:.6g} rad, peak-to-peak {stats.peak_to_peak:.6g} rad")
+    if result.t.size > 1 and math.isfinite(result.period):
+        transient = min(args.transient_revolutions, max(0.0, (result.t[-1] - result.t[0]) / result.period - 1e-9))
+        stats = residual_stats(result, transient_revolutions=transient)
+        print(f"  alpha_r: rms {stats.rms:.6g} rad, peak-to-peak {stats.peak_to_peak:.6g} rad"
+              + (f" (after {transient:g} revolutions)" if transient else ""))
     if args.csv:
-        columns = ["t", "alpha", "alpha_dot", "Theta", "alpha_r"] + list(result.outputs)
+        write_csv(result, args.csv)
+        print(f"  wrote {args.csv}")
+    if args.netcdf:
+        write_netcdf(result, args.netcdf, {"command": " ".join(["camdyn"] + (args.argv or []))})
+        print(f"  wrote {args.netcdf}")
+    if args.plot:
+        plots = _plot_modules()
+        _save_figure(plots.overview(result), args.plot)
+    if not result.ok:
+        print(f"camdyn: the run stopped early: {result.outcome.message}", file=sys.stderr)
+        return EXIT_INCOMPLETE
+    return EXIT_OK
+
+
+def _read_series(path: str, quantity: str):
+    """(t, values, period) from a file written by ``camdyn simulate --csv/--netcdf``."""
+    import numpy as np
+
+    p = Path(path)
+    if not p.exists():
+        raise UsageError(f"{path}: no such file")
+    if p.suffix in (".nc", ".netcdf", ".cdf"):
+        import xarray as xr
+
+        with xr.open_dataset(p, engine="scipy") as ds:
+            if quantity not in ds and quantity != "t":
+                raise UsageError(f"{path}: no variable {quantity!r} (has {', '.join(map(str, ds.data_vars))})")
+            t, x = ds["t"].values.astype(float), ds[quantity].values.astype(float)
+            period = float(ds.attrs.get("period_s", -1.0))
+            theta = ds["Theta"].values.astype(float) if "Theta" in ds else None
+    else:
+        with open(p, newline="") as fh:
+            header = next(csv.reader(fh), None)
+        if not header or "t" not in header or quantity not in header:
+            raise UsageError(f"{path}: a CSV from 'camdyn simulate --csv' with columns t and {quantity} is needed")
+        table = np.genfromtxt(p, delimiter=",", skip_header=1, usecols=[header.index(c) for c in
+                                                                          ("t", quantity, "Theta")
+                                                                          if c in header])
+        t, x = table[:, 0], table[:, 1]
+        theta = table[:, 2] if table.shape[1] > 2 else None
+        period = -1.0
+    if not period > 0 and theta is not None and t.size > 1:  # constant speed: Theta is linear in t
+        rate = (theta[-1] - theta[0]) / (t[-1] - t[0])
+        if rate != 0 and np.allclose(theta, theta[0] + rate * (t - t[0]), rtol=0, atol=1e-9 * max(1, abs(theta).max())):
+            period = abs(2 * math.pi / rate)
+    return t, x, (period if period > 0 else math.inf)
+
+
+class _Series:
+    """A minimal stand-in for a Result (t, period and one quantity) for spectra of saved runs."""
+
+    scene = None
+
+    def __init__(self, t, period, **values):
+        self.t, self.period, self._values = t, period, values
+
+    def __getattr__(self, name):
+        values = self.__dict__.get("_values", {})
+        if name in values:
+            return values[name]
+        raise AttributeError(name)
+
+    def after(self, t0):
+        keep = self.t >= t0
+        return _Series(self.t[keep], self.period, **{k: v[keep] for k, v in self._values.items()})
+
+
+def cmd_spectrum(args) -> int:
+    import numpy as np
+
+    from . import signal
+
+    _check_outputs(args, "csv", "plot")
+    natural = None
+    status = EXIT_OK
+    if args.input:
+        t, x, period = _read_series(args.input, args.quantity)
+        source = _Series(t, period, **{args.quantity: x})
+    else:
+        result = _simulate(args)
+        print(result.summary())
+        if not result.ok:
+            print(f"camdyn: the run stopped early: {result.outcome.message}", file=sys.stderr)
+            status = EXIT_INCOMPLETE
+        source, period = result, result.period
+        if args.speed_rpm is not None:  # the linearization about the static equilibrium (Eq. 23)
+            from .analysis import natural_frequency
+            from .cam import ConstantSpeed
+
+            try:
+                natural = natural_frequency(_rig(args), _scene(args), ConstantSpeed(args.speed_rpm)).Hz
+            except CamdynError:
+                natural = None
+    transient = args.transient_revolutions
+    t = np.asarray(source.t, dtype=float)
+    if transient and math.isfinite(period):
+        if transient * period >= t[-1] - t[0]:
+            raise UsageError(f"--transient-revolutions {transient:g} drops the whole run "
+                             f"({(t[-1] - t[0]) / period:.3g} revolutions)")
+        source = source.after(t[0] + transient * period)
+    from .plots import whole_period_samples
+
+    keep = whole_period_samples(source.t, period)  # harmonics of the cam on frequency bins
+    values = np.asarray(getattr(source, args.quantity), dtype=float)[keep]
+    times = np.asarray(source.t, dtype=float)[keep]
+    f, amp = signal.spectrum(times, values)
+    periods = values.size * (times[1] - times[0]) / period if math.isfinite(period) else math.nan
+    f0 = 1 / period if math.isfinite(period) else math.nan
+    print(f"spectrum of {args.quantity}: {values.size} samples"
+          + (f" ({periods:.4g} cam periods)" if math.isfinite(periods) else "")
+          + f", resolution {f[1] - f[0]:.4g} Hz, "
+          f"up to {f[-1]:.6g} Hz" + (f"; cam frequency Omega_c = {f0:.6g} Hz" if math.isfinite(f0) else ""))
+    if natural:
+        print(f"  linearized natural frequency (Eq. 23): {natural:.6g} Hz")
+    fmax = args.fmax if args.fmax is not None else f[-1]
+    band = (f > 0) & (f <= fmax)
+    peaks = np.flatnonzero((amp[1:-1] > amp[:-2]) & (amp[1:-1] >= amp[2:])) + 1
+    peaks = peaks[band[peaks]]
+    peaks = peaks[np.argsort(amp[peaks])[::-1][:args.peaks]]
+    unit = _units().get(args.quantity, "")
+    for k in sorted(peaks, key=lambda i: f[i]):
+        fk = signal.peak_frequency(f, amp, fmin=f[k], fmax=f[k])  # bin k, refined with its neighbours
+        order = f"  = {fk / f0:.3f} x Omega_c" if math.isfinite(f0) else ""
+        print(f"  peak {fk:12.6g} Hz  amplitude {amp[k]:.4g} {unit}{order}")
+    if args.csv:
         with open(args.csv, "w", newline="") as fh:
             writer = csv.writer(fh)
-            writer.writerow(columns + ["regime"])
-            data = [getattr(result, c) for c in columns]
-            for i in range(result.t.size):
-                writer.writerow([repr(float(col[i])) for col in data] + [result.regime[i]])
+            writer.writerow(["f_Hz", f"amplitude_{args.quantity}_{unit}".rstrip("_")])
+            for fi, ai in zip(f, amp):
+                writer.writerow([repr(float(fi)), repr(float(ai))])
         print(f"  wrote {args.csv}")
-    return 0 if result.ok else 3
+    if args.plot:
+        plots = _plot_modules()
+        bands = [tuple(b) for b in args.band] if args.band else None
+        marks = {r"$\vartheta$ (Eq. 23)": natural} if natural else None
+        fig = plots.spectrum(source, args.quantity, bands=bands, fmax=args.fmax, mark_Hz=marks)
+        _save_figure(fig, args.plot)
+    return status
 
 
 def cmd_equilibrium(args) -> int:
     from .analysis import natural_frequency, static_equilibrium
     from .cam import ConstantSpeed
-    rig = _rig(args.rig)
+
+    rig = _rig(args)
     eq = static_equilibrium(rig, args.contact)
     nf = natural_frequency(rig, _scene(args), ConstantSpeed(args.speed_rpm))
     out = {"alpha_star_rad": eq.alpha, "psi_i_star_m": eq.psi_i, "psi_j_star_m": eq.psi_j, "chi_star_m": eq.chi,
            "contact_stiffness_N_per_m": eq.contact_stiffness, "natural_frequency_Hz": nf.Hz,
-           "natural_frequency_rad_s": nf.damped_rad_s, "damping_ratio": nf.damping_ratio}
+           "natural_frequency_rad_s": nf.damped_rad_s, "undamped_natural_frequency_Hz": nf.undamped_Hz,
+           "damping_ratio": nf.damping_ratio, "regime": nf.regime}
     print(json.dumps(out, indent=2))
-    return 0
+    return EXIT_OK
 
 
 def cmd_contact_loss(args) -> int:
     from .analysis import contact_loss_speed
-    print(f"{contact_loss_speed(_rig(args.rig)):.6g}")
-    return 0
+
+    rig = _rig(args)
+    if args.k_s:
+        values = _parse_values(args.k_s, "--k-s")
+        rows = [(k, contact_loss_speed(rig.replace(k_s=k))) for k in values]
+        print("k_s_N_per_m,contact_loss_rpm")
+        for k, v in rows:
+            print(f"{k:.6g},{v:.6g}")
+    else:
+        print(f"{contact_loss_speed(rig):.6g}")
+    return EXIT_OK
+
+
+# --- sweep ---------------------------------------------------------------------------
+def _sweep_module():
+    try:
+        return importlib.import_module("camdyn.sweep")
+    except ImportError as exc:
+        if getattr(exc, "name", None) in ("camdyn.sweep", None):
+            raise MissingPart("sweeps (camdyn.sweep) are not part of this version of camdyn") from None
+        raise
+
+
+@contextlib.contextmanager
+def _executor(args):
+    """None (serial), a local process pool (--jobs N), or a dask cluster (--dask ADDRESS)."""
+    if args.dask:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise MissingPart("--dask needs dask.distributed: pip install \"dask[distributed]\"") from None
+        with Client(args.dask) as client:
+            yield client.get_executor()
+    elif args.jobs > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(args.jobs) as pool:
+            yield pool
+    else:
+        yield None
+
+
+def _outcome_names(ds) -> dict[int, str]:
+    text = ds.attrs.get("outcome_codes", "")
+    pairs = [item.strip().split("=") for item in text.split(",") if "=" in item]
+    return {int(code): name for code, name in pairs}
+
+
+def cmd_sweep(args) -> int:
+    import numpy as np
+
+    rig, scene = _rig(args), _scene(args)
+    speeds = _parse_values(args.speeds, "--speeds")
+    param = args.param
+    if param and args.values is None:
+        raise UsageError("--param needs --values")
+    if not param and args.values:
+        raise UsageError("--values needs --param (the rig parameter to vary)")
+    values = _parse_values(args.values, "--values") if param else None
+    if param:
+        from .rig import PARAMETERS
+
+        if param not in {p.name for p in PARAMETERS}:
+            raise UsageError(f"--param {param!r} is not a rig parameter; one of "
+                             f"{', '.join(p.name for p in PARAMETERS)}")
+    if args.transient_revolutions >= args.revolutions:
+        raise UsageError("--transient-revolutions must be less than --revolutions")
+    if args.samples_per_revolution < 1:
+        raise UsageError("--samples-per-revolution must be at least 1")
+    _check_outputs(args, "out", "plot")
+    sweeps = _sweep_module()
+    solver = dict(method=args.method, rtol=args.rtol, atol=args.atol)
+    if args.backend:
+        solver["backend"] = args.backend
+    progress = not args.no_progress and sys.stderr.isatty()
+    with _executor(args) as executor:
+        common = dict(executor=executor, progress=progress, **solver)
+        if not param:
+            revolutions, transient = args.revolutions, args.transient_revolutions
+            if revolutions != int(revolutions) or transient != int(transient):
+                raise UsageError("a bifurcation sweep needs whole --revolutions and --transient-revolutions")
+            ds = sweeps.bifurcation(rig, scene, speeds, revolutions=int(revolutions),
+                                    transient_revolutions=int(transient), **common)
+        elif param == "k_s":
+            ds = sweeps.contact_loss_map(rig, scene, values, speeds, revolutions=args.revolutions,
+                                         transient_revolutions=args.transient_revolutions,
+                                         samples_per_revolution=args.samples_per_revolution, **common)
+        else:
+            ds = sweeps.sweep(rig, scene, {param: values, "speed_rpm": speeds},
+                              sweeps.Summary(args.transient_revolutions), revolutions=args.revolutions,
+                              samples_per_revolution=args.samples_per_revolution, **common)
+    names = _outcome_names(ds)
+    success = next((c for c, n in names.items() if n == "SUCCESS"), 0)
+    ok = ds["outcome"].values == success
+    impacting = np.nan_to_num(ds["impacts_per_rev"].values) > 0
+    regimes = np.where(ok, impacting.astype(int), 2)
+    failed = int(np.sum(~ok))
+    print(f"sweep of {scene.slug} on rig {rig.name!r}: {regimes.size} runs, "
+          f"{int(np.sum(regimes == 0))} without impacts after the transient, {int(np.sum(regimes == 1))} impacting, "
+          f"{failed} stopped early")
+    for code in sorted(set(ds["outcome"].values.ravel().tolist()) - {success}):
+        print(f"  {int(np.sum(ds['outcome'].values == code))} stopped with {names.get(int(code), code)}")
+    if args.out:
+        ds.to_netcdf(args.out, engine="scipy")
+        print(f"  wrote {args.out}")
+    if args.plot:
+        plots = _plot_modules()
+        title = f"{scene.slug}, rig {rig.name}"
+        if param:
+            regimes_2d = regimes.reshape(len(values), len(speeds))
+            loss = None
+            if "loss_speed_predicted" in ds:
+                loss = (ds["loss_speed_predicted"].values, ds["k_s"].values)
+            fig = plots.contact_map(speeds, values, regimes_2d, loss_curve=loss, log_k=param == "k_s", title=title)
+            if param != "k_s":
+                fig.axes[0].set_ylabel(param)
+        else:
+            from .analysis import static_equilibrium
+
+            alpha_star = static_equilibrium(rig, scene.contact).alpha
+            fig = plots.bifurcation(speeds, ds["alpha_section"].values, relative_to=alpha_star,
+                                    title=f"{title}: revolutions {args.transient_revolutions:g}-{args.revolutions:g}")
+        _save_figure(fig, args.plot)
+    return EXIT_INCOMPLETE if failed else EXIT_OK
+
+
+# --- regenerate ----------------------------------------------------------------------
+_REGENERATE = r'''
+import importlib, sys
+from pathlib import Path
+derive_dir, out, check_only, jobs = sys.argv[1], Path(sys.argv[2]), sys.argv[3] == "1", int(sys.argv[4])
+if derive_dir:
+    sys.path.insert(0, str(Path(derive_dir).resolve().parent))
+    package = Path(derive_dir).resolve().name
+else:
+    package = "camdyn.derive"
+try:
+    import sympy  # noqa: F401
+except ImportError:
+    print("camdyn: error: regenerate needs SymPy: pip install \"camdyn[derive]\"", file=sys.stderr)
+    sys.exit(4)
+writer = importlib.import_module(package + ".writer")
+catalog = importlib.import_module(package + ".catalog")
+codegen = importlib.import_module(package + ".codegen")
+from tqdm import tqdm
+specs = tuple(sorted(set(catalog.CATALOG), key=lambda s: s.slug))
+bar = dict(total=len(specs), desc="deriving scenes", unit="scene", file=sys.stderr, disable=None)
+if jobs > 1:
+    from concurrent.futures import ProcessPoolExecutor
+    with ProcessPoolExecutor(jobs) as pool:
+        texts = list(tqdm(pool.map(codegen.module_source, specs), **bar))
+else:
+    texts = [codegen.module_source(s) for s in tqdm(specs, **bar)]
+files = {writer.module_name(s) + ".py": t for s, t in zip(specs, texts)}
+files["__init__.py"] = writer.registry_source(specs)
+if not check_only:
+    changed = writer.write(files, out)
+    print(f"{len(files)} files generated in {out}; changed: {', '.join(changed) or 'none'}")
+problems = writer.check(files, out)
+for p in problems:
+    print(p, file=sys.stderr)
+print(f"drift check: {len(files)} files " + ("in sync with derive/" if not problems else f"-- {len(problems)} differ"))
+sys.exit(1 if problems else 0)
+'''
+
+_IMPORT_CHECK = r'''
+import importlib.util, sys
+from pathlib import Path
+out = Path(sys.argv[1])
+name = "camdyn_regenerated_check"
+spec = importlib.util.spec_from_file_location(name, out / "__init__.py", submodule_search_locations=[str(out)])
+pkg = importlib.util.module_from_spec(spec); sys.modules[name] = pkg; spec.loader.exec_module(pkg)
+bad = []
+for slug, module in sorted(pkg.SCENES.items()):
+    try:
+        m = importlib.import_module(name + "." + module)
+        assert m.SLUG == slug, f"{module}.SLUG is {m.SLUG!r}"
+    except Exception as exc:
+        bad.append(f"{module}: {type(exc).__name__}: {exc}")
+if "sympy" in sys.modules:
+    bad.append("the generated code imports SymPy")
+for b in bad:
+    print(b, file=sys.stderr)
+print(f"import check: {len(pkg.SCENES) - len(bad)} of {len(pkg.SCENES)} scene modules import without SymPy")
+sys.exit(1 if bad else 0)
+'''
+
+
+def _default_generated() -> Path:
+    from . import generated
+
+    return Path(generated.__file__).resolve().parent
 
 
 def cmd_regenerate(args) -> int:
-    command = [sys.executable, "-m", "camdyn.derive"] + (["--check"] if args.check else [])
-    return subprocess.call(command)
+    if args.derive:
+        derive_dir = Path(args.derive)
+        if not (derive_dir / "writer.py").is_file() or not (derive_dir / "catalog.py").is_file():
+            raise UsageError(f"--derive {args.derive}: not a camdyn derive/ folder (no writer.py and catalog.py)")
+        out = Path(args.out) if args.out else derive_dir.resolve().parent / "generated"
+    else:
+        out = Path(args.out) if args.out else _default_generated()
+    if args.check and not out.is_dir():
+        raise UsageError(f"{out}: no generated package to check")
+    jobs = args.jobs or (os.cpu_count() or 1)
+    code = subprocess.call([sys.executable, "-c", _REGENERATE, str(args.derive or ""), str(out),
+                            "1" if args.check else "0", str(jobs)])
+    if code != 0:
+        return EXIT_MISSING if code == 4 else EXIT_CHECK_FAILED if code == 1 else EXIT_INTERNAL
+    code = subprocess.call([sys.executable, "-c", _IMPORT_CHECK, str(out)])
+    if code != 0:
+        return EXIT_CHECK_FAILED
+    if not args.check and out.resolve() != _default_generated():
+        print(f"  the scenes in {out} are not camdyn.generated; see docs/model-editing.md to use them")
+    return EXIT_OK
+
+
+# --- reproduce -----------------------------------------------------------------------
+def _studies_module():
+    try:
+        return importlib.import_module("camdyn.studies")
+    except ImportError as exc:
+        if getattr(exc, "name", None) and not str(exc.name).startswith("camdyn.studies"):
+            raise
+        raise MissingPart("the paper's studies (camdyn.studies) are not part of this version of camdyn") from None
+
+
+def cmd_reproduce(args) -> int:
+    studies = _studies_module()
+    names = list(studies.STUDIES)
+    if args.list or args.study in (None, "list"):
+        for name, (_, text) in studies.STUDIES.items():
+            print(f"{name:14s} {text}")
+        if args.study is None and not args.list:
+            print("run one with: camdyn reproduce <study> [--fast] (or 'all')")
+        return EXIT_OK
+    if args.study not in names + ["all"]:
+        import difflib
+
+        close = difflib.get_close_matches(args.study, names, n=1)
+        raise UsageError(f"no study {args.study!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
+                         + f"; one of: {', '.join(names)}, all")
+    quiet = args.json or args.study == "numbers"
+    log = (lambda *a, **k: print(*a, file=sys.stderr, **k)) if quiet else print
+    from .studies.common import to_json
+
+    for name in names if args.study == "all" else [args.study]:
+        output = studies.run(name, fast=True if args.fast else None, out=args.out, write_docs=not args.no_docs,
+                             data_dir=args.data_dir, log=log)
+        if quiet:
+            print(to_json(output.numbers))
+        else:
+            for figure in output.figures:
+                print(f"wrote {figure}")
+    return EXIT_OK
+
+
+def cmd_scenes(args) -> int:
+    from . import generated, presets
+
+    if args.json:
+        print(json.dumps({"scenes": sorted(generated.SCENES), "rigs": presets.available(),
+                          "options": {k: list(v) for k, v in generated.OPTIONS.items()}}, indent=2))
+        return EXIT_OK
+    print("generated scenes (contact_damping_friction_motion_model[_vrprinted][_printedsign]):")
+    for slug in sorted(generated.SCENES):
+        print(f"  {slug}")
+    print("shipped rigs: " + ", ".join(presets.available()) + "  (or a path to a .toml rig file)")
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------------- parser
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises UsageError (one line, exit 2) instead of printing usage and exiting."""
+
+    def error(self, message):
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+_FORMATTER = argparse.RawDescriptionHelpFormatter
+
+
+def _options():
+    from . import generated
+
+    return generated.OPTIONS
+
+
+def _add_physics(p, contact: bool = True, full: bool = True):
+    opts = _options()
+    g = p.add_argument_group("rig and scene")
+    g.add_argument("--rig", default="example", help="shipped rig name (see 'camdyn scenes') or a .toml rig file "
+                                                    "(default: example)")
+    if contact:
+        g.add_argument("--contact", default="line", choices=opts["contact"], help="contact law (default: line)")
+    g.add_argument("--damping", default="D", choices=opts["damping"], help="damping model, Eqs. 24-28 (default: D)")
+    g.add_argument("--friction", default="coulomb", choices=opts["friction"],
+                   help="friction model: coulomb (I) or tanh (II) (default: coulomb)")
+    if full:
+        g.add_argument("--model", default="nonlinear", choices=opts["model"],
+                       help="non-linear, or a linearization (Section 8) (default: nonlinear)")
+        g.add_argument("--sliding-velocity", default="kinematic", choices=opts["sliding_velocity"],
+                       dest="sliding_velocity", help="v_r: derived, or as printed (misprint 8) (default: kinematic)")
+        g.add_argument("--damping-sign", default="dissipative", choices=opts["damping_sign"], dest="damping_sign",
+                       help="B/D coefficient: dissipative, or as printed (misprint 2) (default: dissipative)")
+
+
+def _add_cam(p, required_speed: bool = False):
+    g = p.add_argument_group("cam motion (one of)")
+    g.add_argument("--speed-rpm", type=float, dest="speed_rpm", metavar="S",
+                   help="constant cam speed in rev/min; > 0 counter-clockwise (de-energizing), < 0 clockwise")
+    g.add_argument("--oscillating-rpm", type=float, dest="oscillating_rpm", metavar="F",
+                   help="oscillating cam, F oscillations per minute (Section 7.2: 40)")
+    g.add_argument("--amplitude-pp", type=float, default=math.pi, dest="amplitude_pp", metavar="RAD",
+                   help="peak-to-peak angle of the oscillating cam in rad (default: pi)")
+
+
+def _add_run(p, revolutions: float = 3.0, sample_rate: float = 20_000.0):
+    g = p.add_argument_group("run and solver")
+    g.add_argument("--revolutions", type=float, default=revolutions,
+                   help=f"run length in cam periods (default: {revolutions:g})")
+    g.add_argument("--t-end", type=float, dest="t_end", metavar="SECONDS", help="run length in seconds instead")
+    g.add_argument("--sample-rate-Hz", type=float, default=sample_rate, dest="sample_rate_Hz", metavar="HZ",
+                   help=f"output samples per second (default: {sample_rate:g})")
+    _add_solver(g)
+
+
+def _add_solver(g):
+    from .integrate import METHODS
+
+    g.add_argument("--method", default="DOP853", choices=sorted(METHODS),
+                   help="SciPy integration method (default: DOP853)")
+    g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (default: 1e-8)")
+    g.add_argument("--atol", type=float, default=1e-12, help="absolute tolerance (default: 1e-12)")
+    g.add_argument("--backend", choices=["scipy", "compiled"], default=None,
+                   help="integration backend (default: camdyn's default); 'compiled' where available")
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="camdyn", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="camdyn", formatter_class=_FORMATTER,
+                     description="Contact dynamics of a rotational cam-follower (Sundar, Dreyer & Singh, "
+                                 "J. Sound Vib. 2013).\nRun 'camdyn <command> --help' for a command's options.",
+                     epilog=EXIT_CODES_HELP + "\n\nexample:\n  camdyn simulate --speed-rpm 1100 --plot run.png")
+    parser.add_argument("--version", action="version", version=f"camdyn {_version()}")
+    parser.add_argument("--traceback", action="store_true", help="show the Python traceback on errors")
+    parser.add_argument("--no-progress", action="store_true", dest="no_progress",
+                        help="never show progress bars (they show only on a terminal anyway)")
+    sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
+    sub.required = True
 
-    def physics(p, contact=True):
-        p.add_argument("--rig", default="example", help="shipped rig name or path to a .toml file")
-        if contact:
-            p.add_argument("--contact", default="line", choices=["line", "point"])
-        p.add_argument("--damping", default="D", choices=["none", "A", "B", "C", "D", "E"])
-        p.add_argument("--friction", default="coulomb", choices=["none", "coulomb", "tanh"])
+    def command(name, help_, epilog, func, **kw):
+        p = sub.add_parser(name, help=help_, description=help_[0].upper() + help_[1:] + ".",
+                           epilog=epilog + "\n\n" + EXIT_CODES_HELP, formatter_class=_FORMATTER, **kw)
+        p.set_defaults(func=func)
+        return p
 
-    p = sub.add_parser("simulate", help="simulate at a constant cam speed")
-    physics(p)
-    p.add_argument("--speed-rpm", type=float, required=True, dest="speed_rpm")
-    p.add_argument("--revolutions", type=float, default=3.0)
-    p.add_argument("--sample-rate-Hz", type=float, default=20_000.0, dest="sample_rate_Hz")
-    p.add_argument("--rtol", type=float, default=1e-8)
-    p.add_argument("--csv", help="write the time histories to this CSV file")
-    p.set_defaults(func=cmd_simulate)
+    p = command("simulate", "simulate a run and save its time histories and a plot",
+                "examples:\n"
+                "  camdyn simulate --speed-rpm 300 --revolutions 2 --plot run.png\n"
+                "  camdyn simulate --speed-rpm 1100 --damping B --csv run.csv --netcdf run.nc\n"
+                "  camdyn simulate --oscillating-rpm 40 --friction tanh --revolutions 1 --plot osc.png\n\n"
+                "The run starts at the static equilibrium. CSV: one column per quantity (SI units) and the\n"
+                "regime; NetCDF: the same with units, regime codes and impact times. The plot shows\n"
+                "alpha_r, F_n and v_r over t/T with free flight shaded.", cmd_simulate)
+    _add_physics(p)
+    _add_cam(p)
+    _add_run(p)
+    g = p.add_argument_group("outputs")
+    g.add_argument("--csv", metavar="FILE", help="write the time histories to this CSV file")
+    g.add_argument("--netcdf", metavar="FILE", help="write the time histories to this NetCDF file (.nc)")
+    g.add_argument("--plot", metavar="FILE", help="save an overview figure (PNG, PDF or SVG by extension)")
+    g.add_argument("--transient-revolutions", type=float, default=0.0, dest="transient_revolutions",
+                   metavar="N", help="revolutions left out of the alpha_r statistics (default: 0)")
 
-    p = sub.add_parser("equilibrium", help="static equilibrium and natural frequency (Eqs. 16-23)")
-    physics(p)
+    p = command("spectrum", "amplitude spectrum of a run, with the harmonics of the cam speed",
+                "examples:\n"
+                "  camdyn spectrum --speed-rpm 300 --revolutions 10 --band 0 60 --band 1800 2600 --plot s.png\n"
+                "  camdyn spectrum --input run.nc --quantity alpha_r\n\n"
+                "Simulates a run (same options as simulate) or reads one written by 'camdyn simulate\n"
+                "--csv/--netcdf', prints the strongest peaks as multiples of the cam frequency and the\n"
+                "linearized natural frequency, and plots the spectrum with k*Omega_c marked.", cmd_spectrum)
+    _add_physics(p)
+    _add_cam(p)
+    _add_run(p, revolutions=10.0, sample_rate=10_000.0)
+    g = p.add_argument_group("spectrum")
+    g.add_argument("--input", metavar="FILE", help="a .csv or .nc written by 'camdyn simulate' (no simulation)")
+    g.add_argument("--quantity", default="alpha", help="time history to analyse (default: alpha; e.g. alpha_r, F_n)")
+    g.add_argument("--transient-revolutions", type=float, default=1.0, dest="transient_revolutions", metavar="N",
+                   help="revolutions dropped before the transform (default: 1)")
+    g.add_argument("--peaks", type=int, default=8, help="how many peaks to list (default: 8)")
+    g.add_argument("--fmax", type=float, metavar="HZ", help="highest frequency listed and plotted")
+    g.add_argument("--band", type=float, nargs=2, action="append", metavar=("LO", "HI"),
+                   help="plot this band (Hz) in its own panel; repeat for more panels")
+    g.add_argument("--csv", metavar="FILE", help="write f_Hz and amplitude to this CSV file")
+    g.add_argument("--plot", metavar="FILE", help="save the spectrum figure")
+
+    p = command("equilibrium", "static equilibrium and linearized natural frequency (Eqs. 16-23), as JSON",
+                "example:\n  camdyn equilibrium --contact point --speed-rpm 300\n\n"
+                "The cam speed (default: at rest) sets the direction of Coulomb friction, which is why\n"
+                "de- and self-energizing rigs differ (Section 7.1).", cmd_equilibrium,
+                aliases=["natural-frequency"])
+    _add_physics(p, full=False)
     p.add_argument("--speed-rpm", type=float, default=0.0, dest="speed_rpm",
-                   help="cam speed setting the friction direction (default: at rest)")
-    p.set_defaults(func=cmd_equilibrium)
+                   help="cam speed setting the friction direction (default: 0, at rest)")
 
-    p = sub.add_parser("contact-loss", help="contact-loss speed in rev/min by inverse kinematics")
-    p.add_argument("--rig", default="example")
-    p.set_defaults(func=cmd_contact_loss)
+    p = command("contact-loss", "cam speed (rev/min) above which the follower leaves the cam",
+                "examples:\n  camdyn contact-loss --rig my_rig.toml\n  camdyn contact-loss --k-s 100:10000:5:log\n\n"
+                "By inverse kinematics (Section 6): the speed at which rigid contact would need a\n"
+                "pulling contact force. With --k-s, one line per spring stiffness (CSV).", cmd_contact_loss)
+    p.add_argument("--rig", default="example", help="shipped rig name or a .toml rig file (default: example)")
+    p.add_argument("--k-s", dest="k_s", metavar="VALUES",
+                   help="spring stiffnesses in N/m: 'start:stop:count[:log]' or 'v1,v2,...'")
 
-    p = sub.add_parser("regenerate", help="regenerate camdyn.generated (needs camdyn[derive])")
-    p.add_argument("--check", action="store_true", help="only check that generated/ is up to date")
-    p.set_defaults(func=cmd_regenerate)
+    p = command("sweep", "sweep the cam speed (and one rig parameter): bifurcation diagram or contact map",
+                "examples:\n"
+                "  camdyn sweep --speeds 600:1500:91 --revolutions 200 --transient-revolutions 50 --plot bif.png\n"
+                "  camdyn sweep --speeds 200:1600:29 --param k_s --values 200:20000:21:log --plot map.png\n"
+                "  camdyn sweep --speeds 900:1300:5 --param zeta_D --values 0.01,0.1 --out zeta.nc\n\n"
+                "One run per point from the static equilibrium (camdyn.sweep; the compiled backend by\n"
+                "default). With --speeds only: the Poincare section of alpha (once per revolution, after\n"
+                "the transient) against speed. With --param k_s: the map of runs with and without impacts\n"
+                "over (speed, k_s) with the inverse-kinematics contact-loss curve (Fig. 9); any other rig\n"
+                "parameter gives the same map over that parameter. --out saves the labelled results as\n"
+                "NetCDF; --jobs or --dask run the points in parallel.", cmd_sweep)
+    _add_physics(p)
+    g = p.add_argument_group("sweep")
+    g.add_argument("--speeds", required=True, metavar="VALUES",
+                   help="cam speeds in rev/min: 'start:stop:count[:log]' or 'v1,v2,...'")
+    g.add_argument("--param", metavar="NAME", help="a rig parameter to vary as well (e.g. k_s, e, zeta_D)")
+    g.add_argument("--values", metavar="VALUES", help="its values (SI), same syntax as --speeds")
+    g.add_argument("--revolutions", type=float, default=60.0, help="run length in revolutions (default: 60)")
+    g.add_argument("--transient-revolutions", type=float, default=20.0, dest="transient_revolutions", metavar="N",
+                   help="revolutions dropped before the statistics and the section (default: 20)")
+    g.add_argument("--samples-per-revolution", type=int, default=64, dest="samples_per_revolution", metavar="N",
+                   help="output samples per revolution for the maps (default: 64; the bifurcation uses 1)")
+    g.add_argument("--jobs", type=int, default=1, help="local worker processes (default: 1)")
+    g.add_argument("--dask", metavar="ADDRESS", help="run on this dask scheduler (tcp://host:port)")
+    _add_solver(g)
+    g.add_argument("--out", metavar="FILE", help="save the sweep as NetCDF (.nc)")
+    g.add_argument("--plot", metavar="FILE", help="save the bifurcation diagram or contact map")
+
+    p = command("regenerate", "regenerate the model code from derive/ (needs camdyn[derive])",
+                "examples:\n"
+                "  camdyn regenerate                  # rewrite camdyn.generated from camdyn.derive\n"
+                "  camdyn regenerate --check          # exit 1 if generated/ is out of date\n"
+                "  camdyn regenerate --derive my/derive --out my/generated   # an edited copy\n\n"
+                "Derives every scene of derive/catalog.py, writes the modules, checks that the folder\n"
+                "now matches derive/ exactly (drift check), and imports every module without SymPy.\n"
+                "See docs/model-editing.md.", cmd_regenerate)
+    p.add_argument("--check", action="store_true", help="only check: exit 1 if the folder differs from derive/")
+    p.add_argument("--derive", metavar="DIR", help="a derive/ folder to use instead of the installed camdyn.derive")
+    p.add_argument("--out", metavar="DIR", help="generated package folder (default: camdyn.generated, or "
+                                                "DIR/../generated with --derive)")
+    p.add_argument("--jobs", type=int, default=0, help="processes (default: all cores)")
+
+    p = command("reproduce", "reproduce a study of the paper on the reference rig: its figure and numbers",
+                "examples:\n  camdyn reproduce --list\n  camdyn reproduce fig10 --fast --out /tmp/repro\n"
+                "  camdyn reproduce numbers --json\n\n"
+                "Writes the study's figure (<out>/img/repro_<study>.png) and its section of\n"
+                "<out>/reproduction.md, the paper's statement beside camdyn's result (camdyn.studies;\n"
+                "the same as 'python -m camdyn.studies <study>'). <out> is the checkout's docs/ by default.",
+                cmd_reproduce)
+    p.add_argument("study", nargs="?", help="the study (see --list), or 'all'")
+    p.add_argument("--list", action="store_true", help="list the studies")
+    p.add_argument("--fast", action="store_true", help="reduced speeds and revolutions (also: CAMDYN_FAST=1)")
+    p.add_argument("--out", metavar="DIR", help="folder of reproduction.md and img/ (default: docs/)")
+    p.add_argument("--json", action="store_true", help="print the study's numbers as JSON on stdout")
+    p.add_argument("--no-docs", action="store_true", dest="no_docs", help="do not update the report")
+    p.add_argument("--data-dir", metavar="DIR", dest="data_dir",
+                   help="where 'reference-rig' writes the rig presets (default: camdyn/data)")
+
+    p = command("scenes", "list the generated scenes and the shipped rigs",
+                "example:\n  camdyn scenes --json", cmd_scenes)
+    p.add_argument("--json", action="store_true", help="print scenes, rigs and scene options as JSON")
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = _parser()
-    args = parser.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    show_traceback = "--traceback" in argv
     try:
-        return args.func(args)
-    except (CamdynError, ValueError, OSError) as exc:
-        print(f"camdyn: error: {exc}", file=sys.stderr)
-        return 2
+        args = _parser().parse_args(argv)
+        args.argv = argv
+        code = args.func(args)
+        sys.stdout.flush()  # here, so that a closed pipe is handled below, not at exit
+        return code
+    except KeyboardInterrupt:
+        print("camdyn: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # e.g. 'camdyn scenes | head': the reader left; say nothing more
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
+    except Exception as exc:  # one line, never a traceback (unless asked for)
+        if show_traceback:
+            import traceback
+
+            traceback.print_exc()
+        code, line = _classify(exc)
+        print(f"camdyn: {line}", file=sys.stderr)
+        return code
+
+
+def _classify(exc: BaseException) -> tuple[int, str]:
+    """Exit code and the one-line message of an exception."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    if isinstance(exc, MissingPart):
+        return EXIT_MISSING, f"error: {text}"
+    if isinstance(exc, ImportError):
+        return EXIT_MISSING, f"error: a module is missing: {text}"
+    if isinstance(exc, (CamdynError, ValueError)):
+        return EXIT_USAGE, f"error: {text}"
+    if isinstance(exc, OSError):
+        if exc.filename and exc.strerror:
+            return EXIT_USAGE, f"error: {exc.filename}: {exc.strerror}"
+        return EXIT_USAGE, f"error: {text}"
+    return EXIT_INTERNAL, f"internal error ({type(exc).__name__}: {text}); please report it with --traceback"
 
 
 if __name__ == "__main__":

@@ -1,10 +1,27 @@
-"""The camdyn command: outputs, one-line errors, exit codes."""
+"""The camdyn command: outputs, --help everywhere, one-line errors, documented exit codes."""
 from __future__ import annotations
 
 import csv
 import json
+import math
+import subprocess
+import sys
 
+import numpy as np
+import pytest
+
+from camdyn import cli
 from camdyn.cli import main
+
+PNG = b"\x89PNG\r\n\x1a\n"
+QUICK = ["--speed-rpm", "1100", "--revolutions", "2", "--sample-rate-Hz", "5000"]  # impacting, < 1 s
+
+
+def one_error_line(capsys, starts="camdyn: error:"):
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith(starts), err[0]
+    return err[0]
 
 
 def test_simulate_writes_csv(tmp_path, capsys):
@@ -17,17 +34,253 @@ def test_simulate_writes_csv(tmp_path, capsys):
     assert "alpha_r: rms" in capsys.readouterr().out
 
 
+def test_simulate_writes_netcdf_and_plot(tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("matplotlib")
+    nc, png = tmp_path / "run.nc", tmp_path / "run.png"
+    assert main(["simulate", *QUICK, "--netcdf", str(nc), "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == PNG
+    with xr.open_dataset(nc, engine="scipy") as ds:
+        assert ds.attrs["scene"] == "line_d_coulomb_constant_nonlinear"
+        assert math.isclose(ds.attrs["period_s"], 60 / 1100)
+        assert ds["alpha_r"].attrs["units"] == "rad" and ds["F_n"].attrs["units"] == "N"
+        names = ds["regime"].attrs["flag_meanings"].split()
+        assert "free" in names and ds["impact_t"].size > 0  # 1100 rev/min is above contact loss
+        assert set(np.unique(ds["regime"].values)) <= set(range(len(names)))
+    out = capsys.readouterr().out
+    assert str(nc) in out and str(png) in out
+
+
+def test_spectrum_of_a_saved_run_finds_the_cam_harmonics(tmp_path, capsys):
+    run = tmp_path / "run.csv"
+    assert main(["simulate", "--speed-rpm", "1500", "--revolutions", "10", "--sample-rate-Hz", "2000",
+                 "--csv", str(run)]) == 0
+    capsys.readouterr()
+    spec = tmp_path / "spec.csv"
+    assert main(["spectrum", "--input", str(run), "--transient-revolutions", "2", "--peaks", "1",
+                 "--csv", str(spec)]) == 0
+    out = capsys.readouterr().out
+    assert "cam frequency Omega_c = 25 Hz" in out  # period inferred from Theta(t) in the CSV
+    ratio = float(out.split(" x Omega_c")[0].split("=")[-1])
+    assert abs(ratio - 1) < 0.01  # the strongest peak of alpha is the fundamental
+    rows = list(csv.reader(spec.open()))
+    assert rows[0] == ["f_Hz", "amplitude_alpha_rad"] and len(rows) > 100
+
+
+def test_spectrum_simulates_and_plots(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    png = tmp_path / "spec.png"
+    assert main(["spectrum", *QUICK, "--transient-revolutions", "0.5", "--band", "0", "200",
+                 "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == PNG
+    assert "linearized natural frequency" in capsys.readouterr().out
+
+
 def test_equilibrium_prints_json(capsys):
     assert main(["equilibrium", "--damping", "none", "--friction", "none"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["psi_i_star_m"] < 0 and data["natural_frequency_Hz"] > 0
 
 
+def test_natural_frequency_alias_and_friction_direction(capsys):
+    hz = {}
+    for speed in ("300", "-300"):
+        assert main(["natural-frequency", "--speed-rpm", speed]) == 0
+        hz[speed] = json.loads(capsys.readouterr().out)["natural_frequency_Hz"]
+    assert hz["300"] != hz["-300"]  # de- and self-energizing differ (Section 7.1)
+
+
+def test_contact_loss_single_and_over_k_s(capsys):
+    assert main(["contact-loss"]) == 0
+    single = float(capsys.readouterr().out)
+    assert main(["contact-loss", "--k-s", "2000,8000"]) == 0
+    lines = capsys.readouterr().out.split()
+    assert lines[0] == "k_s_N_per_m,contact_loss_rpm"
+    speeds = [float(line.split(",")[1]) for line in lines[1:]]
+    assert math.isclose(speeds[0], single, rel_tol=1e-9)
+    assert math.isclose(speeds[1], 2 * speeds[0], rel_tol=1e-5)  # Omega_loss ~ sqrt(k_s)
+
+
+def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("matplotlib")
+    nc, png = tmp_path / "bif.nc", tmp_path / "bif.png"
+    scipy = ["--backend", "scipy"]  # no compile step in the test
+    assert main(["sweep", "--speeds", "1200,1500", "--revolutions", "4", "--transient-revolutions", "2",
+                 "--out", str(nc), "--plot", str(png), *scipy]) == 0
+    assert png.read_bytes()[:8] == PNG
+    with xr.open_dataset(nc, engine="scipy") as ds:
+        assert ds["alpha_section"].dims == ("speed_rpm", "revolution")
+        assert ds["alpha_section"].shape == (2, 3)  # after revolutions 2, 3, 4
+        assert np.all(np.isfinite(ds["alpha_section"].values))
+        assert np.all(ds["impacts_per_rev"].values > 0)
+    assert "2 runs" in capsys.readouterr().out
+    nc2, png2 = tmp_path / "map.nc", tmp_path / "map.png"
+    assert main(["sweep", "--speeds", "1200,1500", "--param", "k_s", "--values", "200,400",
+                 "--revolutions", "2", "--transient-revolutions", "1", "--samples-per-revolution", "20",
+                 "--out", str(nc2), "--plot", str(png2), *scipy]) == 0
+    assert png2.read_bytes()[:8] == PNG
+    with xr.open_dataset(nc2, engine="scipy") as ds:
+        assert ds["impacts_per_rev"].dims == ("k_s", "speed_rpm")
+        assert "loss_speed_predicted" in ds
+    assert main(["sweep", "--speeds", "1200", "--revolutions", "4.5", "--transient-revolutions", "2", *scipy]) == 2
+    assert "whole --revolutions" in capsys.readouterr().err
+
+
+def test_scenes_lists_generated_scenes(capsys):
+    assert main(["scenes", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert "line_d_coulomb_constant_nonlinear" in data["scenes"] and "example" in data["rigs"]
+    assert "friction" in data["options"]
+
+
+COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "sweep",
+            "regenerate", "reproduce", "scenes"]
+
+
+@pytest.mark.parametrize("command", [None] + COMMANDS)
+def test_help_everywhere(command, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(([command] if command else []) + ["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith("usage: camdyn") and "exit codes:" in out
+
+
+def test_every_command_is_documented_in_the_top_level_help(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = capsys.readouterr().out
+    for command in COMMANDS:
+        assert command in out
+
+
 def test_errors_are_one_line_with_exit_code_2(tmp_path, capsys):
     bad = tmp_path / "bad.toml"
     bad.write_text("name = 'x'\n[parameters]\nr_c = -1\n")
     assert main(["contact-loss", "--rig", str(bad)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("camdyn: error:")
+    one_error_line(capsys)
     assert main(["simulate", "--speed-rpm", "nan", "--revolutions", "1"]) == 2
-    assert "speed_rpm" in capsys.readouterr().err
+    assert "speed_rpm" in one_error_line(capsys)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["frobnicate"], "invalid choice"),
+    (["simulate"], "a cam motion is needed"),
+    (["simulate", "--speed-rpm", "300", "--damping", "X"], "--damping"),
+    (["simulate", "--speed-rpm", "fast"], "--speed-rpm"),
+    (["simulate", "--speed-rpm", "300", "--oscillating-rpm", "40"], "not both"),
+    (["simulate", "--speed-rpm", "300", "--rig", "missing.toml"], "missing.toml"),
+    (["simulate", "--speed-rpm", "300", "--model", "linear_paper", "--damping", "B"], "not generated"),
+    (["simulate", "--speed-rpm", "300", "--csv", "/no/such/folder/run.csv"], "does not exist"),
+    (["simulate", "--speed-rpm", "300", "--rtol", "1"], "rtol"),
+    (["sweep", "--speeds", "1:2"], "start:stop:count"),
+    (["sweep", "--speeds", "1000", "--param", "k_x", "--values", "1,2"], "not a rig parameter"),
+    (["sweep", "--speeds", "1000", "--values", "1,2"], "needs --param"),
+    (["spectrum", "--input", "nothere.csv"], "no such file"),
+    (["regenerate", "--derive", "."], "not a camdyn derive/ folder"),
+])
+def test_bad_input_is_one_line_and_exit_code_2(argv, words, capsys):
+    assert main(argv) == 2
+    assert words in one_error_line(capsys)
+
+
+def test_a_run_that_stops_early_exits_3_and_still_writes(tmp_path, monkeypatch, capsys):
+    import camdyn.simulation
+    from camdyn.outcome import Outcome
+
+    real = camdyn.simulation.simulate
+
+    def stopping(*args, **kwargs):
+        result = real(*args, **kwargs)
+        result.outcome = Outcome.CHATTER
+        return result
+
+    monkeypatch.setattr(camdyn.simulation, "simulate", stopping)
+    out = tmp_path / "run.csv"
+    assert main(["simulate", *QUICK, "--csv", str(out)]) == 3
+    assert out.exists()
+    assert "stopped early" in one_error_line(capsys, starts="camdyn: the run stopped early")
+
+
+def test_missing_optional_parts_exit_4(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if not installed
+    assert main(["simulate", *QUICK, "--plot", "x.png"]) == 4
+    assert 'pip install "camdyn[plot]"' in one_error_line(capsys)
+    monkeypatch.setitem(sys.modules, "camdyn.studies", None)
+    assert main(["reproduce", "fig10"]) == 4
+    assert "camdyn.studies" in one_error_line(capsys)
+
+
+def test_reproduce_lists_and_checks_study_names(capsys):
+    pytest.importorskip("camdyn.studies")
+    assert main(["reproduce", "--list"]) == 0
+    assert "fig9" in capsys.readouterr().out
+    assert main(["reproduce", "fig99"]) == 2
+    assert "did you mean 'fig9'" in one_error_line(capsys)
+
+
+def test_backend_option_reaches_simulate(monkeypatch, capsys):
+    import inspect
+
+    import camdyn.simulation
+
+    real = camdyn.simulation.simulate
+    seen = []
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs.get("backend"))
+        kwargs.pop("backend", None)  # run on SciPy: no compile step in the test
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(camdyn.simulation, "simulate", spy)
+    if "backend" in inspect.signature(real).parameters:
+        assert main(["simulate", *QUICK, "--backend", "compiled"]) == 0
+        assert seen == ["compiled"]
+    else:  # a camdyn without the compiled engine says so
+        assert main(["simulate", *QUICK, "--backend", "compiled"]) == 4
+        assert "compiled" in one_error_line(capsys)
+
+
+def test_internal_errors_are_one_line_exit_5_and_traceback_on_request(monkeypatch, capsys):
+    def broken(args):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(cli, "cmd_scenes", broken)
+    assert main(["scenes"]) == 5
+    line = one_error_line(capsys, starts="camdyn: internal error")
+    assert "boom" in line and "--traceback" in line
+    assert main(["--traceback", "scenes"]) == 5
+    assert "Traceback (most recent call last)" in capsys.readouterr().err
+
+
+def test_interrupt_exits_130(monkeypatch, capsys):
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "cmd_scenes", interrupted)
+    assert main(["scenes"]) == 130
+    assert capsys.readouterr().err.strip() == "camdyn: interrupted"
+
+
+def test_a_closed_pipe_is_quiet():
+    proc = subprocess.run(f"{sys.executable} -m camdyn.cli scenes | head -1", shell=True, capture_output=True,
+                          text=True)
+    assert proc.stdout.startswith("generated scenes") and proc.stderr == ""
+
+
+def test_console_script_exit_code_and_no_traceback():
+    proc = subprocess.run([sys.executable, "-m", "camdyn.cli", "simulate", "--speed-rpm", "1e9"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert proc.stdout == ""
+
+
+def test_parse_values():
+    assert cli._parse_values("1:3:3", "x") == [1.0, 2.0, 3.0]
+    assert cli._parse_values("1,10", "x") == [1.0, 10.0]
+    assert np.allclose(cli._parse_values("1:100:3:log", "x"), [1, 10, 100])
+    for bad in ("", "1:2", "1:2:0", "a,b", "0:1:3:log", "1:2:3:lin"):
+        with pytest.raises(cli.UsageError):
+            cli._parse_values(bad, "x")

@@ -1,0 +1,461 @@
+"""Figures in the style of the paper (needs matplotlib: ``pip install "camdyn[plot]"``).
+
+Every function draws on ``ax`` when given (or creates a figure) and returns the
+figure, so it works in a notebook, a script or the ``camdyn`` command alike.
+matplotlib is imported inside the functions: ``import camdyn.plots`` works
+without it, and a call says how to install it.
+
+* :func:`time_history`  one quantity over t/T (cam revolutions), e.g. alpha_r (Figs. 5, 6a, 11-15)
+* :func:`overview`      alpha_r, F_n and v_r of one run, free flight shaded
+* :func:`spectrum`      amplitude spectra with the harmonics of Omega_c marked (Figs. 6b, 10, 16)
+* :func:`poincare`      phase plane with the once-per-revolution Poincare section
+* :func:`bifurcation`   Poincare section against cam speed
+* :func:`contact_map`   sliding / impacting regimes over (cam speed, k_s) (Fig. 9)
+* :func:`work_precision` error against run time, one line per solver set-up
+
+:func:`poincare_section` (no matplotlib) samples a run once per cam period; :func:`style` gives
+the same look to figures you build yourself.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+__all__ = ["PAPER_STYLE", "QUANTITIES", "style", "time_history", "overview", "spectrum", "poincare_section",
+           "poincare", "bifurcation", "contact_map", "work_precision"]
+
+#: rcParams of the paper-like look: thin lines, inward ticks on all sides, no frame on legends.
+PAPER_STYLE = {
+    "figure.dpi": 110,
+    "savefig.dpi": 150,
+    "savefig.bbox": "tight",
+    "font.size": 9.5,
+    "axes.labelsize": 9.5,
+    "axes.titlesize": 10,
+    "axes.linewidth": 0.8,
+    "axes.grid": True,
+    "grid.linewidth": 0.4,
+    "grid.alpha": 0.35,
+    "lines.linewidth": 0.9,
+    "xtick.direction": "in",
+    "ytick.direction": "in",
+    "xtick.top": True,
+    "ytick.right": True,
+    "legend.frameon": False,
+    "legend.fontsize": 8.5,
+}
+
+#: Display name (matplotlib mathtext) and SI unit of each time history of a Result.
+QUANTITIES = {
+    "alpha": (r"\alpha", "rad"),
+    "alpha_dot": (r"\dot\alpha", "rad/s"),
+    "alpha_r": (r"\alpha_r", "rad"),
+    "alpha_i": (r"\alpha_i", "rad"),
+    "Theta": (r"\Theta", "rad"),
+    "psi_i": (r"\psi_i", "m"),
+    "psi_j": (r"\psi_j", "m"),
+    "psi_i_dot": (r"\dot\psi_i", "m/s"),
+    "F_s": (r"F_s", "N"),
+    "F_n": (r"F_n", "N"),
+    "F_f": (r"F_f", "N"),
+    "v_r": (r"v_r", "m/s"),
+    "N_x": (r"N_x", "N"),
+    "energy": (r"E", "J"),
+    "P_in": (r"P_{in}", "W"),
+    "D_c": (r"D_c", "W"),
+    "D_f": (r"D_f", "W"),
+}
+
+_PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
+_SCALABLE = {"rad", "m", "m/s", "N", "J", "W"}
+#: regime codes of contact_map, with their colours
+REGIME_CODES = {"sliding": 0, "impacting": 1, "failed": 2}
+_REGIME_COLOURS = ("#cfe3f3", "#f4b183", "#bfbfbf")
+_FREE_SHADE = "0.9"
+_MAX_HARMONIC_LINES = 60
+
+
+def _pyplot():
+    """matplotlib.pyplot, or an ImportError that says how to get it."""
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as exc:  # pragma: no cover - exercised by test_plots with a blocked import
+        raise ImportError("camdyn.plots needs matplotlib, which is not installed: "
+                          "pip install \"camdyn[plot]\"") from exc
+    return plt
+
+
+def style():
+    """A context manager with the paper-like look, for figures you build yourself::
+
+        with camdyn.plots.style():
+            fig, axes = plt.subplots(1, 2)
+    """
+    return _style()
+
+
+def _style():
+    plt = _pyplot()
+    from cycler import cycler
+    style = dict(PAPER_STYLE)  # plus colour and line style cycled together
+    style["axes.prop_cycle"] = (cycler(color=["k", "#c0392b", "#2e75b6", "#548235", "#7030a0", "#bf9000"])
+                                + cycler(linestyle=["-", "--", "-.", ":", (0, (5, 1, 1, 1)), (0, (3, 1))]))
+    return plt.rc_context(style)
+
+
+def _figure(ax, nrows=1, figsize=(6.4, 3.0), sharex=False):
+    plt = _pyplot()
+    if ax is not None:
+        axes = np.atleast_1d(ax)
+        return axes.flat[0].figure, axes
+    fig, axes = plt.subplots(nrows, 1, figsize=figsize, sharex=sharex, constrained_layout=True, squeeze=False)
+    return fig, axes[:, 0]
+
+
+def _labelled(results) -> list[tuple[str | None, object]]:
+    """A Result, a sequence of Results or a {label: Result} mapping as (label, result) pairs."""
+    if isinstance(results, Mapping):
+        return [(str(k), v) for k, v in results.items()]
+    if isinstance(results, Sequence) and not isinstance(results, (str, bytes)):
+        return [(getattr(r, "scene", None), r) for r in results]
+    return [(None, results)]
+
+
+def _values(result, quantity: str) -> np.ndarray:
+    if quantity not in QUANTITIES:
+        raise ValueError(f"quantity {quantity!r} is not one of {sorted(QUANTITIES)}")
+    return np.asarray(getattr(result, quantity), dtype=float)
+
+
+def _prefix(values, unit: str) -> tuple[float, str]:
+    """(scale, unit label) so that the largest |value| reads between 1 and 1000."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    if unit not in _SCALABLE or finite.size == 0:
+        return 1.0, unit
+    peak = float(np.max(np.abs(finite)))
+    for scale, p in _PREFIXES:
+        if peak >= scale:
+            return scale, p + unit
+    return _PREFIXES[-1][0], _PREFIXES[-1][1] + unit
+
+
+def _label(quantity: str, unit: str) -> str:
+    return f"${QUANTITIES[quantity][0]}$ ({unit})" if unit else f"${QUANTITIES[quantity][0]}$"
+
+
+def _revolutions(result) -> tuple[np.ndarray, str]:
+    """Time axis: t/T counted from the first sample, or t in seconds when the cam has no period."""
+    t = np.asarray(result.t, dtype=float)
+    period = float(getattr(result, "period", math.inf))
+    if math.isfinite(period) and period > 0:
+        return (t - t[0]) / period if t.size else t, r"$t/T$ (cam revolutions)"
+    return t, r"$t$ (s)"
+
+
+def _free_intervals(result) -> list[tuple[float, float]]:
+    """(start, end) sample indices of the runs of samples in free flight."""
+    free = np.asarray(result.regime) == "free"
+    if not free.any():
+        return []
+    edges = np.flatnonzero(np.diff(np.r_[0, free.astype(int), 0]))
+    return list(zip(edges[::2], edges[1::2] - 1))
+
+
+def time_history(results, quantity: str = "alpha_r", *, revolutions: tuple[float, float] | None = None,
+                 mark_impacts: bool = False, shade_free: bool = False, ax=None, title: str | None = None):
+    """``quantity`` over t/T, the time normalised by one cam revolution (Figs. 5, 6a, 11-15).
+
+    ``results``: a Result, a list of them, or ``{label: Result}`` to overlay runs (e.g. damping
+    models A-E).  ``revolutions=(a, b)`` shows only a <= t/T <= b.  ``mark_impacts`` ticks the
+    impact times; ``shade_free`` shades free flight (one run only).  The unit gets an SI prefix
+    (µrad, mN...) so the numbers read between 1 and 1000.
+    """
+    pairs = _labelled(results)
+    with _style():
+        fig, (ax,) = _figure(ax)
+        unit = QUANTITIES.get(quantity, (None, ""))[1]
+        scale, unit_label = _prefix(np.concatenate([_values(r, quantity) for _, r in pairs]), unit)
+        for label, r in pairs:
+            x, xlabel = _revolutions(r)
+            y = _values(r, quantity) / scale
+            keep = np.ones(x.size, bool) if revolutions is None else (x >= revolutions[0]) & (x <= revolutions[1])
+            line, = ax.plot(x[keep], y[keep], label=label)
+            if mark_impacts and r.impacts().size:
+                period = r.period if math.isfinite(r.period) else 1.0
+                xi = (r.impacts() - r.t[0]) / period
+                if revolutions is not None:
+                    xi = xi[(xi >= revolutions[0]) & (xi <= revolutions[1])]
+                ax.plot(xi, np.full(xi.size, np.nanmin(y[keep])), "|", color=line.get_color(), ms=7,
+                        label=None)
+            if shade_free and len(pairs) == 1:
+                for i, j in _free_intervals(r):
+                    ax.axvspan(x[i], x[j], color=_FREE_SHADE, lw=0, zorder=0)
+        ax.set(xlabel=xlabel, ylabel=_label(quantity, unit_label))
+        if revolutions is not None:
+            ax.set_xlim(*revolutions)
+        if any(label for label, _ in pairs):
+            ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+def overview(result, *, quantities: Sequence[str] | None = None, title: str | None = None):
+    """A stacked view of one run over t/T: alpha_r, F_n and (with friction) v_r; free flight shaded."""
+    if quantities is None:
+        quantities = ["alpha_r", "F_n"]
+        if np.any(np.asarray(result.F_f) != 0):
+            quantities.append("v_r")
+    with _style():
+        fig, axes = _figure(None, nrows=len(quantities), figsize=(6.4, 1.9 * len(quantities) + 0.4), sharex=True)
+        for ax, q in zip(axes, quantities):
+            time_history(result, q, ax=ax, shade_free=True)
+            if ax is not axes[-1]:
+                ax.set_xlabel("")
+        summary = f"{result.scene}, rig {result.meta.get('rig', '?')}"
+        cam = result.meta.get("cam")
+        if getattr(cam, "speed_rpm", None) is not None:
+            summary += f", {cam.speed_rpm:g} rev/min"
+        axes[0].set_title(title or summary + ("" if result.ok else f" ({result.outcome.name})"))
+        if _free_intervals(result):
+            from matplotlib.patches import Patch
+            fig.legend(handles=[Patch(color=_FREE_SHADE, label="free flight (no contact)")], loc="outside lower right",
+                       fontsize=7.5)
+    return fig
+
+
+def _fundamental_Hz(result) -> float:
+    period = float(getattr(result, "period", math.inf))
+    return 1.0 / period if math.isfinite(period) and period > 0 else math.nan
+
+
+def spectrum(results, quantity: str = "alpha", *, bands: Sequence[tuple[float, float]] | None = None,
+             fmax: float | None = None, harmonics: int | bool = True, mark_Hz: Mapping[str, float] | None = None,
+             transient_revolutions: float = 0.0, whole_periods: bool = True, log: bool = True,
+             window: str = "hann", ax=None, title: str | None = None):
+    """One-sided amplitude spectrum of ``quantity`` with the harmonics of Omega_c marked (Figs. 10, 16).
+
+    ``bands=[(f0, f1), ...]`` draws one panel per frequency band (Fig. 10: (a) the low
+    harmonics, (b) around the natural frequency); else one panel up to ``fmax``.
+    ``harmonics``: mark k Omega_c (True: all in view, labelled while there is room; an int:
+    the first n; False: none).  ``mark_Hz={"vartheta": 2182.0}`` marks other frequencies.
+    ``transient_revolutions`` are dropped first; with ``whole_periods`` the record is then cut
+    to a whole number of cam periods, so that the harmonics fall on frequency bins.  The
+    signal's mean is removed.
+    """
+    _pyplot()
+    from matplotlib.lines import Line2D
+
+    from . import signal
+
+    pairs = _labelled(results)
+    spectra = []
+    for label, r in pairs:
+        if transient_revolutions:
+            r = r.after(r.t[0] + transient_revolutions * r.period)
+        t, x = np.asarray(r.t, dtype=float), _values(r, quantity)
+        if whole_periods:
+            keep = whole_period_samples(t, r.period)
+            t, x = t[keep], x[keep]
+        f, amp = signal.spectrum(t, x, window=window)
+        spectra.append((label, f, amp, _fundamental_Hz(r)))
+    if bands is None:
+        top = fmax if fmax is not None else max(f[-1] for _, f, _, _ in spectra)
+        bands = [(0.0, top)]
+    unit = QUANTITIES[quantity][1]
+    with _style():
+        fig, axes = _figure(ax, nrows=len(bands), figsize=(6.4, 2.6 * len(bands) + 0.3))
+        for ax_, (lo, hi) in zip(axes, bands):
+            peak = max(float(np.max(a[(f >= lo) & (f <= hi)], initial=0.0)) for _, f, a, _ in spectra)
+            scale, unit_label = _prefix([peak], unit)
+            for label, f, amp, _ in spectra:
+                keep = (f >= lo) & (f <= hi)
+                ax_.plot(f[keep], amp[keep] / scale, label=label)
+            if log:
+                ax_.set_yscale("log")
+            ax_.set_xlim(lo, hi)
+            ax_.set(xlabel="frequency (Hz)", ylabel=f"|${QUANTITIES[quantity][0]}$| ({unit_label})")
+            f0 = spectra[0][3]
+            handles = [h for h in ax_.get_lines() if not h.get_label().startswith("_")]
+            if harmonics and math.isfinite(f0):
+                ks = np.arange(max(1, math.ceil(lo / f0)), math.floor(hi / f0) + 1)
+                if harmonics is not True:
+                    ks = ks[ks <= int(harmonics)]
+                if 0 < ks.size <= _MAX_HARMONIC_LINES:
+                    for k in ks:
+                        ax_.axvline(k * f0, color="0.55", lw=0.6, ls=":", zorder=0)
+                        if ks.size <= 15:
+                            ax_.text(k * f0, 0.985, f"{k}", transform=ax_.get_xaxis_transform(), ha="center",
+                                     va="top", fontsize=6.5, color="0.35",
+                                     bbox=dict(fc="white", ec="none", pad=0.3, alpha=0.8))
+                    handles.append(Line2D([], [], color="0.55", lw=0.6, ls=":",
+                                          label=rf"$k\,\Omega_c$, $\Omega_c$ = {f0:.4g} Hz"
+                                          + (" (k on top)" if ks.size <= 15 else "")))
+                elif ks.size:
+                    handles.append(Line2D([], [], color="none",
+                                          label=rf"harmonics of $\Omega_c$ = {f0:.4g} Hz: too dense to mark here"))
+            for name, fm in (mark_Hz or {}).items():
+                if lo <= fm <= hi:
+                    handles.append(ax_.axvline(fm, color="#c0392b", lw=0.8, ls="--", zorder=0,
+                                               label=f"{name} = {fm:.5g} Hz"))
+            if handles:
+                ax_.legend(handles=handles, loc="best")
+        if title:
+            axes[0].set_title(title)
+    return fig
+
+
+def whole_period_samples(t, period: float) -> np.ndarray:
+    """Boolean mask of the first samples of ``t`` covering a whole number of periods
+    ([t0, t0 + k T), k as large as fits); all samples if the period is not finite or
+    longer than the record."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2 or not (math.isfinite(period) and period > 0):
+        return np.ones(t.size, dtype=bool)
+    k = math.floor((t[-1] - t[0]) / period + 1e-9)
+    if k < 1:
+        return np.ones(t.size, dtype=bool)
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    return t < t[0] + k * period - dt / 2
+
+
+def poincare_section(result, quantities: Sequence[str] = ("alpha", "alpha_dot"), *,
+                     transient_revolutions: float = 0.0, phase: float = 0.0) -> dict[str, np.ndarray]:
+    """The run sampled once per cam period, at t = t0 + (n + phase) T after the transient.
+
+    Values between samples are interpolated linearly; they are exact when the sample rate
+    is a whole multiple of the cam frequency (``sample_rate_Hz = k / T``).  Returns
+    ``{"t": times, quantity: values, ...}``.
+    """
+    period = float(result.period)
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError("a Poincare section needs a periodic cam (result.period is not finite)")
+    t = np.asarray(result.t, dtype=float)
+    first = math.ceil(transient_revolutions - phase - 1e-9)
+    n_last = math.floor((t[-1] - t[0]) / period - phase + 1e-9)
+    times = t[0] + (np.arange(max(first, 0), n_last + 1) + phase) * period
+    return {"t": times, **{q: np.interp(times, t, _values(result, q)) for q in quantities}}
+
+
+def poincare(result, *, transient_revolutions: float = 0.0, phase: float = 0.0, ax=None, title: str | None = None):
+    """Phase plane (alpha, alpha_dot) of one run, grey, with its Poincare section once per revolution, black."""
+    sec = poincare_section(result, transient_revolutions=transient_revolutions, phase=phase)
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(4.6, 3.6))
+        keep = result.t >= result.t[0] + transient_revolutions * result.period
+        a_scale, a_unit = _prefix(result.alpha[keep] - result.alpha_star, "rad")
+        ax.plot((result.alpha[keep] - result.alpha_star) / a_scale, result.alpha_dot[keep], color="0.75", lw=0.5)
+        ax.plot((sec["alpha"] - result.alpha_star) / a_scale, sec["alpha_dot"], "o", color="k", ms=3.5,
+                label=f"once per revolution ({sec['t'].size} points)")
+        ax.set(xlabel=rf"$\alpha - \alpha^*$ ({a_unit})", ylabel=r"$\dot\alpha$ (rad/s)")
+        ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: float | None = None, ax=None,
+                title: str | None = None):
+    """Poincare section against cam speed: one column of points per speed.
+
+    ``points``: a list of arrays (one per speed), a 2-D array (speed x revolution; NaN for
+    missing points), or an xarray DataArray with the speed as its first dimension.
+    ``relative_to`` is subtracted (e.g. alpha*), to show the deviation.
+    """
+    speeds = np.asarray(speed_rpm, dtype=float)
+    if hasattr(points, "values") and not isinstance(points, np.ndarray):
+        points = points.values
+    columns = [np.asarray(p, dtype=float).ravel() for p in points]
+    if len(columns) != speeds.size:
+        raise ValueError(f"{speeds.size} speeds but {len(columns)} columns of points")
+    xs = np.concatenate([np.full(c.size, s) for s, c in zip(speeds, columns)]) if columns else np.empty(0)
+    ys = np.concatenate(columns) if columns else np.empty(0)
+    ok = np.isfinite(ys)
+    xs, ys = xs[ok], ys[ok] - (relative_to or 0.0)
+    unit = QUANTITIES.get(quantity, (None, "rad"))[1]
+    scale, unit_label = _prefix(ys, unit)
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(6.4, 3.4))
+        ax.plot(xs, ys / scale, ",", color="k", alpha=0.9)
+        ax.plot(xs, ys / scale, "o", color="k", ms=1.2, alpha=0.6)
+        symbol = QUANTITIES.get(quantity, (quantity, ""))[0]
+        if relative_to is not None:
+            symbol += r" - " + symbol + "^*"
+        ax.set(xlabel=r"cam speed $\Omega_c$ (rev/min)", ylabel=f"${symbol}$ once per revolution ({unit_label})")
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_k: bool = True, ax=None,
+                title: str | None = None):
+    """Contact regimes over the (cam speed, k_s) plane, as in Fig. 9.
+
+    ``regime[i, j]`` is the regime at ``k_s[i]``, ``speed_rpm[j]``: a code of
+    :data:`REGIME_CODES` (0 sliding, 1 impacting, 2 failed) or its name.  ``loss_curve=(speeds,
+    k_s)`` overlays a curve, e.g. the contact-loss speed by inverse kinematics for each k_s.
+    """
+    _pyplot()
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    speeds, ks = np.asarray(speed_rpm, dtype=float), np.asarray(k_s, dtype=float)
+    codes = np.asarray(regime)
+    if codes.dtype.kind in "US":
+        codes = np.vectorize(lambda name: REGIME_CODES[str(name)])(codes)
+    codes = np.asarray(codes, dtype=float)
+    if codes.shape != (ks.size, speeds.size):
+        raise ValueError(f"regime has shape {codes.shape}; expected (len(k_s), len(speed_rpm)) = "
+                         f"{(ks.size, speeds.size)}")
+    codes = np.where(np.isfinite(codes), codes, REGIME_CODES["failed"])
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(5.6, 3.8))
+        cmap = ListedColormap(_REGIME_COLOURS)
+        ax.pcolormesh(speeds, ks, codes, cmap=cmap, norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], 3), shading="nearest")
+        handles = [Patch(color=_REGIME_COLOURS[c], label=name) for name, c in REGIME_CODES.items()
+                   if np.any(codes == c)]
+        if loss_curve is not None:
+            ls, lk = (np.asarray(v, dtype=float) for v in loss_curve)
+            handles.append(ax.plot(ls, lk, color="k", lw=1.2, label="contact loss (inverse kinematics)")[0])
+            ax.set_xlim(speeds.min() - 0.5 * np.ptp(speeds) / max(speeds.size - 1, 1),
+                        speeds.max() + 0.5 * np.ptp(speeds) / max(speeds.size - 1, 1))
+        if log_k:
+            ax.set_yscale("log")
+        ax.grid(False)
+        ax.set(xlabel=r"cam speed $\Omega_c$ (rev/min)", ylabel=r"spring stiffness $k_s$ (N/m)")
+        ax.legend(handles=handles, loc="upper left", frameon=True, framealpha=0.85)
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+def work_precision(records, *, ax=None, title: str | None = None, error_label: str = "error"):
+    """Run time against error, log-log, one line per set-up (label), points annotated with rtol.
+
+    ``records``: an iterable of mappings with keys ``label``, ``error``, ``seconds`` and
+    optionally ``rtol``.  Lower left is better: less time for the same error.
+    """
+    groups: dict[str, list] = {}
+    for rec in records:
+        groups.setdefault(str(rec["label"]), []).append(rec)
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(6.0, 3.8))
+        for label, recs in groups.items():
+            recs = sorted(recs, key=lambda r: r["error"])
+            err = np.array([max(float(r["error"]), 1e-300) for r in recs])
+            sec = np.array([float(r["seconds"]) for r in recs])
+            line, = ax.plot(err, sec, marker="o", ms=4, label=label)
+            for r, x, y in zip(recs, err, sec):
+                if r.get("rtol") is not None:
+                    ax.annotate(f"{r['rtol']:.0e}", (x, y), textcoords="offset points", xytext=(3, 3),
+                                fontsize=6.5, color=line.get_color())
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set(xlabel=error_label, ylabel="run time (s)")
+        ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+    return fig

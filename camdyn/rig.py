@@ -141,7 +141,10 @@ PARAMETERS: tuple[Parameter, ...] = (
     )),
     Parameter("L_us", "m", "free length of the follower spring", True, "Eq. 11", _LENGTH),
     Parameter("k_s", "N/m", "follower spring stiffness", True, "Eq. 11", (_POSITIVE,)),
-    Parameter("I_Pb", "kg m^2", "moment of inertia of the follower about its pivot P", True, "Eq. 10", (_POSITIVE,)),
+    Parameter("I_Pb", "kg m^2", "moment of inertia of the follower about its pivot P", True, "Eq. 10",
+              (_POSITIVE, Rule(">= 1e-9", lambda x, _: x >= 1e-9,
+                               "given in g mm^2 or kg mm^2? camdyn uses SI kg m^2 (a follower lighter "
+                               "than 1e-9 kg m^2 has a contact mode too fast to integrate)", guard=True))),
     Parameter("Y_c", "Pa", "Young's modulus of the cam", True, "Eq. 14", _MODULUS),
     Parameter("Y_b", "Pa", "Young's modulus of the follower", True, "Eq. 14", _MODULUS),
     Parameter("nu_c", "dimensionless", "Poisson's ratio of the cam", True, "Eq. 14", _POISSON),

@@ -16,6 +16,9 @@ from .rig import Rig
 from .scene import Scene
 
 MAX_SAMPLES = 50_000_000
+#: contact-mode periods one run may span: ~20 steps each, so about 2e9 steps at the most
+#: (hours of SciPy stepping); beyond it the run is refused instead of hanging
+MAX_CONTACT_PERIODS = 1e8
 BACKENDS = ("scipy", "compiled")
 
 
@@ -67,6 +70,12 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
             raise ParameterError("revolutions", revolutions, "t_end (s): this cam has no period")
         t_end = revolutions * cam.period
     duration = _positive("t_end", t_end, "t_end > 0 (s)")
+    periods = duration * model.equilibrium.vartheta / (2 * math.pi)
+    if periods > MAX_CONTACT_PERIODS:
+        raise ParameterError(
+            "t_end", duration, f"at most {MAX_CONTACT_PERIODS:.0e} periods of the contact mode "
+            f"({model.equilibrium.frequency_Hz:.3g} Hz for this rig: check I_Pb, k_s, Y_c, Y_b, l_lambda); "
+            f"this run spans {periods:.3g}")
     if isinstance(t_start, bool) or not isinstance(t_start, (int, float)) or not math.isfinite(t_start):
         raise ParameterError("t_start", t_start, "a finite time (s)")
     fs = _positive("sample_rate_Hz", sample_rate_Hz, "sample_rate_Hz > 0")

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import camdyn
@@ -35,6 +35,8 @@ def _check_result(r):
 
 @SLOW
 @given(name=st.sampled_from([p.name for p in PARAMETERS]), value=hostile_numbers)
+@example(name="I_Pb", value=1e-300)  # found by this test: a contact mode at 1e152 Hz, a near-endless run
+@example(name="k_s", value=1e300)
 def test_one_hostile_rig_parameter(name, value):
     """Any one parameter replaced by anything: a valid rig that simulates, or a camdyn error."""
     try:

@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 from . import signal
 from .cam import RPM, CamMotion, ConstantSpeed
 from .errors import GeometryError, ParameterError
-from .model import ANGLE_LIMIT, Equilibrium, Model, solve_equilibrium
+from .model import ANGLE_LIMIT, Equilibrium, Model, solve_equilibrium, static_parameters
 from .result import Result
 from .rig import Rig
 from .scene import Scene
@@ -81,7 +81,7 @@ def natural_frequency(rig: Rig, scene: Scene | None = None, cam: CamMotion | Non
 def rigid_contact_angle(rig: Rig, theta, contact: str = "line") -> np.ndarray:
     """alpha_i(Theta): the follower angle if it stayed in rigid contact (Eq. 29, misprint 10)."""
     K = _static_scene(contact).kernels()
-    p = K.pack({k: (getattr(rig, k, None) if getattr(rig, k, None) is not None else 1.0) for k in K.INPUTS})
+    p = static_parameters(rig, K)
     theta = np.asarray(theta, dtype=float)
     if np.any(np.vectorize(lambda th: K.reach(th, p))(theta) <= 0):
         raise GeometryError("the follower cannot reach the cam at some of these cam angles")
@@ -100,7 +100,7 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     Returns inf when no cam angle decelerates the follower (e = 0).
     """
     K = _static_scene("line").kernels()
-    p = K.pack({k: (getattr(rig, k, None) if getattr(rig, k, None) is not None else 1.0) for k in K.INPUTS})
+    p = static_parameters(rig, K)
     thetas = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
     margin = np.array([K.reach(th, p) for th in thetas])
     if np.any(margin <= 0):
@@ -143,7 +143,7 @@ def energy_balance_peak(rig: Rig, speed_rpm: float, xi: float, *, potential: str
         raise ParameterError("potential", potential, "'printed' or 'consistent'")
     eq = static_equilibrium(rig, contact)
     K = _static_scene(contact).kernels()
-    p = K.pack({k: (getattr(rig, k, None) if getattr(rig, k, None) is not None else 1.0) for k in K.INPUTS})
+    p = static_parameters(rig, K)
     col = 1 if potential == "printed" else 0
     T_b = 0.5 * rig.I_Pb * ((1 + xi) * rig.e * ConstantSpeed(speed_rpm).Omega_c / eq.chi) ** 2
     V0 = K.spring_potential(eq.alpha, p)[col]

@@ -14,7 +14,6 @@ from types import ModuleType
 import numpy as np
 from scipy.optimize import brentq
 
-from . import generated
 from .cam import CamMotion, ConstantSpeed
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
@@ -43,6 +42,15 @@ class Equilibrium:
         return self.vartheta / (2 * math.pi)
 
 
+def static_parameters(rig: Rig, kernels: ModuleType) -> np.ndarray:
+    """The parameter vector for the kernels that do not depend on a run (``static_moment``,
+    ``reach``, ``rigid_contact``, ``spring_potential``): the rig's values, and NaN in the slots
+    those kernels never read (equilibrium results, cam constants, optional parameters not
+    given), so that a read of one would show as NaN rather than pass as a made-up number."""
+    values = {name: getattr(rig, name, None) for name in kernels.INPUTS}
+    return kernels.pack({name: math.nan if v is None else v for name, v in values.items()})
+
+
 def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
     """alpha* from M(alpha*) = 0 near the 0-state, with M from the generated ``static_moment``.
 
@@ -51,8 +59,7 @@ def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
     The contact moment grows as alpha turns into the cam (alpha < alpha0), so the
     root is bracketed by stepping down from alpha0.
     """
-    values = {**rig.to_dict(), **{k: 1.0 for k in _DERIVED + _CAM}}  # static_moment reads none of these
-    p = kernels.pack({k: values[k] for k in kernels.INPUTS if values.get(k) is not None})
+    p = static_parameters(rig, kernels)
 
     def moment(a):
         return kernels.static_moment(a, p)[0]
@@ -112,7 +119,7 @@ class Model:
     def _check_reach(self):
         """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""
         thetas = self.rig.theta0 + np.linspace(0, 2 * math.pi, 721)
-        p = self.kernels.pack({k: getattr(self.rig, k, None) or 1.0 for k in self.kernels.INPUTS})
+        p = static_parameters(self.rig, self.kernels)
         margins = [self.kernels.reach(th, p) for th in thetas]
         worst = int(np.argmin(margins))
         if not margins[worst] > 0:

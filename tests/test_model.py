@@ -87,7 +87,9 @@ def test_spring_that_does_not_press_the_follower_has_no_equilibrium():
 
 
 def test_cam_that_the_follower_cannot_reach():
-    rig = RIG.replace(chi0=0.01, e=0.02, r_c=0.025)
+    """Pivot E below the contact (Theta0 = -pi/2) and P almost over it: the eccentric swings
+    the cam centre to within r_c + w_b/2 of P, where no follower angle touches the cam."""
+    rig = RIG.replace(chi0=0.01, e=0.02, r_c=0.025, theta0=-math.pi / 2)
     with pytest.raises(GeometryError, match="cannot|too close"):
         Model(rig, camdyn.Scene(), camdyn.ConstantSpeed(100))
 
@@ -154,3 +156,16 @@ def test_follower_leaving_for_good_stops_with_a_clear_outcome():
     assert r.outcome is camdyn.Outcome.ANGLE_LIMIT and not r.ok
     assert "90 degrees" in r.outcome.message
     assert np.all(np.isfinite(r.alpha)) and np.all(np.abs(r.alpha) < math.pi / 2)
+
+
+def test_static_kernels_get_the_rigs_zeros_and_nan_for_what_they_never_read():
+    """Regression: placeholders were once filled with `value or 1.0`, turning alpha0 = 0.0 into
+    1.0 rad in the reach check.  Zeros must pass through; unread slots are NaN, never a number."""
+    from camdyn.model import static_parameters
+    K = camdyn.Scene().kernels()
+    rig = RIG.replace(alpha0=0.0, e=0.0)
+    p = static_parameters(rig, K)
+    assert p[K.PARAMS.index("alpha0")] == 0.0 and p[K.PARAMS.index("e")] == 0.0
+    for name in ("chi_star", "vartheta", "Omega_c"):
+        assert math.isnan(p[K.PARAMS.index(name)])
+    assert all(math.isfinite(v) for v in K.rigid_contact(0.3, p)) and math.isfinite(K.reach(0.3, p))

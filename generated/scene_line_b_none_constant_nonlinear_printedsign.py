@@ -802,3 +802,125 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x0 = (1/2)*Omega_c*t
         return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[14]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact: P_in
+        4: contact: D_c
+        5: contact: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        beta_B = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = alpha + theta0 + x11
+        x13 = e*cos(x12)
+        x14 = sin(x11)
+        x15 = -chi0*x5 + 2*x13*x14 + x6*x9
+        x16 = cos(x4)
+        x17 = Omega_c*x13*cos(x11)
+        x18 = alpha_dot + x10
+        x19 = sin(x12)
+        x20 = alpha_dot*x6*x8*cos(x7)
+        x21 = pi*Y_e*l_lambda
+        x22 = alpha_dot*chi0*x16 + 2*e*x14*x18*x19 - x17 - x20
+        x23 = -1/4*x15*x21
+        x24 = beta_B*x23
+        return alpha_dot*(-x3*(L_us + d_x*x0 - d_y - x1*x2) - (x22*x24 + x23)*(-2*chi0*x9 + chi0 + 2*e*x14*x19 - x5*(r_c + x2))) + (1/8)*x15*x21*(-2*alpha_dot*chi0*x16 - 4*e*x14*x18*x19 + 2*x17 + 2*x20) + x22**2*x24 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_B = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        return (1/4)*pi*Y_e*beta_B*l_lambda*(chi0*sin(x0) - x1*x3**2 - 2*x7*x8)*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x8*(alpha_dot + x4)*sin(x6))**2
+    elif c == 5:
+        return 0
+    return nan

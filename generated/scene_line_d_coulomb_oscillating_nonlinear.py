@@ -1983,3 +1983,513 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x2 = omega_c*x1*cos(x0)
         return (1/2)*alpha_dot*w_b - e*x2*sin(alpha + theta0 + x1*sin(x0)) - r_c*x2
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+    elif j == 1:
+        r_c = p[0]
+        e = p[1]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c**2
+        x1 = omega_c*t
+        x2 = (1/2)*Theta_p*sin(x1)
+        x3 = x0*x2
+        x4 = alpha + theta0 + x2
+        return -1/4*Theta_p**2*e*x0*cos(x1)**2*cos(x4) + e*x3*sin(x4) + r_c*x3
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = (1/2)*Theta_p
+        return -e*omega_c*x1*cos(x0)*cos(alpha + theta0 + x1*sin(x0))
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading_fwd: P_in
+        4: contact_loading_fwd: D_c
+        5: contact_loading_fwd: D_f
+        6: contact_loading_bwd: P_in
+        7: contact_loading_bwd: D_c
+        8: contact_loading_bwd: D_f
+        9: contact_unloading_fwd: P_in
+        10: contact_unloading_fwd: D_c
+        11: contact_unloading_fwd: D_f
+        12: contact_unloading_bwd: P_in
+        13: contact_unloading_bwd: D_c
+        14: contact_unloading_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = omega_c*t
+        x11 = Theta_p*sin(x10)
+        x12 = (1/4)*x11
+        x13 = alpha + theta0
+        x14 = x12 + x13
+        x15 = cos(x14)
+        x16 = sin(x12)
+        x17 = e*x16
+        x18 = -chi0*x5 + 2*x15*x17 + x6*x9
+        x19 = cos(x4)
+        x20 = alpha_dot*x6*x8*cos(x7)
+        x21 = Theta_p*omega_c*cos(x10)
+        x22 = x15*cos(x12)
+        x23 = sin(x14)
+        x24 = alpha_dot + (1/4)*x21
+        x25 = pi*Y_e*l_lambda
+        x26 = (1/2)*x21
+        x27 = e*x26
+        x28 = alpha_dot*chi0*x19 + 2*e*x16*x23*x24 - x20 - x22*x27
+        x29 = (1/4)*x25
+        x30 = beta_D*x29*abs(x18)
+        x31 = -x18*x29 + x28*x30
+        x32 = -mu_m*x31
+        return alpha_dot*(-x2*x32 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x31*(-2*chi0*x9 + chi0 + 2*e*x16*x23 - x5*(r_c + x2))) + (1/8)*x18*x25*(-2*alpha_dot*chi0*x19 + e*x21*x22 - 4*x17*x23*x24 + 2*x20) + x28**2*x30 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x32*((1/2)*alpha_dot*w_b - r_c*x26 - x27*sin((1/2)*x11 + x13))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = omega_c*t
+        x5 = (1/4)*Theta_p
+        x6 = x5*sin(x4)
+        x7 = alpha + theta0 + x6
+        x8 = e*cos(x7)
+        x9 = sin(x6)
+        x10 = omega_c*cos(x4)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x10*x8*cos(x6) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x9*(alpha_dot + x10*x5)*sin(x7))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x8*x9)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = alpha - alpha0
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = (1/4)*x3
+        x10 = x4 + x9
+        x11 = e*cos(x10)
+        x12 = sin(x9)
+        x13 = -chi0*sin(x5) + 2*x11*x12 + x6*x8**2
+        x14 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*(-beta_D*x14*(alpha_dot*chi0*cos(x5) - alpha_dot*x6*x8*cos(x7) + 2*e*x12*(alpha_dot + (1/4)*x1)*sin(x10) - x11*x2*cos(x9))*abs(x13) + x13*x14)*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = omega_c*t
+        x11 = Theta_p*sin(x10)
+        x12 = (1/4)*x11
+        x13 = alpha + theta0
+        x14 = x12 + x13
+        x15 = cos(x14)
+        x16 = sin(x12)
+        x17 = e*x16
+        x18 = -chi0*x5 + 2*x15*x17 + x6*x9
+        x19 = cos(x4)
+        x20 = alpha_dot*x6*x8*cos(x7)
+        x21 = Theta_p*omega_c*cos(x10)
+        x22 = x15*cos(x12)
+        x23 = sin(x14)
+        x24 = alpha_dot + (1/4)*x21
+        x25 = pi*Y_e*l_lambda
+        x26 = (1/2)*x21
+        x27 = e*x26
+        x28 = alpha_dot*chi0*x19 + 2*e*x16*x23*x24 - x20 - x22*x27
+        x29 = (1/4)*x25
+        x30 = beta_D*x29*abs(x18)
+        x31 = -x18*x29 + x28*x30
+        x32 = -x31
+        return alpha_dot*((1/2)*mu_m*w_b*x32 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x31*(-2*chi0*x9 + chi0 + 2*e*x16*x23 - x5*(r_c + x2))) - mu_m*x32*((1/2)*alpha_dot*w_b - r_c*x26 - x27*sin((1/2)*x11 + x13)) + (1/8)*x18*x25*(-2*alpha_dot*chi0*x19 + e*x21*x22 - 4*x17*x23*x24 + 2*x20) + x28**2*x30 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = omega_c*t
+        x5 = (1/4)*Theta_p
+        x6 = x5*sin(x4)
+        x7 = alpha + theta0 + x6
+        x8 = e*cos(x7)
+        x9 = sin(x6)
+        x10 = omega_c*cos(x4)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x10*x8*cos(x6) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x9*(alpha_dot + x10*x5)*sin(x7))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x8*x9)
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = alpha - alpha0
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = (1/4)*x3
+        x10 = x4 + x9
+        x11 = e*cos(x10)
+        x12 = sin(x9)
+        x13 = -chi0*sin(x5) + 2*x11*x12 + x6*x8**2
+        x14 = (1/4)*pi*Y_e*l_lambda
+        return -mu_m*(-beta_D*x14*(alpha_dot*chi0*cos(x5) - alpha_dot*x6*x8*cos(x7) + 2*e*x12*(alpha_dot + (1/4)*x1)*sin(x10) - x11*x2*cos(x9))*abs(x13) + x13*x14)*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 9:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = alpha_dot*x6*x8*cos(x7)
+        x10 = omega_c*t
+        x11 = Theta_p*omega_c*cos(x10)
+        x12 = (1/2)*x11
+        x13 = e*x12
+        x14 = Theta_p*sin(x10)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = x18*cos(x15)
+        x20 = sin(x15)
+        x21 = alpha_dot + (1/4)*x11
+        x22 = sin(x17)
+        x23 = alpha_dot*chi0*x5 + 2*e*x20*x21*x22 - x13*x19 - x9
+        x24 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x25 = sin(x4)
+        x26 = x8**2
+        x27 = e*x20
+        x28 = -chi0*x25 + 2*x18*x27 + x26*x6
+        x29 = pi*Y_e*l_lambda
+        x30 = x23*x24 - 1/4*x28*x29
+        x31 = -mu_m*x30
+        return alpha_dot*(-x2*x31 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x30*(-2*chi0*x26 + chi0 + 2*e*x20*x22 - x25*(r_c + x2))) + x23**2*x24 + (1/8)*x28*x29*(-2*alpha_dot*chi0*x5 + e*x11*x19 - 4*x21*x22*x27 + 2*x9) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x31*((1/2)*alpha_dot*w_b - r_c*x12 - x13*sin((1/2)*x14 + x16))
+    elif c == 10:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4))**2/chi_star**2
+    elif c == 11:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = alpha - alpha0
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = (1/4)*x3
+        x10 = x4 + x9
+        x11 = e*cos(x10)
+        x12 = sin(x9)
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x5) - alpha_dot*x6*x8*cos(x7) + 2*e*x12*(alpha_dot + (1/4)*x1)*sin(x10) - x11*x2*cos(x9))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x5) - 2*x11*x12 - x6*x8**2))*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 12:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = alpha_dot*x6*x8*cos(x7)
+        x10 = omega_c*t
+        x11 = Theta_p*omega_c*cos(x10)
+        x12 = (1/2)*x11
+        x13 = e*x12
+        x14 = Theta_p*sin(x10)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = x18*cos(x15)
+        x20 = sin(x15)
+        x21 = alpha_dot + (1/4)*x11
+        x22 = sin(x17)
+        x23 = alpha_dot*chi0*x5 + 2*e*x20*x21*x22 - x13*x19 - x9
+        x24 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x25 = sin(x4)
+        x26 = x8**2
+        x27 = e*x20
+        x28 = -chi0*x25 + 2*x18*x27 + x26*x6
+        x29 = pi*Y_e*l_lambda
+        x30 = x23*x24 - 1/4*x28*x29
+        x31 = -x30
+        return alpha_dot*((1/2)*mu_m*w_b*x31 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x30*(-2*chi0*x26 + chi0 + 2*e*x20*x22 - x25*(r_c + x2))) - mu_m*x31*((1/2)*alpha_dot*w_b - r_c*x12 - x13*sin((1/2)*x14 + x16)) + x23**2*x24 + (1/8)*x28*x29*(-2*alpha_dot*chi0*x5 + e*x11*x19 - 4*x21*x22*x27 + 2*x9) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 13:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4))**2/chi_star**2
+    elif c == 14:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = alpha - alpha0
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = (1/4)*x3
+        x10 = x4 + x9
+        x11 = e*cos(x10)
+        x12 = sin(x9)
+        return -mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x5) - alpha_dot*x6*x8*cos(x7) + 2*e*x12*(alpha_dot + (1/4)*x1)*sin(x10) - x11*x2*cos(x9))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x5) - 2*x11*x12 - x6*x8**2))*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    return nan

@@ -1245,3 +1245,275 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x3 = (1/2)*alpha - 1/2*alpha0
         return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading: P_in
+        4: contact_loading: D_c
+        5: contact_loading: D_f
+        6: contact_unloading: P_in
+        7: contact_unloading: D_c
+        8: contact_unloading: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = alpha + theta0
+        x13 = x11 + x12
+        x14 = e*cos(x13)
+        x15 = sin(x11)
+        x16 = 2*x14*x15
+        x17 = -chi0*x5 + x16 + x6*x9
+        x18 = cos(x4)
+        x19 = Omega_c*cos(x11)
+        x20 = x14*x19
+        x21 = alpha_dot + x10
+        x22 = sin(x13)
+        x23 = e*x22
+        x24 = cos(x7)
+        x25 = alpha_dot*x24*x6*x8
+        x26 = pi*Y_e*l_lambda
+        x27 = alpha_dot*chi0*x18 + 2*e*x15*x21*x22 - x20 - x25
+        x28 = (1/4)*x26
+        x29 = beta_D*x28*abs(x17)
+        x30 = e*sin(Omega_c*t + x12)
+        x31 = -x17*x28 + x27*x29
+        x32 = r_c + x2
+        x33 = -mu_m*x31*tanh(s*(2*alpha_dot*chi0*x24*x8 + alpha_dot*x18*x32 - x16*x21 - x19*x23 - (Omega_c + alpha_dot)*(r_c + x30)))
+        return alpha_dot*(-x2*x33 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x31*(-2*chi0*x9 + chi0 + 2*e*x15*x22 - x32*x5)) + (1/8)*x17*x26*(-2*alpha_dot*chi0*x18 - 4*x15*x21*x23 + 2*x20 + 2*x25) + x27**2*x29 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x33*(-Omega_c*r_c - Omega_c*x30 + (1/2)*alpha_dot*w_b)
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x7*x8)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = alpha + theta0
+        x1 = e*sin(Omega_c*t + x0)
+        x2 = alpha - alpha0
+        x3 = cos(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = Omega_c*cos(x5)
+        x7 = x0 + x5
+        x8 = sin(x7)
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = cos(x9)
+        x12 = alpha_dot + x4
+        x13 = e*cos(x7)
+        x14 = sin(x5)
+        x15 = 2*x13*x14
+        x16 = 2*r_c + w_b
+        x17 = -chi0*sin(x2) + x10**2*x16 + x15
+        x18 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*(-beta_D*x18*(alpha_dot*chi0*x3 - alpha_dot*x10*x11*x16 + 2*e*x12*x14*x8 - x13*x6)*abs(x17) + x17*x18)*(-Omega_c*r_c - Omega_c*x1 + (1/2)*alpha_dot*w_b)*tanh(s*(2*alpha_dot*chi0*x10*x11 + alpha_dot*x3*(r_c + (1/2)*w_b) - e*x6*x8 - x12*x15 - (Omega_c + alpha_dot)*(r_c + x1)))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0
+        x9 = x7 + x8
+        x10 = e*cos(x9)
+        x11 = Omega_c*cos(x7)
+        x12 = x10*x11
+        x13 = alpha_dot + x6
+        x14 = sin(x7)
+        x15 = sin(x9)
+        x16 = 2*r_c + w_b
+        x17 = (1/2)*alpha - 1/2*alpha0
+        x18 = cos(x17)
+        x19 = sin(x17)
+        x20 = alpha_dot*x16*x18*x19
+        x21 = alpha_dot*chi0*x5 + 2*e*x13*x14*x15 - x12 - x20
+        x22 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x23 = sin(x4)
+        x24 = x19**2
+        x25 = 2*x10*x14
+        x26 = -chi0*x23 + x16*x24 + x25
+        x27 = e*x15
+        x28 = pi*Y_e*l_lambda
+        x29 = e*sin(Omega_c*t + x8)
+        x30 = x21*x22 - 1/4*x26*x28
+        x31 = r_c + x2
+        x32 = -mu_m*x30*tanh(s*(2*alpha_dot*chi0*x18*x19 + alpha_dot*x31*x5 - x11*x27 - x13*x25 - (Omega_c + alpha_dot)*(r_c + x29)))
+        return alpha_dot*(-x2*x32 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x30*(-2*chi0*x24 + chi0 + 2*e*x14*x15 - x23*x31)) + x21**2*x22 + (1/8)*x26*x28*(-2*alpha_dot*chi0*x5 + 2*x12 - 4*x13*x14*x27 + 2*x20) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x32*(-Omega_c*r_c - Omega_c*x29 + (1/2)*alpha_dot*w_b)
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[14]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = alpha + theta0
+        x1 = e*sin(Omega_c*t + x0)
+        x2 = alpha - alpha0
+        x3 = cos(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = Omega_c*cos(x5)
+        x7 = x0 + x5
+        x8 = sin(x7)
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = cos(x9)
+        x12 = alpha_dot + x4
+        x13 = e*cos(x7)
+        x14 = sin(x5)
+        x15 = 2*x13*x14
+        x16 = 2*r_c + w_b
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x3 - alpha_dot*x10*x11*x16 + 2*e*x12*x14*x8 - x13*x6)/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x2) - x10**2*x16 - x15))*(-Omega_c*r_c - Omega_c*x1 + (1/2)*alpha_dot*w_b)*tanh(s*(2*alpha_dot*chi0*x10*x11 + alpha_dot*x3*(r_c + (1/2)*w_b) - e*x6*x8 - x12*x15 - (Omega_c + alpha_dot)*(r_c + x1)))
+    return nan

@@ -1260,3 +1260,282 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x5 = omega_c*cos(x1)
         return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading: P_in
+        4: contact_loading: D_c
+        5: contact_loading: D_f
+        6: contact_unloading: P_in
+        7: contact_unloading: D_c
+        8: contact_unloading: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = omega_c*t
+        x11 = Theta_p*sin(x10)
+        x12 = (1/4)*x11
+        x13 = alpha + theta0
+        x14 = x12 + x13
+        x15 = cos(x14)
+        x16 = sin(x12)
+        x17 = e*x16
+        x18 = -chi0*x5 + 2*x15*x17 + x6*x9
+        x19 = cos(x4)
+        x20 = alpha_dot*x6*x8*cos(x7)
+        x21 = Theta_p*omega_c*cos(x10)
+        x22 = x15*cos(x12)
+        x23 = sin(x14)
+        x24 = alpha_dot + (1/4)*x21
+        x25 = pi*Y_e*l_lambda
+        x26 = (1/2)*x21
+        x27 = e*x26
+        x28 = alpha_dot*chi0*x19 + 2*e*x16*x23*x24 - x20 - x22*x27
+        x29 = (1/4)*x25
+        x30 = beta_D*x29*abs(x18)
+        x31 = (1/2)*alpha_dot*w_b - r_c*x26 - x27*sin((1/2)*x11 + x13)
+        x32 = -x18*x29 + x28*x30
+        x33 = -mu_m*x32*tanh(s*x31)
+        return alpha_dot*(-x2*x33 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x32*(-2*chi0*x9 + chi0 + 2*e*x16*x23 - x5*(r_c + x2))) + (1/8)*x18*x25*(-2*alpha_dot*chi0*x19 + e*x21*x22 - 4*x17*x23*x24 + 2*x20) + x28**2*x30 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x31*x33
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = omega_c*t
+        x5 = (1/4)*Theta_p
+        x6 = x5*sin(x4)
+        x7 = alpha + theta0 + x6
+        x8 = e*cos(x7)
+        x9 = sin(x6)
+        x10 = omega_c*cos(x4)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x10*x8*cos(x6) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x9*(alpha_dot + x10*x5)*sin(x7))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x8*x9)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = (1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2
+        x6 = alpha - alpha0
+        x7 = 2*r_c + w_b
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        x14 = -chi0*sin(x6) + 2*x12*x13 + x7*x9**2
+        x15 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*x5*(-beta_D*x15*(alpha_dot*chi0*cos(x6) - alpha_dot*x7*x9*cos(x8) + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))*abs(x14) + x14*x15)*tanh(s*x5)
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = alpha_dot*x6*x8*cos(x7)
+        x10 = omega_c*t
+        x11 = Theta_p*omega_c*cos(x10)
+        x12 = (1/2)*x11
+        x13 = e*x12
+        x14 = Theta_p*sin(x10)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = x18*cos(x15)
+        x20 = sin(x15)
+        x21 = alpha_dot + (1/4)*x11
+        x22 = sin(x17)
+        x23 = alpha_dot*chi0*x5 + 2*e*x20*x21*x22 - x13*x19 - x9
+        x24 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x25 = sin(x4)
+        x26 = x8**2
+        x27 = e*x20
+        x28 = -chi0*x25 + 2*x18*x27 + x26*x6
+        x29 = pi*Y_e*l_lambda
+        x30 = (1/2)*alpha_dot*w_b - r_c*x12 - x13*sin((1/2)*x14 + x16)
+        x31 = x23*x24 - 1/4*x28*x29
+        x32 = -mu_m*x31*tanh(s*x30)
+        return alpha_dot*(-x2*x32 - x3*(L_us + d_x*x0 - d_y - x1*x2) - x31*(-2*chi0*x26 + chi0 + 2*e*x20*x22 - x25*(r_c + x2))) + x23**2*x24 + (1/8)*x28*x29*(-2*alpha_dot*chi0*x5 + e*x11*x19 - 4*x21*x22*x27 + 2*x9) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1)) + x30*x32
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[14]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = omega_c*t
+        x2 = (1/4)*Theta_p
+        x3 = x2*sin(x1)
+        x4 = alpha + theta0 + x3
+        x5 = omega_c*cos(x1)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4))**2/chi_star**2
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = (1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2
+        x6 = alpha - alpha0
+        x7 = 2*r_c + w_b
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        return mu_m*x5*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x6) - alpha_dot*x7*x9*cos(x8) + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x6) - 2*x12*x13 - x7*x9**2))*tanh(s*x5)
+    return nan

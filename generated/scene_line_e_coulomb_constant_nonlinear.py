@@ -1876,3 +1876,456 @@ def surface_index(k, t, alpha, alpha_dot, p):
         Omega_c = p[18]
         return -Omega_c*e*sin(Omega_c*t + alpha + theta0) - Omega_c*r_c + (1/2)*alpha_dot*w_b
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[18]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    elif j == 1:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[18]
+        return -Omega_c**2*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[18]
+        return -Omega_c*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading_fwd: P_in
+        4: contact_loading_fwd: D_c
+        5: contact_loading_fwd: D_f
+        6: contact_loading_bwd: P_in
+        7: contact_loading_bwd: D_c
+        8: contact_loading_bwd: D_f
+        9: contact_unloading_fwd: P_in
+        10: contact_unloading_fwd: D_c
+        11: contact_unloading_fwd: D_f
+        12: contact_unloading_bwd: P_in
+        13: contact_unloading_bwd: D_c
+        14: contact_unloading_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_E = p[14]
+        Y_e = p[15]
+        Omega_c = p[18]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = sin(x11)
+        x13 = e*x12
+        x14 = alpha + theta0
+        x15 = x11 + x14
+        x16 = cos(x15)
+        x17 = 2*x16
+        x18 = -chi0*x5 + x13*x17 + x6*x9
+        x19 = cos(x4)
+        x20 = Omega_c*e
+        x21 = x20*cos(x11)
+        x22 = alpha_dot + x10
+        x23 = sin(x15)
+        x24 = alpha_dot*x6*x8*cos(x7)
+        x25 = pi*Y_e*l_lambda
+        x26 = alpha_dot*chi0*x19 + 2*e*x12*x22*x23 - x16*x21 - x24
+        x27 = beta_E*abs(x18)**(1/4)
+        x28 = -1/4*x18*x25 + x26*x27
+        x29 = -mu_m*x28
+        return alpha_dot*(-x2*x29 - x28*(-2*chi0*x9 + chi0 + 2*e*x12*x23 - x5*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) + (1/8)*x18*x25*(-2*alpha_dot*chi0*x19 - 4*x13*x22*x23 + x17*x21 + 2*x24) + x26**2*x27 + x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x20*sin(Omega_c*t + x14)) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_E = p[14]
+        Omega_c = p[18]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        return beta_E*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x7*x8)**(1/4)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_E = p[14]
+        Y_e = p[15]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = alpha - alpha0
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = -chi0*sin(x2) + 2*e*x10*x9 + x3*x5**2
+        return mu_m*((1/4)*pi*Y_e*l_lambda*x11 - beta_E*(alpha_dot*chi0*cos(x2) - alpha_dot*x3*x5*cos(x4) + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x11)**(1/4))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_E = p[14]
+        Y_e = p[15]
+        Omega_c = p[18]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = sin(x4)
+        x6 = 2*r_c + w_b
+        x7 = (1/2)*alpha - 1/2*alpha0
+        x8 = sin(x7)
+        x9 = x8**2
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = sin(x11)
+        x13 = e*x12
+        x14 = alpha + theta0
+        x15 = x11 + x14
+        x16 = cos(x15)
+        x17 = 2*x16
+        x18 = -chi0*x5 + x13*x17 + x6*x9
+        x19 = cos(x4)
+        x20 = Omega_c*e
+        x21 = x20*cos(x11)
+        x22 = alpha_dot + x10
+        x23 = sin(x15)
+        x24 = alpha_dot*x6*x8*cos(x7)
+        x25 = pi*Y_e*l_lambda
+        x26 = alpha_dot*chi0*x19 + 2*e*x12*x22*x23 - x16*x21 - x24
+        x27 = beta_E*abs(x18)**(1/4)
+        x28 = -1/4*x18*x25 + x26*x27
+        x29 = -x28
+        return alpha_dot*((1/2)*mu_m*w_b*x29 - x28*(-2*chi0*x9 + chi0 + 2*e*x12*x23 - x5*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) - mu_m*x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x20*sin(Omega_c*t + x14)) + (1/8)*x18*x25*(-2*alpha_dot*chi0*x19 - 4*x13*x22*x23 + x17*x21 + 2*x24) + x26**2*x27 + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_E = p[14]
+        Omega_c = p[18]
+        x0 = alpha - alpha0
+        x1 = 2*r_c + w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        return beta_E*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*cos(x0) - alpha_dot*x1*x3*cos(x2) + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-chi0*sin(x0) + x1*x3**2 + 2*x7*x8)**(1/4)
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_E = p[14]
+        Y_e = p[15]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = alpha - alpha0
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = -chi0*sin(x2) + 2*e*x10*x9 + x3*x5**2
+        return -mu_m*((1/4)*pi*Y_e*l_lambda*x11 - beta_E*(alpha_dot*chi0*cos(x2) - alpha_dot*x3*x5*cos(x4) + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x11)**(1/4))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 9:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_E = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0
+        x9 = x7 + x8
+        x10 = cos(x9)
+        x11 = Omega_c*e
+        x12 = x11*cos(x7)
+        x13 = alpha_dot + x6
+        x14 = sin(x7)
+        x15 = sin(x9)
+        x16 = 2*r_c + w_b
+        x17 = (1/2)*alpha - 1/2*alpha0
+        x18 = sin(x17)
+        x19 = alpha_dot*x16*x18*cos(x17)
+        x20 = alpha_dot*chi0*x5 + 2*e*x13*x14*x15 - x10*x12 - x19
+        x21 = 2*I_Pb*vartheta*zeta_E/chi_star**2
+        x22 = sin(x4)
+        x23 = x18**2
+        x24 = e*x14
+        x25 = 2*x10
+        x26 = -chi0*x22 + x16*x23 + x24*x25
+        x27 = pi*Y_e*l_lambda
+        x28 = x20*x21 - 1/4*x26*x27
+        x29 = -mu_m*x28
+        return alpha_dot*(-x2*x29 - x28*(-2*chi0*x23 + chi0 + 2*e*x14*x15 - x22*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) + x20**2*x21 + (1/8)*x26*x27*(-2*alpha_dot*chi0*x5 + x12*x25 - 4*x13*x15*x24 + 2*x19) + x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x11*sin(Omega_c*t + x8)) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 10:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_E = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return 2*I_Pb*vartheta*zeta_E*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 11:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_E = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = alpha - alpha0
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        return mu_m*(-2*I_Pb*vartheta*zeta_E*(alpha_dot*chi0*cos(x2) - alpha_dot*x3*x5*cos(x4) + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x2) - 2*e*x10*x9 - x3*x5**2))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 12:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_E = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha - alpha0
+        x5 = cos(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0
+        x9 = x7 + x8
+        x10 = cos(x9)
+        x11 = Omega_c*e
+        x12 = x11*cos(x7)
+        x13 = alpha_dot + x6
+        x14 = sin(x7)
+        x15 = sin(x9)
+        x16 = 2*r_c + w_b
+        x17 = (1/2)*alpha - 1/2*alpha0
+        x18 = sin(x17)
+        x19 = alpha_dot*x16*x18*cos(x17)
+        x20 = alpha_dot*chi0*x5 + 2*e*x13*x14*x15 - x10*x12 - x19
+        x21 = 2*I_Pb*vartheta*zeta_E/chi_star**2
+        x22 = sin(x4)
+        x23 = x18**2
+        x24 = e*x14
+        x25 = 2*x10
+        x26 = -chi0*x22 + x16*x23 + x24*x25
+        x27 = pi*Y_e*l_lambda
+        x28 = x20*x21 - 1/4*x26*x27
+        x29 = -x28
+        return alpha_dot*((1/2)*mu_m*w_b*x29 - x28*(-2*chi0*x23 + chi0 + 2*e*x14*x15 - x22*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) - mu_m*x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x11*sin(Omega_c*t + x8)) + x20**2*x21 + (1/8)*x26*x27*(-2*alpha_dot*chi0*x5 + x12*x25 - 4*x13*x15*x24 + 2*x19) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 13:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_E = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return 2*I_Pb*vartheta*zeta_E*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 14:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_E = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = alpha - alpha0
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        return -mu_m*(-2*I_Pb*vartheta*zeta_E*(alpha_dot*chi0*cos(x2) - alpha_dot*x3*x5*cos(x4) + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(chi0*sin(x2) - 2*e*x10*x9 - x3*x5**2))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    return nan

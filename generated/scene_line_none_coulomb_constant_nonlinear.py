@@ -1101,3 +1101,194 @@ def surface_index(k, t, alpha, alpha_dot, p):
         Omega_c = p[14]
         return -Omega_c*e*sin(Omega_c*t + alpha + theta0) - Omega_c*r_c + (1/2)*alpha_dot*w_b
     return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[14]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    elif j == 1:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[14]
+        return -Omega_c**2*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[14]
+        return -Omega_c*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_fwd: P_in
+        4: contact_fwd: D_c
+        5: contact_fwd: D_f
+        6: contact_bwd: P_in
+        7: contact_bwd: D_c
+        8: contact_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha + theta0
+        x5 = Omega_c*e
+        x6 = alpha - alpha0
+        x7 = sin(x6)
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = e*x14
+        x16 = x13 + x4
+        x17 = 2*cos(x16)
+        x18 = -chi0*x7 + x11*x8 + x15*x17
+        x19 = -x18
+        x20 = pi*Y_e*l_lambda
+        x21 = (1/4)*x19*x20
+        x22 = 2*chi0
+        x23 = sin(x16)
+        return alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x19 - x21*(chi0 + 2*e*x14*x23 - x11*x22 - x7*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) - mu_m*x21*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x5*sin(Omega_c*t + x4)) + (1/8)*x18*x20*(2*alpha_dot*x10*x8*cos(x9) - alpha_dot*x22*cos(x6) - 4*x15*x23*(alpha_dot + x12) + x17*x5*cos(x13)) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 4:
+        return 0
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = Omega_c*t
+        x1 = alpha + theta0
+        x2 = (1/2)*x0
+        return -1/4*pi*Y_e*l_lambda*mu_m*(chi0*sin(alpha - alpha0) - 2*e*sin(x2)*cos(x1 + x2) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2)*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = tan(alpha)
+        x1 = (1/cos(alpha))
+        x2 = (1/2)*w_b
+        x3 = d_x*k_s
+        x4 = alpha + theta0
+        x5 = Omega_c*e
+        x6 = alpha - alpha0
+        x7 = sin(x6)
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = e*x14
+        x16 = x13 + x4
+        x17 = 2*cos(x16)
+        x18 = -chi0*x7 + x11*x8 + x15*x17
+        x19 = pi*Y_e*l_lambda
+        x20 = -x18*x19
+        x21 = (1/4)*x20
+        x22 = 2*chi0
+        x23 = sin(x16)
+        return alpha_dot*(-1/8*mu_m*w_b*x20 - x21*(chi0 + 2*e*x14*x23 - x11*x22 - x7*(r_c + x2)) - x3*(L_us + d_x*x0 - d_y - x1*x2)) + mu_m*x21*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x5*sin(Omega_c*t + x4)) + (1/8)*x18*x19*(2*alpha_dot*x10*x8*cos(x9) - alpha_dot*x22*cos(x6) - 4*x15*x23*(alpha_dot + x12) + x17*x5*cos(x13)) + x3*(L_us*alpha_dot + alpha_dot*d_x*sin(alpha)/cos(alpha) - alpha_dot*d_y - x2*(alpha_dot*x0*x1 + alpha_dot*(x0**2 + 1))/(x0 + x1))
+    elif c == 7:
+        return 0
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = Omega_c*t
+        x1 = alpha + theta0
+        x2 = (1/2)*x0
+        return (1/4)*pi*Y_e*l_lambda*mu_m*(chi0*sin(alpha - alpha0) - 2*e*sin(x2)*cos(x1 + x2) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2)*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)
+    return nan

@@ -179,4 +179,5 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
             t = t_end
     t_all, y_all, names = sampler.arrays()
     stats["switches"] = len(switches)
+    stats["backend"] = "scipy"
     return Trajectory(t_all, y_all, names, keys, switches, outcome, stats)

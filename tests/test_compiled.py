@@ -167,7 +167,7 @@ def _toy_run(y0, t_end, interior, p=(1.0, 1e4, math.inf), rtol=1e-8, max_step=ma
            np.array([-1, 0, 1], dtype=np.int64), np.array([-1, -1], dtype=np.int64))
     t_eval = np.linspace(0, t_end, 11)
     fset = np.array([rtol, 1e-12, max_step, 1e-14, 1e9, 1e-9, 0.0])
-    iset = np.array([interior, 10_000, 20, rate_check, 0], dtype=np.int64)
+    iset = np.array([interior, 10_000, 20, rate_check, 0, -1], dtype=np.int64)
     out_y, out_r = np.empty((2, 11)), np.empty(11, dtype=np.int64)
     fns = (_toy_rhs, _toy_gap, _toy_rate, _toy_rate)
     return engine.run(fns, arrays(DOP853), np.array(p), tab, 2, -1, 0.0, t_end,

@@ -114,8 +114,9 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     contact_step = 0.1 / model.equilibrium.vartheta  # s: as the SciPy backend (camdyn.integrate)
     fset = np.array([options.rtol, options.atol, options.max_step, ev.xtol, ANGLE_LIMIT, CHATTER_WINDOW,
                      contact_step])
+    rate_flag = next((k for k, f in enumerate(K.FLAGS) if K.FLAG_SURFACES[f][0] == "gap_rate"), -1)
     iset = np.array([ev.interior_points, ev.max_events, CHATTER_SWITCHES, hasattr(K, "aux_index"),
-                     has_stick(K)], dtype=np.int64)
+                     has_stick(K), rate_flag], dtype=np.int64)
     out_y = np.empty((5 if options.ledger else 2, t_eval.size))
     out_r = np.empty(t_eval.size, dtype=np.int64)
     p = np.ascontiguousarray(model.p, dtype=float)

@@ -6,8 +6,9 @@ Coulomb friction, their stick modes).  The switching rules are those of the SciP
 from the state's side of their surfaces (looking ahead when exactly on one), and ends with
 them out of scope; a slip reversal where both one-sided fields point at v_r = 0 sticks,
 and sticking ends when one of them turns away; every other flag just flips.  After a
-switch into contact the first step is capped at a tenth of a radian of the contact mode,
-as in the SciPy backend (a free-flight step would blow up on the stiff contact).
+switch from free flight into contact the first step is capped at a tenth of a radian of
+the contact mode, as in the SciPy backend (a free-flight step would blow up on the stiff
+contact).
 
 With a ledger (``out_y`` of 5 rows) the work of the drive, contact damping and friction is
 integrated along the dense output (:mod:`.ledger`) and sampled with the state.
@@ -33,11 +34,12 @@ from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, ste
 OUTCOMES = ("SUCCESS", "STEP_FAILED", "MAX_EVENTS", "CHATTER", "NONFINITE", "ANGLE_LIMIT")
 SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = range(6)
 #: settings arrays: floats (rtol, atol, max_step, xtol, angle_limit, chatter_window,
-#: contact_step: the first step's cap after a switch into contact, 0 for none) and ints
+#: contact_step: the first step's cap after a switch from free flight into contact, 0 for
+#: none) and ints
 #: (interior_points, max_events, chatter_switches, rate_check: gap-rate excursion check on,
-#: stick: Coulomb stick modes exist)
+#: stick: Coulomb stick modes exist, rate_flag: the flag whose surface is the gap rate or -1)
 F_RTOL, F_ATOL, F_MAX_STEP, F_XTOL, F_ANGLE, F_CHATTER, F_CONTACT_STEP = range(7)
-I_INTERIOR, I_MAX_EVENTS, I_CHATTER, I_RATE, I_STICK = range(5)
+I_INTERIOR, I_MAX_EVENTS, I_CHATTER, I_RATE, I_STICK, I_RATE_FLAG = range(6)
 #: columns of a switch record
 SWITCH_COLUMNS = ("t", "flag", "before", "after", "alpha", "alpha_dot")
 #: counters returned
@@ -85,17 +87,17 @@ def chattering(sw, n, window, count):
 
 
 @njit(cache=True)
-def first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, K):
+def first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_free, K):
     """K[0] = f(t, y) and the size of the first step in regime r: SciPy's initial step at
-    the start, else the last step's size (capped after a switch into contact).
-    Returns (h_abs, RHS evaluations)."""
+    the start, else the last step's size (capped after a switch from free flight into
+    contact).  Returns (h_abs, RHS evaluations)."""
     K[0, 0], K[0, 1] = y1, accel(fns, nr, r, t, y0, y1, p)
     if h_last < 0.0:
         error_order = -1.0 / method[9] - 1.0
         return initial_step(fns, nr, r, t, y0, y1, K[0, 1], t_end, fset[F_MAX_STEP], error_order,
                             fset[F_RTOL], fset[F_ATOL], p), 2
     h_abs = min(h_last, t_end - t)
-    if fset[F_CONTACT_STEP] > 0.0 and tab[1].shape[0] > 0 and tab[0][r, 0] == 1:
+    if from_free and tab[0][r, 0] == 1:
         h_abs = min(h_abs, fset[F_CONTACT_STEP])
     return h_abs, 1
 
@@ -135,7 +137,8 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
     r = r0 if r0 >= 0 else entering(fns, tab, t, y0, y1, p, on_true_side(fns, tab, 0, t, y0, y1, p, True))
     h_last = -1.0
     while t < t_end and outcome == SUCCESS:
-        h_abs, nfev = first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, K)
+        from_free = n_sw > 0 and fset[F_CONTACT_STEP] > 0.0 and tab[0][int(sw[n_sw - 1, 2]), 0] == 0
+        h_abs, nfev = first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_free, K)
         stats[0] += nfev
         watched = watch(tab, nr, r, dirs)
         have_start = False
@@ -158,7 +161,7 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
             if watched:
                 maybe_on_surface = not have_start or zero_at_start(dirs, g_prev)
                 k, t_cross = first_crossing(fns, tab, nr, r, dirs, t, t_new, y0, y1, n0, n1, Q, p, n_int, xtol,
-                                            rate_check, have_start, g_prev, r_prev, g_next)
+                                            rate_check, iset[I_RATE_FLAG], have_start, g_prev, r_prev, g_next)
                 if k == NONFINITE:
                     outcome = NONFINITE_STATE
                     break

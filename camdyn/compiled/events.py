@@ -103,7 +103,7 @@ def hidden_excursion(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga,
 
 @njit(cache=True)
 def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, rate_check,
-                   have_start, g_prev, r_prev, g_next):
+                   rate_flag, have_start, g_prev, r_prev, g_next):
     """Earliest crossing of any watched value over the step [t0, t1].
 
     Each watched g is sampled at t0 (state y), at n_interior equally spaced interior times
@@ -113,6 +113,8 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
     :func:`locate`; the earliest time wins, ties to the lowest index.
     Returns (k, t): k = -1 when nothing crosses, NONFINITE when a g is not finite.
 
+    ``rate_flag``: the flag whose surface is the gap rate itself (damping D/E), or -1: its
+    value is the rate already computed for the excursion check.
     ``have_start``: g_prev (and r_prev, the gap rate) already hold the values at t0 (the
     previous step's end).  With no crossing, they hold the values at t1 on return.
     g_next is a work array.  All three have one entry per value index.
@@ -139,10 +141,15 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
             a, ad = n0, n1
         else:
             a, ad = dense_eval(tb, t0, h, y0, y1, Q)
+        rb_known = False
+        rb = 0.0
         for k in range(nv):
             if dirs[k] == 0 or (found >> k) & 1:
                 continue
-            g_next[k] = value(fns, tab, nr, r, k, tb, a, ad, p)
+            if k == rate_flag and rb_known:
+                g_next[k] = rb
+            else:
+                g_next[k] = value(fns, tab, nr, r, k, tb, a, ad, p)
             if not (math.isfinite(g_prev[k]) and math.isfinite(g_next[k])):
                 return NONFINITE, tb
             tk = -1.0
@@ -150,6 +157,7 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
                 tk = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, ta, tb, g_prev[k], g_next[k], xtol)
             elif k == 0 and rate:
                 rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
+                rb_known = True
                 t_ext, g_ext = hidden_excursion(fns, tab, nr, r, dirs[0], t0, h, y0, y1, Q, p, ta, tb,
                                                 g_prev[0], r_prev[0], rb)
                 if t_ext >= 0.0:

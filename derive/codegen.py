@@ -93,10 +93,38 @@ def _function_code(f: Function, params: list[str]) -> str:
     return "\n".join(lines + _body_lines(f, params))
 
 
+def _economise_trig(exprs: list[sp.Expr]) -> list[sp.Expr]:
+    """The same expressions with fewer distinct trigonometric calls, for the emitted code only.
+
+    tan(u) and sec(u) become sin(u)/cos(u) and 1/cos(u) (a sin/cos pair of one argument costs
+    about one call: compilers fuse it into sincos), and sin(2v), cos(2v) become
+    2 sin(v) cos(v) and 1 - 2 sin(v)^2 when sin(v) or cos(v) is computed anyway (the
+    half-angle forms of the gap, geometry.psi_i_conditioned, bring v = (alpha - alpha0)/2).
+    Both rewrites are exact identities, accurate to a few ulp.
+    """
+    exprs = [sp.sympify(x).replace(sp.tan, lambda u: sp.sin(u) / sp.cos(u))
+             .replace(sp.sec, lambda u: 1 / sp.cos(u)) for x in exprs]
+    args = sorted({call.args[0] for x in exprs for call in x.atoms(sp.sin, sp.cos)}, key=sp.default_sort_key)
+    double = {}
+    for u in args:
+        for v in args:
+            if v != u and sp.expand(u - 2 * v) == 0:
+                double[u] = v
+                break
+    if not double:
+        return exprs
+    subs = {}
+    for u, v in double.items():
+        subs[sp.sin(u)] = 2 * sp.sin(v) * sp.cos(v)
+        subs[sp.cos(u)] = 1 - 2 * sp.sin(v) ** 2
+    return [x.xreplace(subs) for x in exprs]
+
+
 def _body_lines(f: Function, params: list[str]) -> list[str]:
     """The statements of a function (parameter unpacking, CSE, return), indented once."""
     printer = _Vector() if f.vectorised else _Scalar()
-    replacements, reduced = sp.cse(list(f.exprs), symbols=sp.numbered_symbols("x"), order="canonical")
+    replacements, reduced = sp.cse(_economise_trig(list(f.exprs)), symbols=sp.numbered_symbols("x"),
+                                   order="canonical")
     used = _param_names(list(f.exprs))
     lines = []
     if "cam" in f.args:

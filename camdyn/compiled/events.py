@@ -37,7 +37,7 @@ def crossed(g0, g1, direction):
     return up or down
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def value_on_step(fns, tab, nr, r, k, tt, t, h, y0, y1, Q, p):
     """Value k at time tt on the step's interpolant."""
     a, ad = dense_eval(tt, t, h, y0, y1, Q)

@@ -335,6 +335,31 @@ def test_warm_start_loads_the_compiled_loop_from_the_disk_cache():
     assert (hits, misses) == (1, 0)
 
 
+def test_cache_is_dropped_when_any_module_of_the_loop_changes(tmp_path):
+    """numba checks only a function's own file: an edit of events.py would leave engine.run's
+    stale machine code in use.  cache.refresh drops the package's cache files when the hash
+    of its sources changes, and only then."""
+    from camdyn.compiled import cache
+    pkg, store = tmp_path / "pkg", tmp_path / "store"
+    pkg.mkdir()
+    (pkg / "a.py").write_text("x = 1\n")
+    store.mkdir()
+    files = [store / "a.f-1.py311.nbi", store / "a.f-1.py311.0.nbc"]
+    for f in files:
+        f.write_text("cached")
+    (store / "a.cpython-311.pyc").write_text("bytecode")
+    assert cache.refresh(store, pkg)          # no stamp yet: dropped
+    assert not any(f.exists() for f in files) and (store / "a.cpython-311.pyc").exists()
+    for f in files:
+        f.write_text("cached")
+    assert not cache.refresh(store, pkg)      # same sources: kept
+    assert all(f.exists() for f in files)
+    (pkg / "b.py").write_text("y = 2\n")   # another module of the package changed
+    assert cache.refresh(store, pkg)
+    assert not any(f.exists() for f in files)
+    assert cache.cache_dir_of(engine.run) is not None  # numba's locator is still where we look
+
+
 def test_tables_encode_the_generated_regimes():
     K = camdyn.Scene(damping="D", friction="coulomb").kernels()
     flags_of, signs, lookup, partner = tables(K)

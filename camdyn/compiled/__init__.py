@@ -10,7 +10,8 @@
 * :mod:`.ledger`   -- the energy ledger's quadrature along the dense output;
 * :mod:`.engine`   -- steps, switches, sampling: the loop;
 * :mod:`.kernels`  -- a scene's generated index kernels as cached cfuncs;
-* :mod:`.backend`  -- Model in, Trajectory out.
+* :mod:`.backend`  -- Model in, Trajectory out;
+* :mod:`.cache`    -- the disk cache kept in step with the package's sources.
 
 Everything compiled is cached on disk (numba ``cache=True``): the first run on a machine
 compiles (cold start), later processes load the cache (warm start).
@@ -26,7 +27,12 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning,
                         message="First-class function type feature is experimental")
 
+from . import engine  # noqa: E402
 from .backend import integrate  # noqa: E402
+from .cache import cache_dir_of, refresh  # noqa: E402
 from .tableau import DOP853, DOPRI5, TABLEAUS, Tableau, TableauError  # noqa: E402
+
+# before numba loads anything cached: drop the cache if any module of the loop changed
+refresh(cache_dir_of(engine.run))
 
 __all__ = ["integrate", "Tableau", "TableauError", "DOPRI5", "DOP853", "TABLEAUS"]

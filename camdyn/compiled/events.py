@@ -102,6 +102,28 @@ def hidden_excursion(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga,
 
 
 @njit(cache=True)
+def turned_back(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, rb):
+    """Start (t, g) of the bracket of a gap sign change over (ta, tb], and whether it is one.
+
+    If the gap moves away from the watched direction at ta (rate * direction < 0), it can
+    reach the surface only after turning: the bracket starts at the turn (the rate's root)
+    when the gap is still on the near side there.  If the rate never turns, the sign change
+    is rounding noise (a restart just across the surface, where the gap is ~1e-19 m and the
+    time's rounding alone moves it by more): not a crossing.  camdyn.events._turned_back.
+    """
+    if ra * direction >= 0.0:
+        return ta, ga, True
+    if rb * direction < 0.0:
+        return ta, ga, False
+    k_rate = tab[1].shape[0] + GAP_RATE
+    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
+    g_ext = value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+    if g_ext * direction < 0.0:
+        return t_ext, g_ext, True
+    return ta, ga, True
+
+
+@njit(cache=True)
 def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, rate_check,
                    rate_flag, have_start, g_prev, r_prev, g_next):
     """Earliest crossing of any watched value over the step [t0, t1].
@@ -109,7 +131,8 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
     Each watched g is sampled at t0 (state y), at n_interior equally spaced interior times
     (interpolant) and at t1 (state n): a micro-hop (out and back inside one step) is seen
     when a sample falls inside it, and, with ``rate_check``, also between two samples from
-    the turn of the gap rate.  Per value the earliest crossing sub-interval is refined with
+    the turn of the gap rate (which also tells a gap sign change that is rounding noise from
+    a crossing, :func:`turned_back`).  Per value the earliest crossing sub-interval is refined with
     :func:`locate`; the earliest time wins, ties to the lowest index.
     Returns (k, t): k = -1 when nothing crosses, NONFINITE when a g is not finite.
 
@@ -154,7 +177,15 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
                 return NONFINITE, tb
             tk = -1.0
             if crossed(g_prev[k], g_next[k], dirs[k]):
-                tk = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, ta, tb, g_prev[k], g_next[k], xtol)
+                lo, glo, genuine = ta, g_prev[k], True
+                if k == 0 and rate:
+                    rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
+                    rb_known = True
+                    lo, glo, genuine = turned_back(fns, tab, nr, r, dirs[0], t0, h, y0, y1, Q, p, ta, tb,
+                                                   g_prev[0], r_prev[0], rb)
+                    r_prev[0] = rb
+                if genuine:
+                    tk = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, lo, tb, glo, g_next[k], xtol)
             elif k == 0 and rate:
                 rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
                 rb_known = True

@@ -138,7 +138,7 @@ def switching_rhs(model: Model):
     the surfaces (no event location), built from the scene's compiled kernels."""
     from camdyn.compiled.backend import tables
     rhs, surface = scene_functions(model.kernels)
-    flags_of, signs, lookup = tables(model.kernels)
+    flags_of, signs, lookup, _ = tables(model.kernels)
     nf = len(model.kernels.FLAGS)
     fixed = 0 if nf == 0 else -1
 

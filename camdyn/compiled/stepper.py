@@ -33,13 +33,13 @@ MAX_FACTOR = 10.0
 ACCEPTED, TOO_SMALL = 0, 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _norm(x0, x1):
     """SciPy's RMS norm of a 2-vector."""
     return math.sqrt(0.5 * (x0 * x0 + x1 * x1))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def stages(fns, nr, r, t, y0, y1, h, A, C, p, K, first, last):
     """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y))."""
     for s in range(first, last):
@@ -54,7 +54,7 @@ def stages(fns, nr, r, t, y0, y1, h, A, C, p, K, first, last):
         K[s, 1] = accel(fns, nr, r, t + C[s] * h, y0 + d0 * h, z1, p)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_impl(fns, nr, r, t, y0, y1, h, method, p, K):
     """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
     A, C, B, n = method[0], method[1], method[2], method[6]
@@ -71,7 +71,7 @@ def step_impl(fns, nr, r, t, y0, y1, h, method, p, K):
     return n0, n1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     """SciPy's error norm of the attempt (RK45: embedded difference; DOP853: 5th/3rd blend)."""
     E, E3, n, kind = method[3], method[4], method[6], method[8]
@@ -96,7 +96,7 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 2.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(fns, nr, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
 
@@ -160,7 +160,7 @@ def initial_step(fns, nr, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol
     return min(100.0 * h0, h1, length, max_step)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def dense_coefficients(fns, nr, r, t, y0, y1, h, method, p, K, Q):
     """Q = K^T P after computing the extra stages (DOP853): y(t + theta h) = y + h theta (Q0 + Q1 theta + ...).
 
@@ -180,7 +180,7 @@ def dense_coefficients(fns, nr, r, t, y0, y1, h, method, p, K, Q):
     return n_extra
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def dense_eval(tt, t, h, y0, y1, Q):
     """The interpolant at time tt of the step [t, t + h] (Horner in theta)."""
     theta = (tt - t) / h

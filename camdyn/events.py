@@ -193,6 +193,27 @@ def _hidden_excursion(event: Event, dense, ta: float, tb: float, ga: float, ra: 
     return None
 
 
+def _turned_back(event: Event, dense, ta: float, tb: float, ga: float, gb: float, ra: float, rb: float):
+    """The bracket of a sign change of ``g`` over (ta, tb] whose start moves *away* from the
+    watched direction (rate * direction < 0): (ta, tb, ga, gb) unchanged otherwise.
+
+    Moving away, g can reach the surface only after turning (a maximum of g for a downward
+    watch): the sign change lies after the turn, in [t_ext, tb].  If the rate never turns,
+    the "crossing" is rounding noise -- a restart just across a surface, where g is ~1e-19 m
+    and the time's rounding alone moves it by more -- and there is none (None).
+    """
+    if ra * event.direction >= 0:
+        return ta, tb, ga, gb
+    if rb * event.direction < 0:
+        return None
+    t_ext, _ = brentq(lambda s: event.rate(s, dense(s)), ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
+                      maxiter=100, full_output=True, disp=False)
+    g_ext = float(event.fn(t_ext, dense(t_ext)))
+    if g_ext * event.direction < 0:  # still on the near side at the turn: the crossing follows it
+        return t_ext, tb, g_ext, gb
+    return ta, tb, ga, gb
+
+
 def first_crossing(
     events: Sequence[Event],
     dense: Callable[[float], np.ndarray],
@@ -208,7 +229,8 @@ def first_crossing(
     ``settings.interior_points`` equally spaced interior times (with
     ``dense``) and at ``t1`` (with ``y1``). For each event the earliest
     sampled sub-interval that crosses in the event's direction is refined
-    with :func:`locate` on the interpolant. The earliest located time over
+    with :func:`locate` on the interpolant (for an event with a rate, after the
+    turn if the sub-interval starts moving away, see :func:`_turned_back`). The earliest located time over
     all events wins; ties go to the lowest index. Returns None if no event
     crosses. A double crossing between two adjacent samples is invisible.
     """
@@ -224,7 +246,13 @@ def first_crossing(
         rates = [float(event.rate(t, y)) for t, y in zip(times, states)] if event.rate else None
         for k in range(n + 1):
             if crossed(g[k], g[k + 1], event.direction):
-                candidates.append((times[k], index, times[k + 1], g[k], g[k + 1]))
+                bracket = (times[k], times[k + 1], g[k], g[k + 1])
+                if rates is not None:
+                    bracket = _turned_back(event, dense, *bracket, rates[k], rates[k + 1])
+                    if bracket is None:  # rounding noise at a restart, not a crossing
+                        continue
+                ta, tb, ga, gb = bracket
+                candidates.append((ta, index, tb, ga, gb))
                 break
             if rates is not None:
                 hidden = _hidden_excursion(event, dense, times[k], times[k + 1], g[k], rates[k], rates[k + 1])

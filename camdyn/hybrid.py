@@ -191,7 +191,10 @@ class Hybrid:
         jf = m.bind(getattr(m.kernels, f"jac_{name}"))
 
         def fun(t, y):
-            return np.array([y[1], accel(t, y[0], y[1])])
+            try:
+                return np.array([y[1], accel(t, y[0], y[1])])
+            except (ValueError, OverflowError):  # a wild trial stage (sin of inf): NaN rejects the step
+                return np.array([y[1], np.nan])
 
         def jac(t, y):
             d0, d1 = jf(t, y[0], y[1])
@@ -219,7 +222,10 @@ class Hybrid:
         jf_fwd = self.model.bind(getattr(self.model.kernels, f"jac_{self.names[fwd]}"))
 
         def fun(t, y):
-            _, a_eq = self.stick_weight(key, t, y[0], y[1])
+            try:
+                _, a_eq = self.stick_weight(key, t, y[0], y[1])
+            except (ValueError, OverflowError, ZeroDivisionError):  # a wild trial stage: reject the step
+                a_eq = np.nan
             return np.array([y[1], a_eq])
 
         def jac(t, y):  # only implicit methods use it; the forward side's is close enough

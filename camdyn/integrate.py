@@ -137,7 +137,7 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     while t < t_end and outcome is Outcome.SUCCESS:
         regime = hybrid.regime(key, options.ledger)
         keys[regime.name] = key
-        if h is not None and regime.name != "free":
+        if h is not None and switches and switches[-1].before == "free":
             h = min(h, contact_time_scale)  # a free-flight step would blow up the stiff contact
         solver = _solver(options, regime, t, y, t_end, h)
         crossing = None
@@ -179,4 +179,5 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
             t = t_end
     t_all, y_all, names = sampler.arrays()
     stats["switches"] = len(switches)
+    stats["backend"] = "scipy"
     return Trajectory(t_all, y_all, names, keys, switches, outcome, stats)

@@ -96,8 +96,6 @@ def _integrator(backend: str, options: SolverOptions):
     """The integrate() of a backend: camdyn.integrate (SciPy) or camdyn.compiled."""
     if backend == "scipy":
         return integrate
-    if getattr(options, "energy_ledger", False):
-        raise ParameterError("energy_ledger", True, "False with backend='compiled' (use backend='scipy')")
     from .compiled import integrate as compiled
     return compiled
 

@@ -36,7 +36,7 @@ OUTPUT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "D_f": "W", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2", "M": "N m",
                 "dM_dalpha": "N m/rad", "k_lambda": "N/m", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "reach_margin": "m", "dv_r_dt": "m/s^2", "dv_r_dalpha": "m/s/rad", "dv_r_dalpha_dot": "m/rad", "V_s": "J", "V_s_printed": "J",
-                "surface": "m or m/s"}
+                "surface": "m or m/s", "auxiliary": "m/s, m/s^2, m/s/rad or m/rad", "power": "W"}
 
 
 class _Scalar(PythonCodePrinter):
@@ -93,10 +93,38 @@ def _function_code(f: Function, params: list[str]) -> str:
     return "\n".join(lines + _body_lines(f, params))
 
 
+def _economise_trig(exprs: list[sp.Expr]) -> list[sp.Expr]:
+    """The same expressions with fewer distinct trigonometric calls, for the emitted code only.
+
+    tan(u) and sec(u) become sin(u)/cos(u) and 1/cos(u) (a sin/cos pair of one argument costs
+    about one call: compilers fuse it into sincos), and sin(2v), cos(2v) become
+    2 sin(v) cos(v) and 1 - 2 sin(v)^2 when sin(v) or cos(v) is computed anyway (the
+    half-angle forms of the gap, geometry.psi_i_conditioned, bring v = (alpha - alpha0)/2).
+    Both rewrites are exact identities, accurate to a few ulp.
+    """
+    exprs = [sp.sympify(x).replace(sp.tan, lambda u: sp.sin(u) / sp.cos(u))
+             .replace(sp.sec, lambda u: 1 / sp.cos(u)) for x in exprs]
+    args = sorted({call.args[0] for x in exprs for call in x.atoms(sp.sin, sp.cos)}, key=sp.default_sort_key)
+    double = {}
+    for u in args:
+        for v in args:
+            if v != u and sp.expand(u - 2 * v) == 0:
+                double[u] = v
+                break
+    if not double:
+        return exprs
+    subs = {}
+    for u, v in double.items():
+        subs[sp.sin(u)] = 2 * sp.sin(v) * sp.cos(v)
+        subs[sp.cos(u)] = 1 - 2 * sp.sin(v) ** 2
+    return [x.xreplace(subs) for x in exprs]
+
+
 def _body_lines(f: Function, params: list[str]) -> list[str]:
     """The statements of a function (parameter unpacking, CSE, return), indented once."""
     printer = _Vector() if f.vectorised else _Scalar()
-    replacements, reduced = sp.cse(list(f.exprs), symbols=sp.numbered_symbols("x"), order="canonical")
+    replacements, reduced = sp.cse(_economise_trig(list(f.exprs)), symbols=sp.numbered_symbols("x"),
+                                   order="canonical")
     used = _param_names(list(f.exprs))
     lines = []
     if "cam" in f.args:
@@ -115,7 +143,9 @@ def _body_lines(f: Function, params: list[str]) -> list[str]:
 
 #: Index-dispatched kernels for compiled engines (numba): one self-contained function
 #: per family, selecting a branch by an integer, with no call to another kernel.
-INDEX_ARGS = {"r": "regime index, position in REGIME_NAMES", "k": "flag index, position in FLAGS"}
+INDEX_ARGS = {"r": "regime index, position in REGIME_NAMES", "k": "flag index, position in FLAGS",
+              "j": "auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)",
+              "c": "3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]"}
 
 
 def _index_function_code(name: str, selector: str, branches: list[tuple[str, Function]], doc: str,
@@ -138,7 +168,14 @@ def _index_function_code(name: str, selector: str, branches: list[tuple[str, Fun
 
 
 def _index_functions(spec: SceneSpec, functions: tuple[Function, ...], params: list[str]) -> list[str]:
-    """rhs_index over the regimes and, with flags, surface_index over the flags' surfaces."""
+    """The index-dispatched kernels of a compiled engine:
+
+    - ``rhs_index`` over the regimes;
+    - with flags, ``surface_index`` over the flags' surfaces;
+    - in non-linear scenes, ``aux_index``: the gap rate (micro-hops hidden inside a step)
+      and, with Coulomb friction, the partials of v_r (the Filippov stick mode);
+    - ``power_index`` over (regime, flow): the energy ledger's P_in, D_c, D_f (OUTPUTS[10:13]).
+    """
     if spec.motion == "user":  # its kernels need the user's Python callables: not compilable
         return []
     by_name = {f.name: f for f in functions}
@@ -151,7 +188,26 @@ def _index_functions(spec: SceneSpec, functions: tuple[Function, ...], params: l
         out.append(_index_function_code("surface_index", "k", surfaces,
                                         "Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate "
                                         "or slip by index.", "surface", params))
+    if "gap_rate" in by_name:
+        aux = [("psi_i_dot", by_name["gap_rate"])] + _single_outputs(by_name.get("slip_partials"))
+        out.append(_index_function_code("aux_index", "j", aux,
+                                        "Auxiliary scalars of the hybrid loop by index: the gap rate and, "
+                                        "with Coulomb friction, the partials of v_r.", "auxiliary", params))
+    flows = [pair for n in names for pair in _single_outputs(by_name[f"out_{n}"], OUTPUTS[10:13], f"{n}: ")]
+    out.append(_index_function_code("power_index", "c", flows,
+                                    "Power flows of the energy ledger by index: P_in (cam drive), D_c "
+                                    "(contact damping), D_f (friction) of each regime.", "power", params))
     return out
+
+
+def _single_outputs(f: Function | None, outputs: tuple[str, ...] | None = None,
+                    prefix: str = "") -> list[tuple[str, Function]]:
+    """One single-output Function per output of ``f`` (those named in ``outputs``, or all)."""
+    if f is None:
+        return []
+    wanted = f.outputs if outputs is None else outputs
+    return [(prefix + o, Function(f"{f.name}_{o}", f.args, (o,), (f.exprs[f.outputs.index(o)],), f.doc))
+            for o in wanted]
 
 
 def _pack_code(params: list[str]) -> tuple[str, list[str]]:

@@ -113,7 +113,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -132,8 +133,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -171,30 +173,32 @@ def out_free(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = sin(x8)
-    x15 = Omega_c*e
-    x16 = tan(alpha)
-    x17 = (1/cos(alpha))
-    x18 = Omega_c*t + theta0
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 + e*sin(theta0) - e*sin(x18) + x13*x20
-    x22 = chi0*x20 + e*cos(theta0) - e*cos(x18) + x13*x19
-    return (chi0*x1 - x11*x9 - x2*x5, 2*chi0*x5 + x1*x13 - x11*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*cos(x7), k_s*(L_us + d_x*x16 - d_y - x12*x17), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(alpha + x18), 0, asin(x13/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x12*log(x16 + x17)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = 2*x3
+    x12 = sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = cos(alpha)
+    x18 = 1/x17
+    x19 = x18*sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
+    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -232,31 +236,33 @@ def out_free_v(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = numpy.sin(x8)
-    x15 = Omega_c*e
-    x16 = numpy.tan(alpha)
-    x17 = (numpy.cos(alpha)**(-1.0))
-    x18 = Omega_c*t + theta0
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 + e*numpy.sin(theta0) - e*numpy.sin(x18) + x13*x20
-    x22 = chi0*x20 + e*numpy.cos(theta0) - e*numpy.cos(x18) + x13*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = 2*x3
+    x12 = numpy.sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = numpy.cos(alpha)
+    x18 = x17**(-1.0)
+    x19 = x18*numpy.sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
+    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x11*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x13 - x11*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x16 - d_y - x12*x17) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*numpy.sin(alpha + x18) + _zero, 0 + _zero, numpy.arcsin(x13/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x12*numpy.log(x16 + x17)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_fwd(t, alpha, alpha_dot, p):
@@ -286,22 +292,24 @@ def rhs_contact_fwd(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = -chi0*x2 + 2*x10*x11 + x3*x6
-    x13 = sin(x9)
-    x14 = -1/4*pi*Y_e*l_lambda*x12 + beta_C*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x13*(alpha_dot + x7))*abs(x12)**(1/4)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x14 - x14*(-2*chi0*x6 + chi0 + 2*e*x11*x13 - x2*(r_c + x0)))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = x4*cos(x3)
+    x12 = 2*x11
+    x13 = -chi0*x12 + 2*x10*x9 + x2*x5
+    x14 = 2*x5
+    x15 = sin(x8)
+    x16 = -1/4*pi*Y_e*l_lambda*x13 + beta_C*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x11*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x13)**(1/4)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x16 - x16*(-chi0*x14 + chi0 + 2*e*x10*x15 - x12*(r_c + x1)))/I_Pb
 
 
 def jac_contact_fwd(t, alpha, alpha_dot, p):
@@ -331,46 +339,46 @@ def jac_contact_fwd(t, alpha, alpha_dot, p):
     Y_e = p[14]
     Omega_c = p[15]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = chi0*x18
-    x20 = 2*r_c + w_b
-    x21 = x15**2
-    x22 = x20*x21
-    x23 = x12 - x19 + x22
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
     x24 = (1/4)*pi*Y_e*l_lambda
-    x25 = Omega_c*cos(x7)
-    x26 = alpha_dot + x6
-    x27 = sin(x8)
-    x28 = x16*x20
-    x29 = alpha_dot*chi0*x5 - alpha_dot*x28 + 2*e*x10*x26*x27 - x25*x9
+    x25 = Omega_c*cos(x5)
+    x26 = alpha_dot + x4
+    x27 = sin(x6)
+    x28 = x14*x21
+    x29 = alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7
     x30 = abs(x23)
     x31 = beta_C*x30**(1/4)
     x32 = e*x27
-    x33 = x11*x32
-    x34 = chi0*x5 - x28 + x33
+    x33 = x32*x9
+    x34 = chi0*x20 - x28 + x33
     x35 = (1/2)*alpha_dot
-    x36 = -1/4*beta_C*x29*x34*(0.0 if x23 == 0 else copysign(1, x23))/x30**(3/4) + x24*x34 + x31*(-alpha_dot*x19 + x12*x26 - x14**2*x20*x35 + x22*x35 + x25*x32)
-    x37 = mu_m*x2
-    x38 = chi0 - x17*x21 - x18*x3 + x33
+    x36 = -1/4*beta_C*x29*x34*(0.0 if x23 == 0 else copysign(1, x23))/x30**(3/4) + x24*x34 + x31*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x35 + x22*x35 + x25*x32)
+    x37 = mu_m*x3
+    x38 = -chi0*x19 + chi0 - x15*x17 + x33
     x39 = x31*x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + x36*x37 - x36*x38 - (-x23*x24 + x29*x31)*(x12 - x16*x17 - x3*x5)), x0*(x37*x39 - x38*x39))
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + x36*x37 - x36*x38 - (-x23*x24 + x29*x31)*(x10 - x16 - x17*x20)), x0*(x37*x39 - x38*x39))
 
 
 def out_contact_fwd(t, alpha, alpha_dot, p):
@@ -412,55 +420,58 @@ def out_contact_fwd(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = beta_C*abs(x13)**(1/4)
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x35) + x16*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x34*x36
-    return (x14, x20, x26, x29, x33, x34, x36, -x32*x37 + x34*x38, asin(x16/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x15*log(x43)), alpha_dot*(-d_x*x29 - x15*x34 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47, x46, x47)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = beta_C*abs(x12)**(1/4)
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 + e*sin(theta0) - e*sin(x39) + x18*x42
+    x44 = chi0*x42 + e*cos(theta0) - e*cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2)
+    x49 = x27**2*x35
+    x50 = x38*x40
+    return (x13, x21, x27, x33, x37, x38, x40, x28*x38 - x30*x36, asin(x18/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x45)), alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_fwd_v(t, alpha, alpha_dot, p):
@@ -502,56 +513,59 @@ def out_contact_fwd_v(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = beta_C*abs(x13)**(1/4)
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x35) + x16*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x34*x36
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = beta_C*abs(x12)**(1/4)
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x42
+    x44 = chi0*x42 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2.0)
+    x49 = x27**2*x35
+    x50 = x38*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x33 + _zero, x34 + _zero, x36 + _zero, -x32*x37 + x34*x38 + _zero, numpy.arcsin(x16/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x15*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x29 - x15*x34 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x37 + _zero, x38 + _zero, x40 + _zero, x28*x38 - x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def rhs_contact_bwd(t, alpha, alpha_dot, p):
@@ -581,22 +595,24 @@ def rhs_contact_bwd(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = -chi0*x2 + 2*x10*x11 + x3*x6
-    x13 = sin(x9)
-    x14 = -1/4*pi*Y_e*l_lambda*x12 + beta_C*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x13*(alpha_dot + x7))*abs(x12)**(1/4)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x14 - x14*(-2*chi0*x6 + chi0 + 2*e*x11*x13 - x2*(r_c + x0)))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = x4*cos(x3)
+    x12 = 2*x11
+    x13 = -chi0*x12 + 2*x10*x9 + x2*x5
+    x14 = 2*x5
+    x15 = sin(x8)
+    x16 = -1/4*pi*Y_e*l_lambda*x13 + beta_C*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x11*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x13)**(1/4)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x16 - x16*(-chi0*x14 + chi0 + 2*e*x10*x15 - x12*(r_c + x1)))/I_Pb
 
 
 def jac_contact_bwd(t, alpha, alpha_dot, p):
@@ -626,45 +642,45 @@ def jac_contact_bwd(t, alpha, alpha_dot, p):
     Y_e = p[14]
     Omega_c = p[15]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = chi0*x18
-    x20 = 2*r_c + w_b
-    x21 = x15**2
-    x22 = x20*x21
-    x23 = x12 - x19 + x22
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
     x24 = (1/4)*pi*Y_e*l_lambda
-    x25 = Omega_c*cos(x7)
-    x26 = alpha_dot + x6
-    x27 = sin(x8)
-    x28 = x16*x20
-    x29 = alpha_dot*chi0*x5 - alpha_dot*x28 + 2*e*x10*x26*x27 - x25*x9
+    x25 = Omega_c*cos(x5)
+    x26 = alpha_dot + x4
+    x27 = sin(x6)
+    x28 = x14*x21
+    x29 = alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7
     x30 = abs(x23)
     x31 = beta_C*x30**(1/4)
     x32 = e*x27
-    x33 = x11*x32
-    x34 = chi0*x5 - x28 + x33
+    x33 = x32*x9
+    x34 = chi0*x20 - x28 + x33
     x35 = (1/2)*alpha_dot
-    x36 = -1/4*beta_C*x29*x34*(0.0 if x23 == 0 else copysign(1, x23))/x30**(3/4) + x24*x34 + x31*(-alpha_dot*x19 + x12*x26 - x14**2*x20*x35 + x22*x35 + x25*x32)
-    x37 = chi0 - x17*x21 - x18*x3 + x33
+    x36 = -1/4*beta_C*x29*x34*(0.0 if x23 == 0 else copysign(1, x23))/x30**(3/4) + x24*x34 + x31*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x35 + x22*x35 + x25*x32)
+    x37 = -chi0*x19 + chi0 - x15*x17 + x33
     x38 = x31*x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - 1/2*mu_m*w_b*x36 - x36*x37 - (-x23*x24 + x29*x31)*(x12 - x16*x17 - x3*x5)), x0*(-mu_m*x2*x38 - x37*x38))
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - 1/2*mu_m*w_b*x36 - x36*x37 - (-x23*x24 + x29*x31)*(x10 - x16 - x17*x20)), x0*(-mu_m*x3*x38 - x37*x38))
 
 
 def out_contact_bwd(t, alpha, alpha_dot, p):
@@ -706,55 +722,58 @@ def out_contact_bwd(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = beta_C*abs(x13)**(1/4)
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x35) + x16*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = -x34*x36
-    return (x14, x20, x26, x29, x33, -x34, x36, -x32*x37 - x34*x38, asin(x16/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x15*log(x43)), alpha_dot*(-d_x*x29 + (1/2)*mu_m*w_b*x33 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47, x46, x47)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = beta_C*abs(x12)**(1/4)
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 + e*sin(theta0) - e*sin(x39) + x18*x42
+    x44 = chi0*x42 + e*cos(theta0) - e*cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2)
+    x49 = x27**2*x35
+    x50 = -x38*x40
+    return (x13, x21, x27, x33, x37, -x38, x40, -x28*x38 - x30*x36, asin(x18/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x45)), alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_bwd_v(t, alpha, alpha_dot, p):
@@ -796,56 +815,59 @@ def out_contact_bwd_v(t, alpha, alpha_dot, p):
     beta_C = p[13]
     Y_e = p[14]
     Omega_c = p[15]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = beta_C*abs(x13)**(1/4)
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x35) + x16*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = -x34*x36
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = beta_C*abs(x12)**(1/4)
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x42
+    x44 = chi0*x42 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2.0)
+    x49 = x27**2*x35
+    x50 = -x38*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x33 + _zero, -x34 + _zero, x36 + _zero, -x32*x37 - x34*x38 + _zero, numpy.arcsin(x16/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x15*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x29 + (1/2)*mu_m*w_b*x33 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x37 + _zero, -x38 + _zero, x40 + _zero, -x28*x38 - x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -866,8 +888,10 @@ def gap(t, alpha, alpha_dot, p):
     alpha0 = p[4]
     theta0 = p[5]
     Omega_c = p[15]
-    x0 = (1/2)*Omega_c*t
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Omega_c*t
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -892,7 +916,8 @@ def gap_rate(t, alpha, alpha_dot, p):
     x1 = t*x0
     x2 = alpha + theta0 + x1
     x3 = (1/2)*alpha - 1/2*alpha0
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    x4 = sin(x3)
+    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
 
 
 def slip(t, alpha, alpha_dot, p):
@@ -958,25 +983,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[14]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -1047,7 +1074,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1065,10 +1093,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1094,7 +1123,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1112,22 +1142,24 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_C = p[13]
         Y_e = p[14]
         Omega_c = p[15]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = -chi0*x2 + 2*x10*x11 + x3*x6
-        x13 = sin(x9)
-        x14 = -1/4*pi*Y_e*l_lambda*x12 + beta_C*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x13*(alpha_dot + x7))*abs(x12)**(1/4)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x14 - x14*(-2*chi0*x6 + chi0 + 2*e*x11*x13 - x2*(r_c + x0)))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = x4*cos(x3)
+        x12 = 2*x11
+        x13 = -chi0*x12 + 2*x10*x9 + x2*x5
+        x14 = 2*x5
+        x15 = sin(x8)
+        x16 = -1/4*pi*Y_e*l_lambda*x13 + beta_C*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x11*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x13)**(1/4)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x16 - x16*(-chi0*x14 + chi0 + 2*e*x10*x15 - x12*(r_c + x1)))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1145,22 +1177,24 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_C = p[13]
         Y_e = p[14]
         Omega_c = p[15]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = -chi0*x2 + 2*x10*x11 + x3*x6
-        x13 = sin(x9)
-        x14 = -1/4*pi*Y_e*l_lambda*x12 + beta_C*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x13*(alpha_dot + x7))*abs(x12)**(1/4)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x14 - x14*(-2*chi0*x6 + chi0 + 2*e*x11*x13 - x2*(r_c + x0)))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = x4*cos(x3)
+        x12 = 2*x11
+        x13 = -chi0*x12 + 2*x10*x9 + x2*x5
+        x14 = 2*x5
+        x15 = sin(x8)
+        x16 = -1/4*pi*Y_e*l_lambda*x13 + beta_C*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x11*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x13)**(1/4)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x16 - x16*(-chi0*x14 + chi0 + 2*e*x10*x15 - x12*(r_c + x1)))/I_Pb
     return nan
 
 
@@ -1187,8 +1221,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         alpha0 = p[4]
         theta0 = p[5]
         Omega_c = p[15]
-        x0 = (1/2)*Omega_c*t
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/2)*Omega_c*t
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1196,4 +1232,278 @@ def surface_index(k, t, alpha, alpha_dot, p):
         theta0 = p[5]
         Omega_c = p[15]
         return -Omega_c*e*sin(Omega_c*t + alpha + theta0) - Omega_c*r_c + (1/2)*alpha_dot*w_b
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[15]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    elif j == 1:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[15]
+        return -Omega_c**2*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[15]
+        return -Omega_c*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_fwd: P_in
+        4: contact_fwd: D_c
+        5: contact_fwd: D_f
+        6: contact_bwd: P_in
+        7: contact_bwd: D_c
+        8: contact_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_C = p[13]
+        Y_e = p[14]
+        Omega_c = p[15]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = e*x14
+        x16 = alpha + theta0
+        x17 = x13 + x16
+        x18 = cos(x17)
+        x19 = 2*x18
+        x20 = x10*cos(x9)
+        x21 = 2*x20
+        x22 = -chi0*x21 + x11*x8 + x15*x19
+        x23 = Omega_c*e
+        x24 = x23*cos(x13)
+        x25 = 2*x11
+        x26 = 1 - x25
+        x27 = alpha_dot + x12
+        x28 = sin(x17)
+        x29 = alpha_dot*x8
+        x30 = pi*Y_e*l_lambda
+        x31 = alpha_dot*chi0*x26 + 2*e*x14*x27*x28 - x18*x24 - x20*x29
+        x32 = beta_C*abs(x22)**(1/4)
+        x33 = -1/4*x22*x30 + x31*x32
+        x34 = -mu_m*x33
+        return alpha_dot*(-x33*(-chi0*x25 + chi0 + 2*e*x14*x28 - x21*(r_c + x6)) - x34*x6 - x7*(L_us - d_y - x2*x6 + x4)) + (1/8)*x22*x30*(-2*alpha_dot*chi0*x26 - 4*x15*x27*x28 + x19*x24 + x21*x29) + x31**2*x32 + x34*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x23*sin(Omega_c*t + x16)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_C = p[13]
+        Omega_c = p[15]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        x9 = x2*cos(x1)
+        return beta_C*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)**(1/4)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_C = p[13]
+        Y_e = p[14]
+        Omega_c = p[15]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = x4*cos(x3)
+        x12 = -2*chi0*x11 + 2*e*x10*x9 + x2*x5
+        return mu_m*((1/4)*pi*Y_e*l_lambda*x12 - beta_C*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x12)**(1/4))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_C = p[13]
+        Y_e = p[14]
+        Omega_c = p[15]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = e*x14
+        x16 = alpha + theta0
+        x17 = x13 + x16
+        x18 = cos(x17)
+        x19 = 2*x18
+        x20 = x10*cos(x9)
+        x21 = 2*x20
+        x22 = -chi0*x21 + x11*x8 + x15*x19
+        x23 = Omega_c*e
+        x24 = x23*cos(x13)
+        x25 = 2*x11
+        x26 = 1 - x25
+        x27 = alpha_dot + x12
+        x28 = sin(x17)
+        x29 = alpha_dot*x8
+        x30 = pi*Y_e*l_lambda
+        x31 = alpha_dot*chi0*x26 + 2*e*x14*x27*x28 - x18*x24 - x20*x29
+        x32 = beta_C*abs(x22)**(1/4)
+        x33 = -1/4*x22*x30 + x31*x32
+        x34 = -x33
+        return alpha_dot*((1/2)*mu_m*w_b*x34 - x33*(-chi0*x25 + chi0 + 2*e*x14*x28 - x21*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x34*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x23*sin(Omega_c*t + x16)) + (1/8)*x22*x30*(-2*alpha_dot*chi0*x26 - 4*x15*x27*x28 + x19*x24 + x21*x29) + x31**2*x32 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_C = p[13]
+        Omega_c = p[15]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        x9 = x2*cos(x1)
+        return beta_C*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)**(1/4)
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_C = p[13]
+        Y_e = p[14]
+        Omega_c = p[15]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = x4*cos(x3)
+        x12 = -2*chi0*x11 + 2*e*x10*x9 + x2*x5
+        return -mu_m*((1/4)*pi*Y_e*l_lambda*x12 - beta_C*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x12)**(1/4))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
     return nan

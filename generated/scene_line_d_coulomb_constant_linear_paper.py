@@ -129,17 +129,20 @@ def rhs_contact_fwd(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = (1/2)*w_b
-    x1 = d_x*k_s
-    x2 = mu_m*w_b
-    x3 = alpha_star + theta0
-    x4 = -alpha_star
-    x5 = alpha0 + x4
-    x6 = sin(x5)
-    x7 = cos(x5)
-    x8 = (2*chi_star - x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
-    x9 = pi*Y_e*l_lambda
-    return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 - 1/2*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+    x0 = cos(alpha_star)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha_star)
+    x4 = d_x*k_s
+    x5 = mu_m*w_b
+    x6 = alpha_star + theta0
+    x7 = -alpha_star
+    x8 = alpha0 + x7
+    x9 = sin(x8)
+    x10 = cos(x8)
+    x11 = (2*chi_star - x5)*(2*chi0*x10 + 2*e*cos(x6) + 2*r_c*x9 + w_b*x9)
+    x12 = pi*Y_e*l_lambda
+    return (-1/2*I_Pb*alpha_dot*vartheta*x11*zeta_D/chi_star**2 - 1/4*x12*(chi0 - 1/2*x5)*(-chi0*x9 + e*sin(x6) - e*sin(Omega_c*t + x6) + r_c*x10 - r_c + (1/2)*w_b*x10 - x2) - x4*(L_us + d_x*x1*x3 - d_y - x1*x2) - (alpha + x7)*((1/16)*x11*x12 + (1/2)*x4*(2*d_x - w_b*x3)/x0**2))/I_Pb
 
 
 def jac_contact_fwd(t, alpha, alpha_dot, p):
@@ -217,55 +220,58 @@ def out_contact_fwd(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x35) + x16*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x34*x36
-    return (x14, x20, x26, x29, x33, x34, x36, -x32*x37 + x34*x38, asin(x16/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x15*log(x43)), alpha_dot*(-d_x*x29 - x15*x34 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47, x46, x47)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 + e*sin(theta0) - e*sin(x39) + x18*x42
+    x44 = chi0*x42 + e*cos(theta0) - e*cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2)
+    x49 = x27**2*x35
+    x50 = x38*x40
+    return (x13, x21, x27, x33, x37, x38, x40, x28*x38 - x30*x36, asin(x18/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x45)), alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_fwd_v(t, alpha, alpha_dot, p):
@@ -309,56 +315,59 @@ def out_contact_fwd_v(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x35) + x16*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x34*x36
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x42
+    x44 = chi0*x42 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2.0)
+    x49 = x27**2*x35
+    x50 = x38*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x33 + _zero, x34 + _zero, x36 + _zero, -x32*x37 + x34*x38 + _zero, numpy.arcsin(x16/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x15*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x29 - x15*x34 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x37 + _zero, x38 + _zero, x40 + _zero, x28*x38 - x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def rhs_contact_bwd(t, alpha, alpha_dot, p):
@@ -391,17 +400,20 @@ def rhs_contact_bwd(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = (1/2)*w_b
-    x1 = d_x*k_s
-    x2 = mu_m*w_b
-    x3 = alpha_star + theta0
-    x4 = -alpha_star
-    x5 = alpha0 + x4
-    x6 = sin(x5)
-    x7 = cos(x5)
-    x8 = (2*chi_star + x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
-    x9 = pi*Y_e*l_lambda
-    return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 + (1/2)*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+    x0 = cos(alpha_star)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha_star)
+    x4 = d_x*k_s
+    x5 = mu_m*w_b
+    x6 = alpha_star + theta0
+    x7 = -alpha_star
+    x8 = alpha0 + x7
+    x9 = sin(x8)
+    x10 = cos(x8)
+    x11 = (2*chi_star + x5)*(2*chi0*x10 + 2*e*cos(x6) + 2*r_c*x9 + w_b*x9)
+    x12 = pi*Y_e*l_lambda
+    return (-1/2*I_Pb*alpha_dot*vartheta*x11*zeta_D/chi_star**2 - 1/4*x12*(chi0 + (1/2)*x5)*(-chi0*x9 + e*sin(x6) - e*sin(Omega_c*t + x6) + r_c*x10 - r_c + (1/2)*w_b*x10 - x2) - x4*(L_us + d_x*x1*x3 - d_y - x1*x2) - (alpha + x7)*((1/16)*x11*x12 + (1/2)*x4*(2*d_x - w_b*x3)/x0**2))/I_Pb
 
 
 def jac_contact_bwd(t, alpha, alpha_dot, p):
@@ -479,55 +491,58 @@ def out_contact_bwd(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x35) + x16*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = -x34*x36
-    return (x14, x20, x26, x29, x33, -x34, x36, -x32*x37 - x34*x38, asin(x16/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x15*log(x43)), alpha_dot*(-d_x*x29 + (1/2)*mu_m*w_b*x33 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47, x46, x47)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 + e*sin(theta0) - e*sin(x39) + x18*x42
+    x44 = chi0*x42 + e*cos(theta0) - e*cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2)
+    x49 = x27**2*x35
+    x50 = -x38*x40
+    return (x13, x21, x27, x33, x37, -x38, x40, -x28*x38 - x30*x36, asin(x18/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x45)), alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_bwd_v(t, alpha, alpha_dot, p):
@@ -571,56 +586,59 @@ def out_contact_bwd_v(t, alpha, alpha_dot, p):
     chi_star = p[16]
     vartheta = p[17]
     Omega_c = p[18]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = mu_m*x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x35) + x16*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x35) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = -x34*x36
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = mu_m*x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x42
+    x44 = chi0*x42 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2.0)
+    x49 = x27**2*x35
+    x50 = -x38*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x33 + _zero, -x34 + _zero, x36 + _zero, -x32*x37 - x34*x38 + _zero, numpy.arcsin(x16/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x15*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x29 + (1/2)*mu_m*w_b*x33 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x37 + _zero, -x38 + _zero, x40 + _zero, -x28*x38 - x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def static_moment(alpha, p):
@@ -646,25 +664,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[14]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -735,7 +755,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -753,10 +774,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -794,17 +816,20 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[16]
         vartheta = p[17]
         Omega_c = p[18]
-        x0 = (1/2)*w_b
-        x1 = d_x*k_s
-        x2 = mu_m*w_b
-        x3 = alpha_star + theta0
-        x4 = -alpha_star
-        x5 = alpha0 + x4
-        x6 = sin(x5)
-        x7 = cos(x5)
-        x8 = (2*chi_star - x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
-        x9 = pi*Y_e*l_lambda
-        return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 - 1/2*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+        x0 = cos(alpha_star)
+        x1 = 1/x0
+        x2 = (1/2)*w_b
+        x3 = sin(alpha_star)
+        x4 = d_x*k_s
+        x5 = mu_m*w_b
+        x6 = alpha_star + theta0
+        x7 = -alpha_star
+        x8 = alpha0 + x7
+        x9 = sin(x8)
+        x10 = cos(x8)
+        x11 = (2*chi_star - x5)*(2*chi0*x10 + 2*e*cos(x6) + 2*r_c*x9 + w_b*x9)
+        x12 = pi*Y_e*l_lambda
+        return (-1/2*I_Pb*alpha_dot*vartheta*x11*zeta_D/chi_star**2 - 1/4*x12*(chi0 - 1/2*x5)*(-chi0*x9 + e*sin(x6) - e*sin(Omega_c*t + x6) + r_c*x10 - r_c + (1/2)*w_b*x10 - x2) - x4*(L_us + d_x*x1*x3 - d_y - x1*x2) - (alpha + x7)*((1/16)*x11*x12 + (1/2)*x4*(2*d_x - w_b*x3)/x0**2))/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -825,15 +850,244 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[16]
         vartheta = p[17]
         Omega_c = p[18]
-        x0 = (1/2)*w_b
-        x1 = d_x*k_s
-        x2 = mu_m*w_b
-        x3 = alpha_star + theta0
-        x4 = -alpha_star
-        x5 = alpha0 + x4
-        x6 = sin(x5)
-        x7 = cos(x5)
-        x8 = (2*chi_star + x2)*(2*chi0*x7 + 2*e*cos(x3) + 2*r_c*x6 + w_b*x6)
-        x9 = pi*Y_e*l_lambda
-        return (-1/2*I_Pb*alpha_dot*vartheta*x8*zeta_D/chi_star**2 - x1*(L_us + d_x*tan(alpha_star) - d_y - x0*(1/cos(alpha_star))) - 1/4*x9*(chi0 + (1/2)*x2)*(-chi0*x6 + e*sin(x3) - e*sin(Omega_c*t + x3) + r_c*x7 - r_c + (1/2)*w_b*x7 - x0) - (alpha + x4)*((1/2)*x1*(2*d_x - w_b*sin(alpha_star))/cos(alpha_star)**2 + (1/16)*x8*x9))/I_Pb
+        x0 = cos(alpha_star)
+        x1 = 1/x0
+        x2 = (1/2)*w_b
+        x3 = sin(alpha_star)
+        x4 = d_x*k_s
+        x5 = mu_m*w_b
+        x6 = alpha_star + theta0
+        x7 = -alpha_star
+        x8 = alpha0 + x7
+        x9 = sin(x8)
+        x10 = cos(x8)
+        x11 = (2*chi_star + x5)*(2*chi0*x10 + 2*e*cos(x6) + 2*r_c*x9 + w_b*x9)
+        x12 = pi*Y_e*l_lambda
+        return (-1/2*I_Pb*alpha_dot*vartheta*x11*zeta_D/chi_star**2 - 1/4*x12*(chi0 + (1/2)*x5)*(-chi0*x9 + e*sin(x6) - e*sin(Omega_c*t + x6) + r_c*x10 - r_c + (1/2)*w_b*x10 - x2) - x4*(L_us + d_x*x1*x3 - d_y - x1*x2) - (alpha + x7)*((1/16)*x11*x12 + (1/2)*x4*(2*d_x - w_b*x3)/x0**2))/I_Pb
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: contact_fwd: P_in
+        1: contact_fwd: D_c
+        2: contact_fwd: D_f
+        3: contact_bwd: P_in
+        4: contact_bwd: D_c
+        5: contact_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = x13*cos(x9)
+        x15 = (1/2)*alpha - 1/2*alpha0
+        x16 = sin(x15)
+        x17 = x16**2
+        x18 = 2*x17
+        x19 = 1 - x18
+        x20 = alpha_dot + x8
+        x21 = sin(x9)
+        x22 = sin(x11)
+        x23 = cos(x15)
+        x24 = x16*x23
+        x25 = 2*r_c + w_b
+        x26 = alpha_dot*x25
+        x27 = alpha_dot*chi0*x19 + 2*e*x20*x21*x22 - x12*x14 - x24*x26
+        x28 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x29 = e*x21
+        x30 = 2*x12
+        x31 = -2*chi0*x16*x23 + x17*x25 + x29*x30
+        x32 = 2*x24
+        x33 = pi*Y_e*l_lambda
+        x34 = x27*x28 - 1/4*x31*x33
+        x35 = -mu_m*x34
+        return alpha_dot*(-x34*(-chi0*x18 + chi0 + 2*e*x21*x22 - x32*(r_c + x6)) - x35*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x27**2*x28 + (1/8)*x31*x33*(-2*alpha_dot*chi0*x19 + x14*x30 - 4*x20*x22*x29 + x26*x32) + x35*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 1:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 2:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = x13*cos(x9)
+        x15 = (1/2)*alpha - 1/2*alpha0
+        x16 = sin(x15)
+        x17 = x16**2
+        x18 = 2*x17
+        x19 = 1 - x18
+        x20 = alpha_dot + x8
+        x21 = sin(x9)
+        x22 = sin(x11)
+        x23 = cos(x15)
+        x24 = x16*x23
+        x25 = 2*r_c + w_b
+        x26 = alpha_dot*x25
+        x27 = alpha_dot*chi0*x19 + 2*e*x20*x21*x22 - x12*x14 - x24*x26
+        x28 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x29 = e*x21
+        x30 = 2*x12
+        x31 = -2*chi0*x16*x23 + x17*x25 + x29*x30
+        x32 = 2*x24
+        x33 = pi*Y_e*l_lambda
+        x34 = x27*x28 - 1/4*x31*x33
+        x35 = -x34
+        return alpha_dot*((1/2)*mu_m*w_b*x35 - x34*(-chi0*x18 + chi0 + 2*e*x21*x22 - x32*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x35*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x27**2*x28 + (1/8)*x31*x33*(-2*alpha_dot*chi0*x19 + x14*x30 - 4*x20*x22*x29 + x26*x32) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[14]
+        chi_star = p[16]
+        vartheta = p[17]
+        Omega_c = p[18]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        return -mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
     return nan

@@ -125,7 +125,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -144,8 +145,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -184,32 +186,34 @@ def out_free(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = 2*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = sin(x9)
-    x16 = Theta_p*omega_c*cos(x6)
-    x17 = (1/2)*x16
-    x18 = tan(alpha)
-    x19 = (1/cos(alpha))
-    x20 = theta0 + (1/2)*x7
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (chi0*x1 - x10*x12 - x2*x5, 2*chi0*x5 - e*x12*x15 + x1*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x11*x15*(alpha_dot + (1/4)*x16) - x10*x17*cos(x8), k_s*(L_us + d_x*x18 - d_y - x13*x19), 0, 0, (1/2)*alpha_dot*w_b - e*x17*sin(alpha + x20) - r_c*x17, 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x13*log(x18 + x19)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = 2*x10
+    x12 = 2*x3
+    x13 = sin(x8)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_p*omega_c*cos(x5)
+    x18 = (1/2)*x17
+    x19 = cos(alpha)
+    x20 = 1/x19
+    x21 = x20*sin(alpha)
+    x22 = theta0 + (1/2)*x6
+    x23 = sin(alpha0)
+    x24 = cos(alpha0)
+    x25 = -chi0*x23 + e*sin(theta0) - e*sin(x22) + x15*x24
+    x26 = chi0*x24 + e*cos(theta0) - e*cos(x22) + x15*x23
+    return (2*chi0*x2*x4 - x0*x3 - x11*x9, chi0*x12 - e*x11*x13 + 2*x15*x16, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*(alpha_dot + (1/4)*x17) - x18*x9*cos(x7), k_s*(L_us + d_x*x21 - d_y - x14*x20), 0, 0, (1/2)*alpha_dot*w_b - e*x18*sin(alpha + x22) - r_c*x18, 0, asin(x15/sqrt(x25**2 + x26**2)) - atan2(x25, x26), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x19) - x14*log(x20 + x21)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -248,33 +252,35 @@ def out_free_v(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = 2*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = numpy.sin(x9)
-    x16 = Theta_p*omega_c*numpy.cos(x6)
-    x17 = (1/2)*x16
-    x18 = numpy.tan(alpha)
-    x19 = (numpy.cos(alpha)**(-1.0))
-    x20 = theta0 + (1/2)*x7
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = 2*x10
+    x12 = 2*x3
+    x13 = numpy.sin(x8)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_p*omega_c*numpy.cos(x5)
+    x18 = (1/2)*x17
+    x19 = numpy.cos(alpha)
+    x20 = x19**(-1.0)
+    x21 = x20*numpy.sin(alpha)
+    x22 = theta0 + (1/2)*x6
+    x23 = numpy.sin(alpha0)
+    x24 = numpy.cos(alpha0)
+    x25 = -chi0*x23 + e*numpy.sin(theta0) - e*numpy.sin(x22) + x15*x24
+    x26 = chi0*x24 + e*numpy.cos(theta0) - e*numpy.cos(x22) + x15*x23
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x10*x12 - x2*x5 + _zero, 2*chi0*x5 - e*x12*x15 + x1*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x11*x15*(alpha_dot + (1/4)*x16) - x10*x17*numpy.cos(x8) + _zero, k_s*(L_us + d_x*x18 - d_y - x13*x19) + _zero, 0 + _zero, 0 + _zero, (1/2)*alpha_dot*w_b - e*x17*numpy.sin(alpha + x20) - r_c*x17 + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x11*x9 + _zero, chi0*x12 - e*x11*x13 + 2*x15*x16 + _zero, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*(alpha_dot + (1/4)*x17) - x18*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x21 - d_y - x14*x20) + _zero, 0 + _zero, 0 + _zero, (1/2)*alpha_dot*w_b - e*x18*numpy.sin(alpha + x22) - r_c*x18 + _zero, 0 + _zero, numpy.arcsin(x15/numpy.sqrt(x25**2 + x26**2)) - numpy.arctan2(x25, x26) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x19) - x14*numpy.log(x20 + x21)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -305,25 +311,27 @@ def rhs_contact_loading_fwd(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = omega_c*t
     x8 = (1/4)*Theta_p
     x9 = x8*sin(x7)
     x10 = alpha + theta0 + x9
     x11 = e*cos(x10)
     x12 = sin(x9)
-    x13 = -chi0*x2 + 2*x11*x12 + x3*x6
+    x13 = -2*chi0*x4*x6 + 2*x11*x12 + x2*x5
     x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = omega_c*cos(x7)
-    x16 = sin(x10)
-    x17 = beta_D*x14*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x15*x8))*abs(x13) - x13*x14
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x17 - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+    x15 = 2*x5
+    x16 = x4*x6
+    x17 = omega_c*cos(x7)
+    x18 = sin(x10)
+    x19 = beta_D*x14*(-1/2*Theta_p*x11*x17*cos(x9) + alpha_dot*chi0*(1 - x15) - alpha_dot*x16*x2 + 2*e*x12*x18*(alpha_dot + x17*x8))*abs(x13) - x13*x14
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x19 - x19*(-chi0*x15 + chi0 + 2*e*x12*x18 - 2*x16*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -354,47 +362,48 @@ def jac_contact_loading_fwd(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
     x5 = cos(x4)
-    x6 = (1/2)*alpha - 1/2*alpha0
-    x7 = cos(x6)
-    x8 = sin(x6)
-    x9 = x7*x8
-    x10 = 2*chi0
-    x11 = omega_c*t
-    x12 = (1/4)*Theta_p
-    x13 = x12*sin(x11)
-    x14 = alpha + theta0 + x13
-    x15 = e*cos(x14)
-    x16 = sin(x13)
-    x17 = 2*x16
-    x18 = x15*x17
-    x19 = sin(x4)
-    x20 = 2*r_c + w_b
-    x21 = x8**2
-    x22 = x20*x21
-    x23 = -chi0*x19 + x18 + x22
-    x24 = pi*Y_e*l_lambda
-    x25 = (1/4)*x24
-    x26 = x20*x9
-    x27 = omega_c*cos(x11)
-    x28 = (1/2)*Theta_p*x27*cos(x13)
-    x29 = alpha_dot + x12*x27
-    x30 = sin(x14)
-    x31 = alpha_dot*chi0*x5 - alpha_dot*x26 + 2*e*x16*x29*x30 - x15*x28
-    x32 = beta_D*abs(x23)
-    x33 = x25*x32
-    x34 = e*x30
-    x35 = x17*x34
-    x36 = chi0*x5 - x26 + x35
-    x37 = x25*x36
-    x38 = (1/2)*alpha_dot
-    x39 = -beta_D*x25*x31*x36*(0.0 if x23 == 0 else copysign(1, x23)) + x33*(-alpha_dot*chi0*x19 + x18*x29 - x20*x38*x7**2 + x22*x38 + x28*x34) + x37
-    x40 = chi0 - x10*x21 - x19*x3 + x35
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x39 - x39*x40 - (-x23*x25 + x31*x33)*(-x10*x9 + x18 - x3*x5)), x0*((1/8)*mu_m*w_b*x24*x32*x36 - x32*x37*x40))
+    x6 = sin(x4)
+    x7 = x5*x6
+    x8 = 2*x7
+    x9 = chi0*x8
+    x10 = r_c + x3
+    x11 = x6**2
+    x12 = 2*x11
+    x13 = 1 - x12
+    x14 = omega_c*t
+    x15 = (1/4)*Theta_p
+    x16 = x15*sin(x14)
+    x17 = alpha + theta0 + x16
+    x18 = e*cos(x17)
+    x19 = sin(x16)
+    x20 = 2*x19
+    x21 = x18*x20
+    x22 = 2*r_c + w_b
+    x23 = x11*x22
+    x24 = x21 + x23 - x9
+    x25 = pi*Y_e*l_lambda
+    x26 = (1/4)*x25
+    x27 = x22*x7
+    x28 = omega_c*cos(x14)
+    x29 = (1/2)*Theta_p*x28*cos(x16)
+    x30 = alpha_dot + x15*x28
+    x31 = sin(x17)
+    x32 = alpha_dot*chi0*x13 - alpha_dot*x27 + 2*e*x19*x30*x31 - x18*x29
+    x33 = beta_D*abs(x24)
+    x34 = x26*x33
+    x35 = e*x31
+    x36 = x20*x35
+    x37 = chi0*x13 - x27 + x36
+    x38 = x26*x37
+    x39 = (1/2)*alpha_dot
+    x40 = -beta_D*x26*x32*x37*(0.0 if x24 == 0 else copysign(1, x24)) + x34*(-alpha_dot*x9 + x21*x30 - x22*x39*x5**2 + x23*x39 + x29*x35) + x38
+    x41 = -chi0*x12 + chi0 - x10*x8 + x36
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x40 - x40*x41 - (-x24*x26 + x32*x34)*(-x10*x13 + x21 - x9)), x0*((1/8)*mu_m*w_b*x25*x33*x37 - x33*x38*x41))
 
 
 def out_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -437,60 +446,62 @@ def out_contact_loading_fwd(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = mu_m*x38
-    x40 = theta0 + (1/2)*x7
-    x41 = e*sin(alpha + x40)
-    x42 = sin(alpha)
-    x43 = cos(alpha)
-    x44 = sin(alpha0)
-    x45 = cos(alpha0)
-    x46 = -chi0*x44 + e*sin(theta0) - e*sin(x40) + x18*x45
-    x47 = chi0*x45 + e*cos(theta0) - e*cos(x40) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x36
-    x52 = x39*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x41)
-    return (x16, x21, x30, x33, x38, x39, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x41), -x37*x42 + x39*x43, asin(x18/sqrt(x46**2 + x47**2)) - atan2(x46, x47), (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*log(x43) - x17*log(x48)), alpha_dot*(-d_x*x33 - x17*x39 - x37*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52, x51, x52)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = mu_m*x41
+    x43 = theta0 + (1/2)*x6
+    x44 = e*sin(alpha + x43)
+    x45 = sin(alpha0)
+    x46 = cos(alpha0)
+    x47 = -chi0*x45 + e*sin(theta0) - e*sin(x43) + x19*x46
+    x48 = chi0*x46 + e*cos(theta0) - e*cos(x43) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2)
+    x53 = x30**2*x39
+    x54 = x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x44)
+    return (x15, x22, x30, x36, x41, x42, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x44), x31*x42 - x33*x40, asin(x19/sqrt(x47**2 + x48**2)) - atan2(x47, x48), (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x49)), alpha_dot*(-d_x*x36 - x18*x42 - x40*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54, x53, x54)
 
 
 def out_contact_loading_fwd_v(t, alpha, alpha_dot, p):
@@ -533,61 +544,63 @@ def out_contact_loading_fwd_v(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = mu_m*x38
-    x40 = theta0 + (1/2)*x7
-    x41 = e*numpy.sin(alpha + x40)
-    x42 = numpy.sin(alpha)
-    x43 = numpy.cos(alpha)
-    x44 = numpy.sin(alpha0)
-    x45 = numpy.cos(alpha0)
-    x46 = -chi0*x44 + e*numpy.sin(theta0) - e*numpy.sin(x40) + x18*x45
-    x47 = chi0*x45 + e*numpy.cos(theta0) - e*numpy.cos(x40) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x36
-    x52 = x39*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x41)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = mu_m*x41
+    x43 = theta0 + (1/2)*x6
+    x44 = e*numpy.sin(alpha + x43)
+    x45 = numpy.sin(alpha0)
+    x46 = numpy.cos(alpha0)
+    x47 = -chi0*x45 + e*numpy.sin(theta0) - e*numpy.sin(x43) + x19*x46
+    x48 = chi0*x46 + e*numpy.cos(theta0) - e*numpy.cos(x43) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2.0)
+    x53 = x30**2*x39
+    x54 = x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x44)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x38 + _zero, x39 + _zero, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x41) + _zero, -x37*x42 + x39*x43 + _zero, numpy.arcsin(x18/numpy.sqrt(x46**2 + x47**2)) - numpy.arctan2(x46, x47) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*numpy.log(x43) - x17*numpy.log(x48)) + _zero, alpha_dot*(-d_x*x33 - x17*x39 - x37*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52 + _zero, x51 + _zero, x52 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x41 + _zero, x42 + _zero, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x44) + _zero, x31*x42 - x33*x40 + _zero, numpy.arcsin(x19/numpy.sqrt(x47**2 + x48**2)) - numpy.arctan2(x47, x48) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x49)) + _zero, alpha_dot*(-d_x*x36 - x18*x42 - x40*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54 + _zero, x53 + _zero, x54 + _zero)
 
 
 def rhs_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -618,25 +631,27 @@ def rhs_contact_loading_bwd(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = omega_c*t
     x8 = (1/4)*Theta_p
     x9 = x8*sin(x7)
     x10 = alpha + theta0 + x9
     x11 = e*cos(x10)
     x12 = sin(x9)
-    x13 = -chi0*x2 + 2*x11*x12 + x3*x6
+    x13 = -2*chi0*x4*x6 + 2*x11*x12 + x2*x5
     x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = omega_c*cos(x7)
-    x16 = sin(x10)
-    x17 = beta_D*x14*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x15*x8))*abs(x13) - x13*x14
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x17 - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+    x15 = 2*x5
+    x16 = x4*x6
+    x17 = omega_c*cos(x7)
+    x18 = sin(x10)
+    x19 = beta_D*x14*(-1/2*Theta_p*x11*x17*cos(x9) + alpha_dot*chi0*(1 - x15) - alpha_dot*x16*x2 + 2*e*x12*x18*(alpha_dot + x17*x8))*abs(x13) - x13*x14
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x19 - x19*(-chi0*x15 + chi0 + 2*e*x12*x18 - 2*x16*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -667,47 +682,48 @@ def jac_contact_loading_bwd(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
     x5 = cos(x4)
-    x6 = (1/2)*alpha - 1/2*alpha0
-    x7 = cos(x6)
-    x8 = sin(x6)
-    x9 = x7*x8
-    x10 = 2*chi0
-    x11 = omega_c*t
-    x12 = (1/4)*Theta_p
-    x13 = x12*sin(x11)
-    x14 = alpha + theta0 + x13
-    x15 = e*cos(x14)
-    x16 = sin(x13)
-    x17 = 2*x16
-    x18 = x15*x17
-    x19 = sin(x4)
-    x20 = 2*r_c + w_b
-    x21 = x8**2
-    x22 = x20*x21
-    x23 = -chi0*x19 + x18 + x22
-    x24 = pi*Y_e*l_lambda
-    x25 = (1/4)*x24
-    x26 = x20*x9
-    x27 = omega_c*cos(x11)
-    x28 = (1/2)*Theta_p*x27*cos(x13)
-    x29 = alpha_dot + x12*x27
-    x30 = sin(x14)
-    x31 = alpha_dot*chi0*x5 - alpha_dot*x26 + 2*e*x16*x29*x30 - x15*x28
-    x32 = beta_D*abs(x23)
-    x33 = x25*x32
-    x34 = e*x30
-    x35 = x17*x34
-    x36 = chi0*x5 - x26 + x35
-    x37 = x25*x36
-    x38 = (1/2)*alpha_dot
-    x39 = -beta_D*x25*x31*x36*(0.0 if x23 == 0 else copysign(1, x23)) + x33*(-alpha_dot*chi0*x19 + x18*x29 - x20*x38*x7**2 + x22*x38 + x28*x34) + x37
-    x40 = chi0 - x10*x21 - x19*x3 + x35
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - 1/2*mu_m*w_b*x39 - x39*x40 - (-x23*x25 + x31*x33)*(-x10*x9 + x18 - x3*x5)), x0*(-1/8*mu_m*w_b*x24*x32*x36 - x32*x37*x40))
+    x6 = sin(x4)
+    x7 = x5*x6
+    x8 = 2*x7
+    x9 = chi0*x8
+    x10 = r_c + x3
+    x11 = x6**2
+    x12 = 2*x11
+    x13 = 1 - x12
+    x14 = omega_c*t
+    x15 = (1/4)*Theta_p
+    x16 = x15*sin(x14)
+    x17 = alpha + theta0 + x16
+    x18 = e*cos(x17)
+    x19 = sin(x16)
+    x20 = 2*x19
+    x21 = x18*x20
+    x22 = 2*r_c + w_b
+    x23 = x11*x22
+    x24 = x21 + x23 - x9
+    x25 = pi*Y_e*l_lambda
+    x26 = (1/4)*x25
+    x27 = x22*x7
+    x28 = omega_c*cos(x14)
+    x29 = (1/2)*Theta_p*x28*cos(x16)
+    x30 = alpha_dot + x15*x28
+    x31 = sin(x17)
+    x32 = alpha_dot*chi0*x13 - alpha_dot*x27 + 2*e*x19*x30*x31 - x18*x29
+    x33 = beta_D*abs(x24)
+    x34 = x26*x33
+    x35 = e*x31
+    x36 = x20*x35
+    x37 = chi0*x13 - x27 + x36
+    x38 = x26*x37
+    x39 = (1/2)*alpha_dot
+    x40 = -beta_D*x26*x32*x37*(0.0 if x24 == 0 else copysign(1, x24)) + x34*(-alpha_dot*x9 + x21*x30 - x22*x39*x5**2 + x23*x39 + x29*x35) + x38
+    x41 = -chi0*x12 + chi0 - x10*x8 + x36
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - 1/2*mu_m*w_b*x40 - x40*x41 - (-x24*x26 + x32*x34)*(-x10*x13 + x21 - x9)), x0*(-1/8*mu_m*w_b*x25*x33*x37 - x33*x38*x41))
 
 
 def out_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -750,60 +766,62 @@ def out_contact_loading_bwd(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = mu_m*x38
-    x40 = theta0 + (1/2)*x7
-    x41 = e*sin(alpha + x40)
-    x42 = sin(alpha)
-    x43 = cos(alpha)
-    x44 = sin(alpha0)
-    x45 = cos(alpha0)
-    x46 = -chi0*x44 + e*sin(theta0) - e*sin(x40) + x18*x45
-    x47 = chi0*x45 + e*cos(theta0) - e*cos(x40) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x36
-    x52 = -x39*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x41)
-    return (x16, x21, x30, x33, x38, -x39, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x41), -x37*x42 - x39*x43, asin(x18/sqrt(x46**2 + x47**2)) - atan2(x46, x47), (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*log(x43) - x17*log(x48)), alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x38 - x37*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52, x51, x52)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = mu_m*x41
+    x43 = theta0 + (1/2)*x6
+    x44 = e*sin(alpha + x43)
+    x45 = sin(alpha0)
+    x46 = cos(alpha0)
+    x47 = -chi0*x45 + e*sin(theta0) - e*sin(x43) + x19*x46
+    x48 = chi0*x46 + e*cos(theta0) - e*cos(x43) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2)
+    x53 = x30**2*x39
+    x54 = -x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x44)
+    return (x15, x22, x30, x36, x41, -x42, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x44), -x31*x42 - x33*x40, asin(x19/sqrt(x47**2 + x48**2)) - atan2(x47, x48), (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x49)), alpha_dot*(-d_x*x36 + (1/2)*mu_m*w_b*x41 - x40*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54, x53, x54)
 
 
 def out_contact_loading_bwd_v(t, alpha, alpha_dot, p):
@@ -846,61 +864,63 @@ def out_contact_loading_bwd_v(t, alpha, alpha_dot, p):
     Y_e = p[15]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = mu_m*x38
-    x40 = theta0 + (1/2)*x7
-    x41 = e*numpy.sin(alpha + x40)
-    x42 = numpy.sin(alpha)
-    x43 = numpy.cos(alpha)
-    x44 = numpy.sin(alpha0)
-    x45 = numpy.cos(alpha0)
-    x46 = -chi0*x44 + e*numpy.sin(theta0) - e*numpy.sin(x40) + x18*x45
-    x47 = chi0*x45 + e*numpy.cos(theta0) - e*numpy.cos(x40) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x36
-    x52 = -x39*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x41)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = mu_m*x41
+    x43 = theta0 + (1/2)*x6
+    x44 = e*numpy.sin(alpha + x43)
+    x45 = numpy.sin(alpha0)
+    x46 = numpy.cos(alpha0)
+    x47 = -chi0*x45 + e*numpy.sin(theta0) - e*numpy.sin(x43) + x19*x46
+    x48 = chi0*x46 + e*numpy.cos(theta0) - e*numpy.cos(x43) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2.0)
+    x53 = x30**2*x39
+    x54 = -x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x44)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x38 + _zero, -x39 + _zero, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x41) + _zero, -x37*x42 - x39*x43 + _zero, numpy.arcsin(x18/numpy.sqrt(x46**2 + x47**2)) - numpy.arctan2(x46, x47) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*numpy.log(x43) - x17*numpy.log(x48)) + _zero, alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x38 - x37*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52 + _zero, x51 + _zero, x52 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x41 + _zero, -x42 + _zero, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x44) + _zero, -x31*x42 - x33*x40 + _zero, numpy.arcsin(x19/numpy.sqrt(x47**2 + x48**2)) - numpy.arctan2(x47, x48) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x49)) + _zero, alpha_dot*(-d_x*x36 + (1/2)*mu_m*w_b*x41 - x40*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54 + _zero, x53 + _zero, x54 + _zero)
 
 
 def rhs_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -933,23 +953,25 @@ def rhs_contact_unloading_fwd(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = omega_c*t
     x8 = (1/4)*Theta_p
     x9 = x8*sin(x7)
     x10 = alpha + theta0 + x9
     x11 = e*cos(x10)
     x12 = sin(x9)
-    x13 = omega_c*cos(x7)
-    x14 = sin(x10)
-    x15 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x13*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x13*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*x11*x12 - x3*x6)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+    x13 = 2*x5
+    x14 = x4*x6
+    x15 = omega_c*cos(x7)
+    x16 = sin(x10)
+    x17 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*(1 - x13) - alpha_dot*x14*x2 + 2*e*x12*x16*(alpha_dot + x15*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x4*x6 - 2*x11*x12 - x2*x5)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17 - x17*(-chi0*x13 + chi0 + 2*e*x12*x16 - 2*x14*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -982,42 +1004,43 @@ def jac_contact_unloading_fwd(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = alpha - alpha0
-    x4 = cos(x3)
-    x5 = omega_c*t
-    x6 = (1/4)*Theta_p
-    x7 = x6*sin(x5)
-    x8 = alpha + theta0 + x7
-    x9 = sin(x8)
-    x10 = e*x9
-    x11 = sin(x7)
-    x12 = 2*x11
-    x13 = 2*r_c + w_b
-    x14 = (1/2)*alpha - 1/2*alpha0
-    x15 = cos(x14)
-    x16 = sin(x14)
-    x17 = x15*x16
-    x18 = x13*x17
-    x19 = chi0*x4 + x10*x12 - x18
-    x20 = (1/4)*pi*Y_e*l_lambda
-    x21 = sin(x3)
-    x22 = x16**2
-    x23 = x13*x22
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
+    x5 = sin(x4)
+    x6 = x5**2
+    x7 = 2*x6
+    x8 = 1 - x7
+    x9 = omega_c*t
+    x10 = (1/4)*Theta_p
+    x11 = x10*sin(x9)
+    x12 = alpha + theta0 + x11
+    x13 = sin(x12)
+    x14 = e*x13
+    x15 = sin(x11)
+    x16 = 2*x15
+    x17 = 2*r_c + w_b
+    x18 = cos(x4)
+    x19 = x18*x5
+    x20 = x17*x19
+    x21 = chi0*x8 + x14*x16 - x20
+    x22 = (1/4)*pi*Y_e*l_lambda
+    x23 = x17*x6
     x24 = (1/2)*alpha_dot
-    x25 = omega_c*cos(x5)
-    x26 = (1/2)*Theta_p*x25*cos(x7)
-    x27 = alpha_dot + x25*x6
-    x28 = e*cos(x8)
-    x29 = x12*x28
-    x30 = I_Pb*vartheta*zeta_D/chi_star**2
-    x31 = 2*x30
-    x32 = x19*x20 + x31*(-alpha_dot*chi0*x21 + x10*x26 - x13*x15**2*x24 + x23*x24 + x27*x29)
-    x33 = r_c + x2
-    x34 = 2*chi0
-    x35 = chi0 + 2*e*x11*x9 - x21*x33 - x22*x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x32 - x32*x35 - (x20*(chi0*x21 - x23 - x29) + x31*(alpha_dot*chi0*x4 - alpha_dot*x18 + 2*e*x11*x27*x9 - x26*x28))*(-x17*x34 + x29 - x33*x4)), x0*(mu_m*w_b*x19*x30 - x19*x31*x35))
+    x25 = 2*x19
+    x26 = chi0*x25
+    x27 = omega_c*cos(x9)
+    x28 = (1/2)*Theta_p*x27*cos(x11)
+    x29 = alpha_dot + x10*x27
+    x30 = e*cos(x12)
+    x31 = x16*x30
+    x32 = I_Pb*vartheta*zeta_D/chi_star**2
+    x33 = 2*x32
+    x34 = x21*x22 + x33*(-alpha_dot*x26 + x14*x28 - x17*x18**2*x24 + x23*x24 + x29*x31)
+    x35 = r_c + x3
+    x36 = -chi0*x7 + chi0 + 2*e*x13*x15 - x25*x35
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x34 - x34*x36 - (x22*(-x23 + x26 - x31) + x33*(alpha_dot*chi0*x8 - alpha_dot*x20 + 2*e*x13*x15*x29 - x28*x30))*(-x26 + x31 - x35*x8)), x0*(mu_m*w_b*x21*x32 - x21*x33*x36))
 
 
 def out_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -1062,59 +1085,61 @@ def out_contact_unloading_fwd(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = mu_m*x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*sin(alpha + x39)
-    x41 = sin(alpha)
-    x42 = cos(alpha)
-    x43 = sin(alpha0)
-    x44 = cos(alpha0)
-    x45 = -chi0*x43 + e*sin(theta0) - e*sin(x39) + x18*x44
-    x46 = chi0*x44 + e*cos(theta0) - e*cos(x39) + x18*x43
-    x47 = x31 + x32
-    x48 = d_x*k_s
-    x49 = (1/8)*x34
-    x50 = x30**2*x35
-    x51 = x38*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
-    return (x16, x21, x30, x33, x37, x38, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40), -x36*x41 + x38*x42, asin(x18/sqrt(x45**2 + x46**2)) - atan2(x45, x46), (1/2)*I_Pb*alpha_dot**2 + x15**2*x49 + x48*(L_us*alpha - alpha*d_y - d_x*log(x42) - x17*log(x47)), alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x15*x49*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x48*(L_us*alpha_dot + alpha_dot*d_x*x41/x42 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x47) + x50 + x51, x50, x51)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = mu_m*x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*sin(alpha + x42)
+    x44 = sin(alpha0)
+    x45 = cos(alpha0)
+    x46 = -chi0*x44 + e*sin(theta0) - e*sin(x42) + x19*x45
+    x47 = chi0*x45 + e*cos(theta0) - e*cos(x42) + x19*x44
+    x48 = x32 + x34
+    x49 = d_x*k_s
+    x50 = (1/8)*x37
+    x51 = x31**(-2)
+    x52 = x30**2*x38
+    x53 = x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
+    return (x15, x22, x30, x36, x40, x41, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43), x31*x41 - x33*x39, asin(x19/sqrt(x46**2 + x47**2)) - atan2(x46, x47), (1/2)*I_Pb*alpha_dot**2 + x14**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x48)), alpha_dot*(-d_x*x36 - x18*x41 - x39*(chi0 - x22)) + x14*x50*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x49*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x51 + alpha_dot*(x33**2*x51 + 1))/x48) + x52 + x53, x52, x53)
 
 
 def out_contact_unloading_fwd_v(t, alpha, alpha_dot, p):
@@ -1159,60 +1184,62 @@ def out_contact_unloading_fwd_v(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = mu_m*x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*numpy.sin(alpha + x39)
-    x41 = numpy.sin(alpha)
-    x42 = numpy.cos(alpha)
-    x43 = numpy.sin(alpha0)
-    x44 = numpy.cos(alpha0)
-    x45 = -chi0*x43 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x44
-    x46 = chi0*x44 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x43
-    x47 = x31 + x32
-    x48 = d_x*k_s
-    x49 = (1/8)*x34
-    x50 = x30**2*x35
-    x51 = x38*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = mu_m*x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*numpy.sin(alpha + x42)
+    x44 = numpy.sin(alpha0)
+    x45 = numpy.cos(alpha0)
+    x46 = -chi0*x44 + e*numpy.sin(theta0) - e*numpy.sin(x42) + x19*x45
+    x47 = chi0*x45 + e*numpy.cos(theta0) - e*numpy.cos(x42) + x19*x44
+    x48 = x32 + x34
+    x49 = d_x*k_s
+    x50 = (1/8)*x37
+    x51 = x31**(-2.0)
+    x52 = x30**2*x38
+    x53 = x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x37 + _zero, x38 + _zero, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40) + _zero, -x36*x41 + x38*x42 + _zero, numpy.arcsin(x18/numpy.sqrt(x45**2 + x46**2)) - numpy.arctan2(x45, x46) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x49 + x48*(L_us*alpha - alpha*d_y - d_x*numpy.log(x42) - x17*numpy.log(x47)) + _zero, alpha_dot*(-d_x*x33 - x17*x38 - x36*(chi0 - x21)) + x15*x49*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x48*(L_us*alpha_dot + alpha_dot*d_x*x41/x42 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x47) + x50 + x51 + _zero, x50 + _zero, x51 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x40 + _zero, x41 + _zero, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43) + _zero, x31*x41 - x33*x39 + _zero, numpy.arcsin(x19/numpy.sqrt(x46**2 + x47**2)) - numpy.arctan2(x46, x47) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x48)) + _zero, alpha_dot*(-d_x*x36 - x18*x41 - x39*(chi0 - x22)) + x14*x50*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x49*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x51 + alpha_dot*(x33**2*x51 + 1))/x48) + x52 + x53 + _zero, x52 + _zero, x53 + _zero)
 
 
 def rhs_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1245,23 +1272,25 @@ def rhs_contact_unloading_bwd(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = omega_c*t
     x8 = (1/4)*Theta_p
     x9 = x8*sin(x7)
     x10 = alpha + theta0 + x9
     x11 = e*cos(x10)
     x12 = sin(x9)
-    x13 = omega_c*cos(x7)
-    x14 = sin(x10)
-    x15 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x13*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x13*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*x11*x12 - x3*x6)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+    x13 = 2*x5
+    x14 = x4*x6
+    x15 = omega_c*cos(x7)
+    x16 = sin(x10)
+    x17 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*(1 - x13) - alpha_dot*x14*x2 + 2*e*x12*x16*(alpha_dot + x15*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x4*x6 - 2*x11*x12 - x2*x5)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x17 - x17*(-chi0*x13 + chi0 + 2*e*x12*x16 - 2*x14*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1294,42 +1323,43 @@ def jac_contact_unloading_bwd(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = alpha - alpha0
-    x4 = cos(x3)
-    x5 = omega_c*t
-    x6 = (1/4)*Theta_p
-    x7 = x6*sin(x5)
-    x8 = alpha + theta0 + x7
-    x9 = sin(x8)
-    x10 = e*x9
-    x11 = sin(x7)
-    x12 = 2*x11
-    x13 = 2*r_c + w_b
-    x14 = (1/2)*alpha - 1/2*alpha0
-    x15 = cos(x14)
-    x16 = sin(x14)
-    x17 = x15*x16
-    x18 = x13*x17
-    x19 = chi0*x4 + x10*x12 - x18
-    x20 = (1/4)*pi*Y_e*l_lambda
-    x21 = sin(x3)
-    x22 = x16**2
-    x23 = x13*x22
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
+    x5 = sin(x4)
+    x6 = x5**2
+    x7 = 2*x6
+    x8 = 1 - x7
+    x9 = omega_c*t
+    x10 = (1/4)*Theta_p
+    x11 = x10*sin(x9)
+    x12 = alpha + theta0 + x11
+    x13 = sin(x12)
+    x14 = e*x13
+    x15 = sin(x11)
+    x16 = 2*x15
+    x17 = 2*r_c + w_b
+    x18 = cos(x4)
+    x19 = x18*x5
+    x20 = x17*x19
+    x21 = chi0*x8 + x14*x16 - x20
+    x22 = (1/4)*pi*Y_e*l_lambda
+    x23 = x17*x6
     x24 = (1/2)*alpha_dot
-    x25 = omega_c*cos(x5)
-    x26 = (1/2)*Theta_p*x25*cos(x7)
-    x27 = alpha_dot + x25*x6
-    x28 = e*cos(x8)
-    x29 = x12*x28
-    x30 = I_Pb*vartheta*zeta_D/chi_star**2
-    x31 = 2*x30
-    x32 = x19*x20 + x31*(-alpha_dot*chi0*x21 + x10*x26 - x13*x15**2*x24 + x23*x24 + x27*x29)
-    x33 = r_c + x2
-    x34 = 2*chi0
-    x35 = chi0 + 2*e*x11*x9 - x21*x33 - x22*x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - 1/2*mu_m*w_b*x32 - x32*x35 - (x20*(chi0*x21 - x23 - x29) + x31*(alpha_dot*chi0*x4 - alpha_dot*x18 + 2*e*x11*x27*x9 - x26*x28))*(-x17*x34 + x29 - x33*x4)), x0*(-mu_m*w_b*x19*x30 - x19*x31*x35))
+    x25 = 2*x19
+    x26 = chi0*x25
+    x27 = omega_c*cos(x9)
+    x28 = (1/2)*Theta_p*x27*cos(x11)
+    x29 = alpha_dot + x10*x27
+    x30 = e*cos(x12)
+    x31 = x16*x30
+    x32 = I_Pb*vartheta*zeta_D/chi_star**2
+    x33 = 2*x32
+    x34 = x21*x22 + x33*(-alpha_dot*x26 + x14*x28 - x17*x18**2*x24 + x23*x24 + x29*x31)
+    x35 = r_c + x3
+    x36 = -chi0*x7 + chi0 + 2*e*x13*x15 - x25*x35
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - 1/2*mu_m*w_b*x34 - x34*x36 - (x22*(-x23 + x26 - x31) + x33*(alpha_dot*chi0*x8 - alpha_dot*x20 + 2*e*x13*x15*x29 - x28*x30))*(-x26 + x31 - x35*x8)), x0*(-mu_m*w_b*x21*x32 - x21*x33*x36))
 
 
 def out_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1374,59 +1404,61 @@ def out_contact_unloading_bwd(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = mu_m*x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*sin(alpha + x39)
-    x41 = sin(alpha)
-    x42 = cos(alpha)
-    x43 = sin(alpha0)
-    x44 = cos(alpha0)
-    x45 = -chi0*x43 + e*sin(theta0) - e*sin(x39) + x18*x44
-    x46 = chi0*x44 + e*cos(theta0) - e*cos(x39) + x18*x43
-    x47 = x31 + x32
-    x48 = d_x*k_s
-    x49 = (1/8)*x34
-    x50 = x30**2*x35
-    x51 = -x38*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
-    return (x16, x21, x30, x33, x37, -x38, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40), -x36*x41 - x38*x42, asin(x18/sqrt(x45**2 + x46**2)) - atan2(x45, x46), (1/2)*I_Pb*alpha_dot**2 + x15**2*x49 + x48*(L_us*alpha - alpha*d_y - d_x*log(x42) - x17*log(x47)), alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x15*x49*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x48*(L_us*alpha_dot + alpha_dot*d_x*x41/x42 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x47) + x50 + x51, x50, x51)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = mu_m*x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*sin(alpha + x42)
+    x44 = sin(alpha0)
+    x45 = cos(alpha0)
+    x46 = -chi0*x44 + e*sin(theta0) - e*sin(x42) + x19*x45
+    x47 = chi0*x45 + e*cos(theta0) - e*cos(x42) + x19*x44
+    x48 = x32 + x34
+    x49 = d_x*k_s
+    x50 = (1/8)*x37
+    x51 = x31**(-2)
+    x52 = x30**2*x38
+    x53 = -x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
+    return (x15, x22, x30, x36, x40, -x41, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43), -x31*x41 - x33*x39, asin(x19/sqrt(x46**2 + x47**2)) - atan2(x46, x47), (1/2)*I_Pb*alpha_dot**2 + x14**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x48)), alpha_dot*(-d_x*x36 + (1/2)*mu_m*w_b*x40 - x39*(chi0 - x22)) + x14*x50*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x49*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x51 + alpha_dot*(x33**2*x51 + 1))/x48) + x52 + x53, x52, x53)
 
 
 def out_contact_unloading_bwd_v(t, alpha, alpha_dot, p):
@@ -1471,60 +1503,62 @@ def out_contact_unloading_bwd_v(t, alpha, alpha_dot, p):
     vartheta = p[17]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = mu_m*x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*numpy.sin(alpha + x39)
-    x41 = numpy.sin(alpha)
-    x42 = numpy.cos(alpha)
-    x43 = numpy.sin(alpha0)
-    x44 = numpy.cos(alpha0)
-    x45 = -chi0*x43 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x44
-    x46 = chi0*x44 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x43
-    x47 = x31 + x32
-    x48 = d_x*k_s
-    x49 = (1/8)*x34
-    x50 = x30**2*x35
-    x51 = -x38*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = mu_m*x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*numpy.sin(alpha + x42)
+    x44 = numpy.sin(alpha0)
+    x45 = numpy.cos(alpha0)
+    x46 = -chi0*x44 + e*numpy.sin(theta0) - e*numpy.sin(x42) + x19*x45
+    x47 = chi0*x45 + e*numpy.cos(theta0) - e*numpy.cos(x42) + x19*x44
+    x48 = x32 + x34
+    x49 = d_x*k_s
+    x50 = (1/8)*x37
+    x51 = x31**(-2.0)
+    x52 = x30**2*x38
+    x53 = -x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x37 + _zero, -x38 + _zero, 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40) + _zero, -x36*x41 - x38*x42 + _zero, numpy.arcsin(x18/numpy.sqrt(x45**2 + x46**2)) - numpy.arctan2(x45, x46) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x49 + x48*(L_us*alpha - alpha*d_y - d_x*numpy.log(x42) - x17*numpy.log(x47)) + _zero, alpha_dot*(-d_x*x33 + (1/2)*mu_m*w_b*x37 - x36*(chi0 - x21)) + x15*x49*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x48*(L_us*alpha_dot + alpha_dot*d_x*x41/x42 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x47) + x50 + x51 + _zero, x50 + _zero, x51 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x40 + _zero, -x41 + _zero, 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43) + _zero, -x31*x41 - x33*x39 + _zero, numpy.arcsin(x19/numpy.sqrt(x46**2 + x47**2)) - numpy.arctan2(x46, x47) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x48)) + _zero, alpha_dot*(-d_x*x36 + (1/2)*mu_m*w_b*x40 - x39*(chi0 - x22)) + x14*x50*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x49*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x51 + alpha_dot*(x33**2*x51 + 1))/x48) + x52 + x53 + _zero, x52 + _zero, x53 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -1546,8 +1580,10 @@ def gap(t, alpha, alpha_dot, p):
     theta0 = p[5]
     Theta_p = p[18]
     omega_c = p[19]
-    x0 = (1/4)*Theta_p*sin(omega_c*t)
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/4)*Theta_p*sin(omega_c*t)
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -1570,12 +1606,13 @@ def gap_rate(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = (1/2)*alpha - 1/2*alpha0
-    x1 = omega_c*t
-    x2 = (1/4)*Theta_p
-    x3 = x2*sin(x1)
-    x4 = alpha + theta0 + x3
-    x5 = omega_c*cos(x1)
-    return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+    x1 = sin(x0)
+    x2 = omega_c*t
+    x3 = (1/4)*Theta_p
+    x4 = x3*sin(x2)
+    x5 = alpha + theta0 + x4
+    x6 = omega_c*cos(x2)
+    return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
 
 
 def slip(t, alpha, alpha_dot, p):
@@ -1598,14 +1635,15 @@ def slip(t, alpha, alpha_dot, p):
     Theta_p = p[18]
     omega_c = p[19]
     x0 = (1/2)*alpha - 1/2*alpha0
-    x1 = omega_c*t
-    x2 = Theta_p*omega_c*cos(x1)
-    x3 = (1/2)*x2
-    x4 = Theta_p*sin(x1)
-    x5 = alpha + theta0
-    x6 = (1/4)*x4
-    x7 = x5 + x6
-    return 2*alpha_dot*chi0*sin(x0)*cos(x0) + alpha_dot*(r_c + (1/2)*w_b)*cos(alpha - alpha0) - e*x3*sin(x7)*cos(x6) - 2*e*(alpha_dot + (1/4)*x2)*sin(x6)*cos(x7) - (alpha_dot + x3)*(e*sin((1/2)*x4 + x5) + r_c)
+    x1 = sin(x0)
+    x2 = omega_c*t
+    x3 = Theta_p*omega_c*cos(x2)
+    x4 = (1/2)*x3
+    x5 = Theta_p*sin(x2)
+    x6 = alpha + theta0
+    x7 = (1/4)*x5
+    x8 = x6 + x7
+    return 2*alpha_dot*chi0*x1*cos(x0) + alpha_dot*(1 - 2*x1**2)*(r_c + (1/2)*w_b) - e*x4*sin(x8)*cos(x7) - 2*e*(alpha_dot + (1/4)*x3)*sin(x7)*cos(x8) - (alpha_dot + x4)*(e*sin((1/2)*x5 + x6) + r_c)
 
 
 def slip_partials(t, alpha, alpha_dot, p):
@@ -1654,10 +1692,10 @@ def slip_partials(t, alpha, alpha_dot, p):
     x22 = x10*x20
     x23 = (1/2)*alpha - 1/2*alpha0
     x24 = sin(x23)
-    x25 = r_c + (1/2)*w_b
-    x26 = alpha - alpha0
-    x27 = cos(x23)
-    return (-x10*x11 + x10*x13*x18*x21 + x13*x15*x7 + x13*x18*x19 + x16*x18*x7 - x19*x20 - x21*x22 + x5*x7, -alpha_dot*chi0*x24**2 + alpha_dot*chi0*x27**2 - alpha_dot*x25*sin(x26) + 2*e*x13*x17*x21 - x11 - x22, 2*chi0*x24*x27 - 2*x13*x15 + x25*cos(x26) - x5)
+    x25 = x24**2
+    x26 = cos(x23)
+    x27 = r_c + (1/2)*w_b
+    return (-x10*x11 + x10*x13*x18*x21 + x13*x15*x7 + x13*x18*x19 + x16*x18*x7 - x19*x20 - x21*x22 + x5*x7, -alpha_dot*chi0*x25 + alpha_dot*chi0*x26**2 - 2*alpha_dot*x24*x26*x27 + 2*e*x13*x17*x21 - x11 - x22, 2*chi0*x24*x26 - 2*x13*x15 + x27*(1 - 2*x25) - x5)
 
 
 def static_moment(alpha, p):
@@ -1683,25 +1721,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[15]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -1772,7 +1812,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1790,10 +1831,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1821,7 +1863,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1840,25 +1883,27 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         Y_e = p[15]
         Theta_p = p[18]
         omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = cos(x3)
         x7 = omega_c*t
         x8 = (1/4)*Theta_p
         x9 = x8*sin(x7)
         x10 = alpha + theta0 + x9
         x11 = e*cos(x10)
         x12 = sin(x9)
-        x13 = -chi0*x2 + 2*x11*x12 + x3*x6
+        x13 = -2*chi0*x4*x6 + 2*x11*x12 + x2*x5
         x14 = (1/4)*pi*Y_e*l_lambda
-        x15 = omega_c*cos(x7)
-        x16 = sin(x10)
-        x17 = beta_D*x14*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x15*x8))*abs(x13) - x13*x14
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x17 - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+        x15 = 2*x5
+        x16 = x4*x6
+        x17 = omega_c*cos(x7)
+        x18 = sin(x10)
+        x19 = beta_D*x14*(-1/2*Theta_p*x11*x17*cos(x9) + alpha_dot*chi0*(1 - x15) - alpha_dot*x16*x2 + 2*e*x12*x18*(alpha_dot + x17*x8))*abs(x13) - x13*x14
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x19 - x19*(-chi0*x15 + chi0 + 2*e*x12*x18 - 2*x16*(r_c + x1)))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1877,25 +1922,27 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         Y_e = p[15]
         Theta_p = p[18]
         omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = cos(x3)
         x7 = omega_c*t
         x8 = (1/4)*Theta_p
         x9 = x8*sin(x7)
         x10 = alpha + theta0 + x9
         x11 = e*cos(x10)
         x12 = sin(x9)
-        x13 = -chi0*x2 + 2*x11*x12 + x3*x6
+        x13 = -2*chi0*x4*x6 + 2*x11*x12 + x2*x5
         x14 = (1/4)*pi*Y_e*l_lambda
-        x15 = omega_c*cos(x7)
-        x16 = sin(x10)
-        x17 = beta_D*x14*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x15*x8))*abs(x13) - x13*x14
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x17 - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+        x15 = 2*x5
+        x16 = x4*x6
+        x17 = omega_c*cos(x7)
+        x18 = sin(x10)
+        x19 = beta_D*x14*(-1/2*Theta_p*x11*x17*cos(x9) + alpha_dot*chi0*(1 - x15) - alpha_dot*x16*x2 + 2*e*x12*x18*(alpha_dot + x17*x8))*abs(x13) - x13*x14
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x19 - x19*(-chi0*x15 + chi0 + 2*e*x12*x18 - 2*x16*(r_c + x1)))/I_Pb
     elif r == 3:
         r_c = p[0]
         e = p[1]
@@ -1916,23 +1963,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         vartheta = p[17]
         Theta_p = p[18]
         omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = cos(x3)
         x7 = omega_c*t
         x8 = (1/4)*Theta_p
         x9 = x8*sin(x7)
         x10 = alpha + theta0 + x9
         x11 = e*cos(x10)
         x12 = sin(x9)
-        x13 = omega_c*cos(x7)
-        x14 = sin(x10)
-        x15 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x13*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x13*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*x11*x12 - x3*x6)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+        x13 = 2*x5
+        x14 = x4*x6
+        x15 = omega_c*cos(x7)
+        x16 = sin(x10)
+        x17 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*(1 - x13) - alpha_dot*x14*x2 + 2*e*x12*x16*(alpha_dot + x15*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x4*x6 - 2*x11*x12 - x2*x5)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17 - x17*(-chi0*x13 + chi0 + 2*e*x12*x16 - 2*x14*(r_c + x1)))/I_Pb
     elif r == 4:
         r_c = p[0]
         e = p[1]
@@ -1953,23 +2002,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         vartheta = p[17]
         Theta_p = p[18]
         omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = cos(x3)
         x7 = omega_c*t
         x8 = (1/4)*Theta_p
         x9 = x8*sin(x7)
         x10 = alpha + theta0 + x9
         x11 = e*cos(x10)
         x12 = sin(x9)
-        x13 = omega_c*cos(x7)
-        x14 = sin(x10)
-        x15 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x13*cos(x9) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x13*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*x11*x12 - x3*x6)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+        x13 = 2*x5
+        x14 = x4*x6
+        x15 = omega_c*cos(x7)
+        x16 = sin(x10)
+        x17 = 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*x11*x15*cos(x9) + alpha_dot*chi0*(1 - x13) - alpha_dot*x14*x2 + 2*e*x12*x16*(alpha_dot + x15*x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x4*x6 - 2*x11*x12 - x2*x5)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x17 - x17*(-chi0*x13 + chi0 + 2*e*x12*x16 - 2*x14*(r_c + x1)))/I_Pb
     return nan
 
 
@@ -1998,8 +2049,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         theta0 = p[5]
         Theta_p = p[18]
         omega_c = p[19]
-        x0 = (1/4)*Theta_p*sin(omega_c*t)
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/4)*Theta_p*sin(omega_c*t)
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -2010,12 +2063,13 @@ def surface_index(k, t, alpha, alpha_dot, p):
         Theta_p = p[18]
         omega_c = p[19]
         x0 = (1/2)*alpha - 1/2*alpha0
-        x1 = omega_c*t
-        x2 = (1/4)*Theta_p
-        x3 = x2*sin(x1)
-        x4 = alpha + theta0 + x3
-        x5 = omega_c*cos(x1)
-        return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
     elif k == 2:
         r_c = p[0]
         e = p[1]
@@ -2026,12 +2080,597 @@ def surface_index(k, t, alpha, alpha_dot, p):
         Theta_p = p[18]
         omega_c = p[19]
         x0 = (1/2)*alpha - 1/2*alpha0
-        x1 = omega_c*t
-        x2 = Theta_p*omega_c*cos(x1)
-        x3 = (1/2)*x2
-        x4 = Theta_p*sin(x1)
-        x5 = alpha + theta0
-        x6 = (1/4)*x4
-        x7 = x5 + x6
-        return 2*alpha_dot*chi0*sin(x0)*cos(x0) + alpha_dot*(r_c + (1/2)*w_b)*cos(alpha - alpha0) - e*x3*sin(x7)*cos(x6) - 2*e*(alpha_dot + (1/4)*x2)*sin(x6)*cos(x7) - (alpha_dot + x3)*(e*sin((1/2)*x4 + x5) + r_c)
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = Theta_p*omega_c*cos(x2)
+        x4 = (1/2)*x3
+        x5 = Theta_p*sin(x2)
+        x6 = alpha + theta0
+        x7 = (1/4)*x5
+        x8 = x6 + x7
+        return 2*alpha_dot*chi0*x1*cos(x0) + alpha_dot*(1 - 2*x1**2)*(r_c + (1/2)*w_b) - e*x4*sin(x8)*cos(x7) - 2*e*(alpha_dot + (1/4)*x3)*sin(x7)*cos(x8) - (alpha_dot + x4)*(e*sin((1/2)*x5 + x6) + r_c)
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
+    elif j == 1:
+        r_c = p[0]
+        e = p[1]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*sin(x0)
+        x2 = (1/2)*x1
+        x3 = alpha + theta0
+        x4 = x2 + x3
+        x5 = omega_c**2
+        x6 = x2*x5
+        x7 = cos(x0)
+        x8 = Theta_p*omega_c*x7
+        x9 = (1/2)*x8
+        x10 = e*x9
+        x11 = (1/4)*x1
+        x12 = x11 + x3
+        x13 = cos(x12)
+        x14 = sin(x11)
+        x15 = e*x6
+        x16 = cos(x11)
+        x17 = sin(x12)
+        x18 = (1/8)*Theta_p**2*e*x5*x7**2
+        x19 = x14*x17
+        x20 = x13*x16
+        x21 = x10*(alpha_dot + (1/4)*x8)
+        return -x10*(alpha_dot + x9)*cos(x4) + x13*x14*x15 + x15*x16*x17 + x18*x19 - x18*x20 + x19*x21 - x20*x21 + x6*(e*sin(x4) + r_c)
+    elif j == 2:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = cos(x0)
+        x3 = omega_c*t
+        x4 = Theta_p*omega_c*cos(x3)
+        x5 = (1/2)*x4
+        x6 = Theta_p*sin(x3)
+        x7 = alpha + theta0
+        x8 = (1/4)*x6
+        x9 = x7 + x8
+        return -alpha_dot*chi0*x1**2 + alpha_dot*chi0*x2**2 - 2*alpha_dot*x1*x2*(r_c + (1/2)*w_b) - e*x5*cos(x8)*cos(x9) + 2*e*(alpha_dot + (1/4)*x4)*sin(x8)*sin(x9) - e*(alpha_dot + x5)*cos((1/2)*x6 + x7)
+    elif j == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = Theta_p*sin(omega_c*t)
+        x1 = alpha + theta0
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/4)*x0
+        return 2*chi0*x3*cos(x2) - 2*e*sin(x4)*cos(x1 + x4) - e*sin((1/2)*x0 + x1) - r_c + (1 - 2*x3**2)*(r_c + (1/2)*w_b)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading_fwd: P_in
+        4: contact_loading_fwd: D_c
+        5: contact_loading_fwd: D_f
+        6: contact_loading_bwd: P_in
+        7: contact_loading_bwd: D_c
+        8: contact_loading_bwd: D_f
+        9: contact_unloading_fwd: P_in
+        10: contact_unloading_fwd: D_c
+        11: contact_unloading_fwd: D_f
+        12: contact_unloading_bwd: P_in
+        13: contact_unloading_bwd: D_c
+        14: contact_unloading_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = cos(x9)
+        x13 = omega_c*t
+        x14 = Theta_p*sin(x13)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = sin(x15)
+        x20 = e*x19
+        x21 = -2*chi0*x10*x12 + x11*x8 + 2*x18*x20
+        x22 = 2*x11
+        x23 = 1 - x22
+        x24 = x10*x12
+        x25 = 2*x24
+        x26 = alpha_dot*x8
+        x27 = Theta_p*omega_c*cos(x13)
+        x28 = x18*cos(x15)
+        x29 = sin(x17)
+        x30 = alpha_dot + (1/4)*x27
+        x31 = pi*Y_e*l_lambda
+        x32 = (1/2)*x27
+        x33 = e*x32
+        x34 = alpha_dot*chi0*x23 + 2*e*x19*x29*x30 - x24*x26 - x28*x33
+        x35 = (1/4)*x31
+        x36 = beta_D*x35*abs(x21)
+        x37 = -x21*x35 + x34*x36
+        x38 = -mu_m*x37
+        return alpha_dot*(-x37*(-chi0*x22 + chi0 + 2*e*x19*x29 - x25*(r_c + x6)) - x38*x6 - x7*(L_us - d_y - x2*x6 + x4)) + (1/8)*x21*x31*(-2*alpha_dot*chi0*x23 + e*x27*x28 - 4*x20*x29*x30 + x25*x26) + x34**2*x36 + x38*((1/2)*alpha_dot*w_b - r_c*x32 - x33*sin((1/2)*x14 + x16)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = x2*cos(x1)
+        x5 = omega_c*t
+        x6 = (1/4)*Theta_p
+        x7 = x6*sin(x5)
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = omega_c*cos(x5)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x11*x9*cos(x7) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x4 + 2*e*x10*(alpha_dot + x11*x6)*sin(x8))**2*abs(-2*chi0*x4 + x0*x3 + 2*x10*x9)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = 2*r_c + w_b
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = x7**2
+        x9 = cos(x6)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        x14 = -2*chi0*x7*x9 + 2*x12*x13 + x5*x8
+        x15 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*(-beta_D*x15*(alpha_dot*chi0*(1 - 2*x8) - alpha_dot*x5*x7*x9 + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))*abs(x14) + x14*x15)*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = cos(x9)
+        x13 = omega_c*t
+        x14 = Theta_p*sin(x13)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = sin(x15)
+        x20 = e*x19
+        x21 = -2*chi0*x10*x12 + x11*x8 + 2*x18*x20
+        x22 = 2*x11
+        x23 = 1 - x22
+        x24 = x10*x12
+        x25 = 2*x24
+        x26 = alpha_dot*x8
+        x27 = Theta_p*omega_c*cos(x13)
+        x28 = x18*cos(x15)
+        x29 = sin(x17)
+        x30 = alpha_dot + (1/4)*x27
+        x31 = pi*Y_e*l_lambda
+        x32 = (1/2)*x27
+        x33 = e*x32
+        x34 = alpha_dot*chi0*x23 + 2*e*x19*x29*x30 - x24*x26 - x28*x33
+        x35 = (1/4)*x31
+        x36 = beta_D*x35*abs(x21)
+        x37 = -x21*x35 + x34*x36
+        x38 = -x37
+        return alpha_dot*((1/2)*mu_m*w_b*x38 - x37*(-chi0*x22 + chi0 + 2*e*x19*x29 - x25*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x38*((1/2)*alpha_dot*w_b - r_c*x32 - x33*sin((1/2)*x14 + x16)) + (1/8)*x21*x31*(-2*alpha_dot*chi0*x23 + e*x27*x28 - 4*x20*x29*x30 + x25*x26) + x34**2*x36 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = x2*cos(x1)
+        x5 = omega_c*t
+        x6 = (1/4)*Theta_p
+        x7 = x6*sin(x5)
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = omega_c*cos(x5)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x11*x9*cos(x7) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x4 + 2*e*x10*(alpha_dot + x11*x6)*sin(x8))**2*abs(-2*chi0*x4 + x0*x3 + 2*x10*x9)
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        beta_D = p[14]
+        Y_e = p[15]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = 2*r_c + w_b
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = x7**2
+        x9 = cos(x6)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        x14 = -2*chi0*x7*x9 + 2*x12*x13 + x5*x8
+        x15 = (1/4)*pi*Y_e*l_lambda
+        return -mu_m*(-beta_D*x15*(alpha_dot*chi0*(1 - 2*x8) - alpha_dot*x5*x7*x9 + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))*abs(x14) + x14*x15)*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 9:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = x9**2
+        x11 = 2*x10
+        x12 = 1 - x11
+        x13 = cos(x8)
+        x14 = x13*x9
+        x15 = 2*r_c + w_b
+        x16 = alpha_dot*x15
+        x17 = omega_c*t
+        x18 = Theta_p*omega_c*cos(x17)
+        x19 = (1/2)*x18
+        x20 = e*x19
+        x21 = Theta_p*sin(x17)
+        x22 = (1/4)*x21
+        x23 = alpha + theta0
+        x24 = x22 + x23
+        x25 = cos(x24)
+        x26 = x25*cos(x22)
+        x27 = sin(x22)
+        x28 = alpha_dot + (1/4)*x18
+        x29 = sin(x24)
+        x30 = alpha_dot*chi0*x12 + 2*e*x27*x28*x29 - x14*x16 - x20*x26
+        x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x32 = e*x27
+        x33 = -2*chi0*x13*x9 + x10*x15 + 2*x25*x32
+        x34 = 2*x14
+        x35 = pi*Y_e*l_lambda
+        x36 = x30*x31 - 1/4*x33*x35
+        x37 = -mu_m*x36
+        return alpha_dot*(-x36*(-chi0*x11 + chi0 + 2*e*x27*x29 - x34*(r_c + x6)) - x37*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x30**2*x31 + (1/8)*x33*x35*(-2*alpha_dot*chi0*x12 + e*x18*x26 + x16*x34 - 4*x28*x29*x32) + x37*((1/2)*alpha_dot*w_b - r_c*x19 - x20*sin((1/2)*x21 + x23)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 10:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5))**2/chi_star**2
+    elif c == 11:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = 2*r_c + w_b
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = x7**2
+        x9 = cos(x6)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x8) - alpha_dot*x5*x7*x9 + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x7*x9 - 2*x12*x13 - x5*x8))*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
+    elif c == 12:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = x9**2
+        x11 = 2*x10
+        x12 = 1 - x11
+        x13 = cos(x8)
+        x14 = x13*x9
+        x15 = 2*r_c + w_b
+        x16 = alpha_dot*x15
+        x17 = omega_c*t
+        x18 = Theta_p*omega_c*cos(x17)
+        x19 = (1/2)*x18
+        x20 = e*x19
+        x21 = Theta_p*sin(x17)
+        x22 = (1/4)*x21
+        x23 = alpha + theta0
+        x24 = x22 + x23
+        x25 = cos(x24)
+        x26 = x25*cos(x22)
+        x27 = sin(x22)
+        x28 = alpha_dot + (1/4)*x18
+        x29 = sin(x24)
+        x30 = alpha_dot*chi0*x12 + 2*e*x27*x28*x29 - x14*x16 - x20*x26
+        x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x32 = e*x27
+        x33 = -2*chi0*x13*x9 + x10*x15 + 2*x25*x32
+        x34 = 2*x14
+        x35 = pi*Y_e*l_lambda
+        x36 = x30*x31 - 1/4*x33*x35
+        x37 = -x36
+        return alpha_dot*((1/2)*mu_m*w_b*x37 - x36*(-chi0*x11 + chi0 + 2*e*x27*x29 - x34*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x37*((1/2)*alpha_dot*w_b - r_c*x19 - x20*sin((1/2)*x21 + x23)) + x30**2*x31 + (1/8)*x33*x35*(-2*alpha_dot*chi0*x12 + e*x18*x26 + x16*x34 - 4*x28*x29*x32) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 13:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[13]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5))**2/chi_star**2
+    elif c == 14:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        zeta_D = p[13]
+        Y_e = p[15]
+        chi_star = p[16]
+        vartheta = p[17]
+        Theta_p = p[18]
+        omega_c = p[19]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = 2*r_c + w_b
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = x7**2
+        x9 = cos(x6)
+        x10 = (1/4)*x3
+        x11 = x10 + x4
+        x12 = e*cos(x11)
+        x13 = sin(x10)
+        return -mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x8) - alpha_dot*x5*x7*x9 + 2*e*x13*(alpha_dot + (1/4)*x1)*sin(x11) - x12*x2*cos(x10))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x7*x9 - 2*x12*x13 - x5*x8))*((1/2)*alpha_dot*w_b - e*x2*sin((1/2)*x3 + x4) - r_c*x2)
     return nan

@@ -117,7 +117,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -136,8 +137,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -175,30 +177,32 @@ def out_free(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = sin(x8)
-    x15 = Omega_c*e
-    x16 = tan(alpha)
-    x17 = (1/cos(alpha))
-    x18 = Omega_c*t + theta0
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 + e*sin(theta0) - e*sin(x18) + x13*x20
-    x22 = chi0*x20 + e*cos(theta0) - e*cos(x18) + x13*x19
-    return (chi0*x1 - x11*x9 - x2*x5, 2*chi0*x5 + x1*x13 - x11*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*cos(x7), k_s*(L_us + d_x*x16 - d_y - x12*x17), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(alpha + x18), 0, asin(x13/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x12*log(x16 + x17)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = 2*x3
+    x12 = sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = cos(alpha)
+    x18 = 1/x17
+    x19 = x18*sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
+    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -236,31 +240,33 @@ def out_free_v(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = numpy.sin(x8)
-    x15 = Omega_c*e
-    x16 = numpy.tan(alpha)
-    x17 = (numpy.cos(alpha)**(-1.0))
-    x18 = Omega_c*t + theta0
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 + e*numpy.sin(theta0) - e*numpy.sin(x18) + x13*x20
-    x22 = chi0*x20 + e*numpy.cos(theta0) - e*numpy.cos(x18) + x13*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = 2*x3
+    x12 = numpy.sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = numpy.cos(alpha)
+    x18 = x17**(-1.0)
+    x19 = x18*numpy.sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
+    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x11*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x13 - x11*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x16 - d_y - x12*x17) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*numpy.sin(alpha + x18) + _zero, 0 + _zero, numpy.arcsin(x13/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x12*numpy.log(x16 + x17)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading(t, alpha, alpha_dot, p):
@@ -291,25 +297,27 @@ def rhs_contact_loading(t, alpha, alpha_dot, p):
     beta_D = p[15]
     Y_e = p[16]
     Omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0
-    x10 = x8 + x9
-    x11 = cos(x10)
-    x12 = sin(x8)
-    x13 = -chi0*x2 + 2*e*x11*x12 + x3*x6
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0
+    x9 = x7 + x8
+    x10 = cos(x9)
+    x11 = sin(x7)
+    x12 = cos(x3)
+    x13 = -2*chi0*x12*x4 + 2*e*x10*x11 + x2*x5
     x14 = (1/4)*pi*Y_e*l_lambda
     x15 = Omega_c*e
-    x16 = sin(x10)
-    x17 = beta_D*x14*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x7) - x11*x15*cos(x8))*abs(x13) - x13*x14
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x17*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(Omega_c*t + x9))) - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+    x16 = 2*x5
+    x17 = sin(x9)
+    x18 = x12*x4
+    x19 = beta_D*x14*(alpha_dot*chi0*(1 - x16) - alpha_dot*x18*x2 + 2*e*x11*x17*(alpha_dot + x6) - x10*x15*cos(x7))*abs(x13) - x13*x14
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x19*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(Omega_c*t + x8))) - x19*(-chi0*x16 + chi0 + 2*e*x11*x17 - 2*x18*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading(t, alpha, alpha_dot, p):
@@ -340,51 +348,52 @@ def jac_contact_loading(t, alpha, alpha_dot, p):
     Y_e = p[16]
     Omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = alpha + theta0
-    x4 = Omega_c*t + x3
-    x5 = Omega_c*e
-    x6 = tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x5*sin(x4)))
-    x7 = 1 - x6**2
-    x8 = alpha - alpha0
-    x9 = sin(x8)
-    x10 = 2*r_c + w_b
-    x11 = (1/2)*alpha - 1/2*alpha0
-    x12 = sin(x11)
-    x13 = x12**2
-    x14 = x10*x13
-    x15 = (1/2)*Omega_c
-    x16 = t*x15
-    x17 = x16 + x3
-    x18 = cos(x17)
-    x19 = sin(x16)
-    x20 = 2*e*x19
-    x21 = x18*x20
-    x22 = -chi0*x9 + x14 + x21
-    x23 = (1/4)*pi*Y_e*l_lambda
-    x24 = cos(x8)
-    x25 = x5*cos(x16)
-    x26 = alpha_dot + x15
-    x27 = sin(x17)
-    x28 = cos(x11)
-    x29 = x12*x28
-    x30 = x10*x29
-    x31 = alpha_dot*chi0*x24 - alpha_dot*x30 + 2*e*x19*x26*x27 - x18*x25
-    x32 = abs(x22)
-    x33 = beta_D*x32
-    x34 = x23*x33
-    x35 = -x22*x23 + x31*x34
-    x36 = -x35
-    x37 = r_c + x2
-    x38 = 2*chi0
-    x39 = x20*x27
-    x40 = chi0*x24 - x30 + x39
-    x41 = x23*x40
-    x42 = (1/2)*alpha_dot
-    x43 = -beta_D*x23*x31*x40*(0.0 if x22 == 0 else copysign(1, x22)) + x34*(-alpha_dot*chi0*x9 - x10*x28**2*x42 + x14*x42 + x21*x26 + x25*x27) + x41
-    x44 = chi0 - x13*x38 - x37*x9 + x39
-    return (x0*((1/2)*Omega_c*e*mu_m*s*w_b*x36*x7*cos(x4) - d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x43*x6 - x35*(x21 - x24*x37 - x29*x38) - x43*x44), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x32*x40*x6 - 1/4*mu_m*s*w_b**2*x36*x7 - x33*x41*x44))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = alpha + theta0
+    x5 = Omega_c*t + x4
+    x6 = Omega_c*e
+    x7 = tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x6*sin(x5)))
+    x8 = 1 - x7**2
+    x9 = 2*r_c + w_b
+    x10 = (1/2)*alpha - 1/2*alpha0
+    x11 = sin(x10)
+    x12 = x11**2
+    x13 = x12*x9
+    x14 = (1/2)*Omega_c
+    x15 = t*x14
+    x16 = x15 + x4
+    x17 = cos(x16)
+    x18 = sin(x15)
+    x19 = 2*e*x18
+    x20 = x17*x19
+    x21 = cos(x10)
+    x22 = x11*x21
+    x23 = 2*x22
+    x24 = chi0*x23
+    x25 = x13 + x20 - x24
+    x26 = (1/4)*pi*Y_e*l_lambda
+    x27 = x6*cos(x15)
+    x28 = 2*x12
+    x29 = 1 - x28
+    x30 = alpha_dot + x14
+    x31 = sin(x16)
+    x32 = x22*x9
+    x33 = alpha_dot*chi0*x29 - alpha_dot*x32 + 2*e*x18*x30*x31 - x17*x27
+    x34 = abs(x25)
+    x35 = beta_D*x34
+    x36 = x26*x35
+    x37 = -x25*x26 + x33*x36
+    x38 = -x37
+    x39 = r_c + x3
+    x40 = x19*x31
+    x41 = chi0*x29 - x32 + x40
+    x42 = x26*x41
+    x43 = (1/2)*alpha_dot
+    x44 = -beta_D*x26*x33*x41*(0.0 if x25 == 0 else copysign(1, x25)) + x36*(-alpha_dot*x24 + x13*x43 + x20*x30 - x21**2*x43*x9 + x27*x31) + x42
+    x45 = -chi0*x28 + chi0 - x23*x39 + x40
+    return (x0*((1/2)*Omega_c*e*mu_m*s*w_b*x38*x8*cos(x5) - d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x44*x7 - x37*(x20 - x24 - x29*x39) - x44*x45), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x34*x41*x7 - 1/4*mu_m*s*w_b**2*x38*x8 - x35*x42*x45))
 
 
 def out_contact_loading(t, alpha, alpha_dot, p):
@@ -427,56 +436,59 @@ def out_contact_loading(t, alpha, alpha_dot, p):
     beta_D = p[15]
     Y_e = p[16]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = (1/4)*x30
-    x32 = beta_D*x31*abs(x13)
-    x33 = x14*x31 + x26*x32
-    x34 = -x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x35)
-    x37 = mu_m*x34*tanh(s*x36)
-    x38 = sin(alpha)
-    x39 = cos(alpha)
-    x40 = sin(alpha0)
-    x41 = cos(alpha0)
-    x42 = -chi0*x40 + e*sin(theta0) - e*sin(x35) + x16*x41
-    x43 = chi0*x41 + e*cos(theta0) - e*cos(x35) + x16*x40
-    x44 = x27 + x28
-    x45 = d_x*k_s
-    x46 = (1/8)*x30
-    x47 = x26**2*x32
-    x48 = x36*x37
-    return (x14, x20, x26, x29, x34, x37, x36, -x33*x38 + x37*x39, asin(x16/sqrt(x42**2 + x43**2)) - atan2(x42, x43), (1/2)*I_Pb*alpha_dot**2 + x13**2*x46 + x45*(L_us*alpha - alpha*d_y - d_x*log(x39) - x15*log(x44)), alpha_dot*(-d_x*x29 - x15*x37 - x33*(chi0 - x20)) + x13*x46*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x45*(L_us*alpha_dot + alpha_dot*d_x*x38/x39 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x44) + x47 + x48, x47, x48)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = (1/4)*x34
+    x36 = beta_D*x35*abs(x12)
+    x37 = x13*x35 + x27*x36
+    x38 = -x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x39)
+    x41 = mu_m*x38*tanh(s*x40)
+    x42 = sin(alpha0)
+    x43 = cos(alpha0)
+    x44 = -chi0*x42 + e*sin(theta0) - e*sin(x39) + x18*x43
+    x45 = chi0*x43 + e*cos(theta0) - e*cos(x39) + x18*x42
+    x46 = x29 + x31
+    x47 = d_x*k_s
+    x48 = (1/8)*x34
+    x49 = x28**(-2)
+    x50 = x27**2*x36
+    x51 = x40*x41
+    return (x13, x21, x27, x33, x38, x41, x40, x28*x41 - x30*x37, asin(x18/sqrt(x44**2 + x45**2)) - atan2(x44, x45), (1/2)*I_Pb*alpha_dot**2 + x12**2*x48 + x47*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x46)), alpha_dot*(-d_x*x33 - x17*x41 - x37*(chi0 - x21)) + x12*x48*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x49 + alpha_dot*(x30**2*x49 + 1))/x46) + x50 + x51, x50, x51)
 
 
 def out_contact_loading_v(t, alpha, alpha_dot, p):
@@ -519,57 +531,60 @@ def out_contact_loading_v(t, alpha, alpha_dot, p):
     beta_D = p[15]
     Y_e = p[16]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = (1/4)*x30
-    x32 = beta_D*x31*abs(x13)
-    x33 = x14*x31 + x26*x32
-    x34 = -x33
-    x35 = Omega_c*t + theta0
-    x36 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x35)
-    x37 = mu_m*x34*numpy.tanh(s*x36)
-    x38 = numpy.sin(alpha)
-    x39 = numpy.cos(alpha)
-    x40 = numpy.sin(alpha0)
-    x41 = numpy.cos(alpha0)
-    x42 = -chi0*x40 + e*numpy.sin(theta0) - e*numpy.sin(x35) + x16*x41
-    x43 = chi0*x41 + e*numpy.cos(theta0) - e*numpy.cos(x35) + x16*x40
-    x44 = x27 + x28
-    x45 = d_x*k_s
-    x46 = (1/8)*x30
-    x47 = x26**2*x32
-    x48 = x36*x37
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = (1/4)*x34
+    x36 = beta_D*x35*abs(x12)
+    x37 = x13*x35 + x27*x36
+    x38 = -x37
+    x39 = Omega_c*t + theta0
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x39)
+    x41 = mu_m*x38*numpy.tanh(s*x40)
+    x42 = numpy.sin(alpha0)
+    x43 = numpy.cos(alpha0)
+    x44 = -chi0*x42 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x43
+    x45 = chi0*x43 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x42
+    x46 = x29 + x31
+    x47 = d_x*k_s
+    x48 = (1/8)*x34
+    x49 = x28**(-2.0)
+    x50 = x27**2*x36
+    x51 = x40*x41
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x34 + _zero, x37 + _zero, x36 + _zero, -x33*x38 + x37*x39 + _zero, numpy.arcsin(x16/numpy.sqrt(x42**2 + x43**2)) - numpy.arctan2(x42, x43) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x46 + x45*(L_us*alpha - alpha*d_y - d_x*numpy.log(x39) - x15*numpy.log(x44)) + _zero, alpha_dot*(-d_x*x29 - x15*x37 - x33*(chi0 - x20)) + x13*x46*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x45*(L_us*alpha_dot + alpha_dot*d_x*x38/x39 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x44) + x47 + x48 + _zero, x47 + _zero, x48 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x38 + _zero, x41 + _zero, x40 + _zero, x28*x41 - x30*x37 + _zero, numpy.arcsin(x18/numpy.sqrt(x44**2 + x45**2)) - numpy.arctan2(x44, x45) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x48 + x47*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x46)) + _zero, alpha_dot*(-d_x*x33 - x17*x41 - x37*(chi0 - x21)) + x12*x48*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x49 + alpha_dot*(x30**2*x49 + 1))/x46) + x50 + x51 + _zero, x50 + _zero, x51 + _zero)
 
 
 def rhs_contact_unloading(t, alpha, alpha_dot, p):
@@ -602,23 +617,25 @@ def rhs_contact_unloading(t, alpha, alpha_dot, p):
     chi_star = p[17]
     vartheta = p[18]
     Omega_c = p[19]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0
-    x10 = x8 + x9
-    x11 = cos(x10)
-    x12 = sin(x8)
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0
+    x9 = x7 + x8
+    x10 = cos(x9)
+    x11 = sin(x7)
+    x12 = cos(x3)
     x13 = Omega_c*e
-    x14 = sin(x10)
-    x15 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x7) - x11*x13*cos(x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*e*x11*x12 - x3*x6)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x9))) - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+    x14 = 2*x5
+    x15 = sin(x9)
+    x16 = x12*x4
+    x17 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x11*x15*(alpha_dot + x6) - x10*x13*cos(x7))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x12*x4 - 2*e*x10*x11 - x2*x5)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x8))) - x17*(-chi0*x14 + chi0 + 2*e*x11*x15 - 2*x16*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading(t, alpha, alpha_dot, p):
@@ -651,46 +668,47 @@ def jac_contact_unloading(t, alpha, alpha_dot, p):
     vartheta = p[18]
     Omega_c = p[19]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = alpha + theta0
-    x4 = Omega_c*t + x3
-    x5 = Omega_c*e
-    x6 = tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x5*sin(x4)))
-    x7 = 1 - x6**2
-    x8 = alpha - alpha0
-    x9 = sin(x8)
-    x10 = 2*r_c + w_b
-    x11 = (1/2)*alpha - 1/2*alpha0
-    x12 = sin(x11)
-    x13 = x12**2
-    x14 = x10*x13
-    x15 = (1/2)*Omega_c
-    x16 = t*x15
-    x17 = x16 + x3
-    x18 = cos(x17)
-    x19 = sin(x16)
-    x20 = 2*e*x19
-    x21 = x18*x20
-    x22 = (1/4)*pi*Y_e*l_lambda
-    x23 = cos(x8)
-    x24 = x5*cos(x16)
-    x25 = alpha_dot + x15
-    x26 = sin(x17)
-    x27 = cos(x11)
-    x28 = x12*x27
-    x29 = x10*x28
-    x30 = chi_star**(-2)
-    x31 = 2*I_Pb*vartheta*x30*zeta_D
-    x32 = x22*(chi0*x9 - x14 - x21) + x31*(alpha_dot*chi0*x23 - alpha_dot*x29 + 2*e*x19*x25*x26 - x18*x24)
-    x33 = -x32
-    x34 = chi0*x23 + x20*x26 - x29
-    x35 = (1/2)*alpha_dot
-    x36 = x22*x34 + x31*(-alpha_dot*chi0*x9 - x10*x27**2*x35 + x14*x35 + x21*x25 + x24*x26)
-    x37 = r_c + x2
-    x38 = 2*chi0
-    x39 = chi0 + 2*e*x19*x26 - x13*x38 - x37*x9
-    return (x0*((1/2)*Omega_c*e*mu_m*s*w_b*x33*x7*cos(x4) - d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x36*x6 - x32*(x21 - x23*x37 - x28*x38) - x36*x39), x0*(I_Pb*mu_m*vartheta*w_b*x30*x34*x6*zeta_D - 1/4*mu_m*s*w_b**2*x33*x7 - x31*x34*x39))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = alpha + theta0
+    x5 = Omega_c*t + x4
+    x6 = Omega_c*e
+    x7 = tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x6*sin(x5)))
+    x8 = 1 - x7**2
+    x9 = 2*r_c + w_b
+    x10 = (1/2)*alpha - 1/2*alpha0
+    x11 = sin(x10)
+    x12 = x11**2
+    x13 = x12*x9
+    x14 = (1/2)*Omega_c
+    x15 = t*x14
+    x16 = x15 + x4
+    x17 = cos(x16)
+    x18 = sin(x15)
+    x19 = 2*e*x18
+    x20 = x17*x19
+    x21 = cos(x10)
+    x22 = x11*x21
+    x23 = 2*x22
+    x24 = chi0*x23
+    x25 = (1/4)*pi*Y_e*l_lambda
+    x26 = x6*cos(x15)
+    x27 = 2*x12
+    x28 = 1 - x27
+    x29 = alpha_dot + x14
+    x30 = sin(x16)
+    x31 = x22*x9
+    x32 = chi_star**(-2)
+    x33 = 2*I_Pb*vartheta*x32*zeta_D
+    x34 = x25*(-x13 - x20 + x24) + x33*(alpha_dot*chi0*x28 - alpha_dot*x31 + 2*e*x18*x29*x30 - x17*x26)
+    x35 = -x34
+    x36 = chi0*x28 + x19*x30 - x31
+    x37 = (1/2)*alpha_dot
+    x38 = x25*x36 + x33*(-alpha_dot*x24 + x13*x37 + x20*x29 - x21**2*x37*x9 + x26*x30)
+    x39 = r_c + x3
+    x40 = -chi0*x27 + chi0 + 2*e*x18*x30 - x23*x39
+    return (x0*((1/2)*Omega_c*e*mu_m*s*w_b*x35*x8*cos(x5) - d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x38*x7 - x34*(x20 - x24 - x28*x39) - x38*x40), x0*(I_Pb*mu_m*vartheta*w_b*x32*x36*x7*zeta_D - 1/4*mu_m*s*w_b**2*x35*x8 - x33*x36*x40))
 
 
 def out_contact_unloading(t, alpha, alpha_dot, p):
@@ -735,55 +753,58 @@ def out_contact_unloading(t, alpha, alpha_dot, p):
     chi_star = p[17]
     vartheta = p[18]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = tan(alpha)
-    x28 = (1/cos(alpha))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = Omega_c*t + theta0
-    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x34)
-    x36 = mu_m*x33*tanh(s*x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x34) + x16*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x34) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x35*x36
-    return (x14, x20, x26, x29, x33, x36, x35, -x32*x37 + x36*x38, asin(x16/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x15*log(x43)), alpha_dot*(-d_x*x29 - x15*x36 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47, x46, x47)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = cos(alpha)
+    x29 = 1/x28
+    x30 = sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = Omega_c*t + theta0
+    x39 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x38)
+    x40 = mu_m*x37*tanh(s*x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 + e*sin(theta0) - e*sin(x38) + x18*x42
+    x44 = chi0*x42 + e*cos(theta0) - e*cos(x38) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2)
+    x49 = x27**2*x35
+    x50 = x39*x40
+    return (x13, x21, x27, x33, x37, x40, x39, x28*x40 - x30*x36, asin(x18/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x45)), alpha_dot*(-d_x*x33 - x17*x40 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_unloading_v(t, alpha, alpha_dot, p):
@@ -828,56 +849,59 @@ def out_contact_unloading_v(t, alpha, alpha_dot, p):
     chi_star = p[17]
     vartheta = p[18]
     Omega_c = p[19]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25
-    x27 = numpy.tan(alpha)
-    x28 = (numpy.cos(alpha)**(-1.0))
-    x29 = k_s*(L_us + d_x*x27 - d_y - x15*x28)
-    x30 = numpy.pi*Y_e*l_lambda
-    x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x32 = (1/4)*x14*x30 + x26*x31
-    x33 = -x32
-    x34 = Omega_c*t + theta0
-    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x34)
-    x36 = mu_m*x33*numpy.tanh(s*x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x34) + x16*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x34) + x16*x39
-    x43 = x27 + x28
-    x44 = d_x*k_s
-    x45 = (1/8)*x30
-    x46 = x26**2*x31
-    x47 = x35*x36
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
+    x28 = numpy.cos(alpha)
+    x29 = x28**(-1.0)
+    x30 = numpy.sin(alpha)
+    x31 = x29*x30
+    x32 = d_x*x31
+    x33 = k_s*(L_us - d_y - x17*x29 + x32)
+    x34 = numpy.pi*Y_e*l_lambda
+    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x36 = (1/4)*x13*x34 + x27*x35
+    x37 = -x36
+    x38 = Omega_c*t + theta0
+    x39 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x38)
+    x40 = mu_m*x37*numpy.tanh(s*x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 + e*numpy.sin(theta0) - e*numpy.sin(x38) + x18*x42
+    x44 = chi0*x42 + e*numpy.cos(theta0) - e*numpy.cos(x38) + x18*x41
+    x45 = x29 + x31
+    x46 = d_x*k_s
+    x47 = (1/8)*x34
+    x48 = x28**(-2.0)
+    x49 = x27**2*x35
+    x50 = x39*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, x26 + _zero, x29 + _zero, x33 + _zero, x36 + _zero, x35 + _zero, -x32*x37 + x36*x38 + _zero, numpy.arcsin(x16/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x15*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x29 - x15*x36 - x32*(chi0 - x20)) + x13*x45*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x15*(alpha_dot*x27*x28 + alpha_dot*(x27**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, x37 + _zero, x40 + _zero, x39 + _zero, x28*x40 - x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x33 - x17*x40 - x36*(chi0 - x21)) + x12*x47*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x48 + alpha_dot*(x30**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -898,8 +922,10 @@ def gap(t, alpha, alpha_dot, p):
     alpha0 = p[4]
     theta0 = p[5]
     Omega_c = p[19]
-    x0 = (1/2)*Omega_c*t
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Omega_c*t
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -924,7 +950,8 @@ def gap_rate(t, alpha, alpha_dot, p):
     x1 = t*x0
     x2 = alpha + theta0 + x1
     x3 = (1/2)*alpha - 1/2*alpha0
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    x4 = sin(x3)
+    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
 
 
 def static_moment(alpha, p):
@@ -950,25 +977,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[16]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -1039,7 +1068,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1057,10 +1087,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1086,7 +1117,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1105,25 +1137,27 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_D = p[15]
         Y_e = p[16]
         Omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0
-        x10 = x8 + x9
-        x11 = cos(x10)
-        x12 = sin(x8)
-        x13 = -chi0*x2 + 2*e*x11*x12 + x3*x6
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0
+        x9 = x7 + x8
+        x10 = cos(x9)
+        x11 = sin(x7)
+        x12 = cos(x3)
+        x13 = -2*chi0*x12*x4 + 2*e*x10*x11 + x2*x5
         x14 = (1/4)*pi*Y_e*l_lambda
         x15 = Omega_c*e
-        x16 = sin(x10)
-        x17 = beta_D*x14*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*(alpha_dot + x7) - x11*x15*cos(x8))*abs(x13) - x13*x14
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x17*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(Omega_c*t + x9))) - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+        x16 = 2*x5
+        x17 = sin(x9)
+        x18 = x12*x4
+        x19 = beta_D*x14*(alpha_dot*chi0*(1 - x16) - alpha_dot*x18*x2 + 2*e*x11*x17*(alpha_dot + x6) - x10*x15*cos(x7))*abs(x13) - x13*x14
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x19*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(Omega_c*t + x8))) - x19*(-chi0*x16 + chi0 + 2*e*x11*x17 - 2*x18*(r_c + x1)))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1144,23 +1178,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[17]
         vartheta = p[18]
         Omega_c = p[19]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0
-        x10 = x8 + x9
-        x11 = cos(x10)
-        x12 = sin(x8)
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0
+        x9 = x7 + x8
+        x10 = cos(x9)
+        x11 = sin(x7)
+        x12 = cos(x3)
         x13 = Omega_c*e
-        x14 = sin(x10)
-        x15 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*(alpha_dot + x7) - x11*x13*cos(x8))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*e*x11*x12 - x3*x6)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x9))) - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+        x14 = 2*x5
+        x15 = sin(x9)
+        x16 = x12*x4
+        x17 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x11*x15*(alpha_dot + x6) - x10*x13*cos(x7))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x12*x4 - 2*e*x10*x11 - x2*x5)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17*tanh(s*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x8))) - x17*(-chi0*x14 + chi0 + 2*e*x11*x15 - 2*x16*(r_c + x1)))/I_Pb
     return nan
 
 
@@ -1187,8 +1223,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         alpha0 = p[4]
         theta0 = p[5]
         Omega_c = p[19]
-        x0 = (1/2)*Omega_c*t
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/2)*Omega_c*t
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1201,5 +1239,281 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x1 = t*x0
         x2 = alpha + theta0 + x1
         x3 = (1/2)*alpha - 1/2*alpha0
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading: P_in
+        4: contact_loading: D_c
+        5: contact_loading: D_f
+        6: contact_unloading: P_in
+        7: contact_unloading: D_c
+        8: contact_unloading: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = e*x14
+        x16 = alpha + theta0
+        x17 = x13 + x16
+        x18 = cos(x17)
+        x19 = 2*x18
+        x20 = cos(x9)
+        x21 = -2*chi0*x10*x20 + x11*x8 + x15*x19
+        x22 = Omega_c*e
+        x23 = x22*cos(x13)
+        x24 = 2*x11
+        x25 = 1 - x24
+        x26 = alpha_dot + x12
+        x27 = sin(x17)
+        x28 = x10*x20
+        x29 = 2*x28
+        x30 = alpha_dot*x8
+        x31 = pi*Y_e*l_lambda
+        x32 = alpha_dot*chi0*x25 + 2*e*x14*x26*x27 - x18*x23 - x28*x30
+        x33 = (1/4)*x31
+        x34 = beta_D*x33*abs(x21)
+        x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(Omega_c*t + x16)
+        x36 = -x21*x33 + x32*x34
+        x37 = -mu_m*x36*tanh(s*x35)
+        return alpha_dot*(-x36*(-chi0*x24 + chi0 + 2*e*x14*x27 - x29*(r_c + x6)) - x37*x6 - x7*(L_us - d_y - x2*x6 + x4)) + (1/8)*x21*x31*(-2*alpha_dot*chi0*x25 - 4*x15*x26*x27 + x19*x23 + x29*x30) + x32**2*x34 + x35*x37 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        x9 = x2*cos(x1)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Omega_c = p[19]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0)
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = (1/2)*Omega_c
+        x8 = t*x7
+        x9 = x0 + x8
+        x10 = cos(x9)
+        x11 = sin(x8)
+        x12 = cos(x4)
+        x13 = -2*chi0*x12*x5 + 2*e*x10*x11 + x3*x6
+        x14 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*x2*(-beta_D*x14*(alpha_dot*chi0*(1 - 2*x6) - alpha_dot*x12*x3*x5 + 2*e*x11*(alpha_dot + x7)*sin(x9) - x1*x10*cos(x8))*abs(x13) + x13*x14)*tanh(s*x2)
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = x13*cos(x9)
+        x15 = (1/2)*alpha - 1/2*alpha0
+        x16 = sin(x15)
+        x17 = x16**2
+        x18 = 2*x17
+        x19 = 1 - x18
+        x20 = alpha_dot + x8
+        x21 = sin(x9)
+        x22 = sin(x11)
+        x23 = cos(x15)
+        x24 = x16*x23
+        x25 = 2*r_c + w_b
+        x26 = alpha_dot*x25
+        x27 = alpha_dot*chi0*x19 + 2*e*x20*x21*x22 - x12*x14 - x24*x26
+        x28 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x29 = e*x21
+        x30 = 2*x12
+        x31 = -2*chi0*x16*x23 + x17*x25 + x29*x30
+        x32 = 2*x24
+        x33 = pi*Y_e*l_lambda
+        x34 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)
+        x35 = x27*x28 - 1/4*x31*x33
+        x36 = -mu_m*x35*tanh(s*x34)
+        return alpha_dot*(-x35*(-chi0*x18 + chi0 + 2*e*x21*x22 - x32*(r_c + x6)) - x36*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x27**2*x28 + (1/8)*x31*x33*(-2*alpha_dot*chi0*x19 + x14*x30 - 4*x20*x22*x29 + x26*x32) + x34*x36 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[14]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Omega_c = p[19]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0)
+        x3 = 2*r_c + w_b
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = (1/2)*Omega_c
+        x8 = t*x7
+        x9 = x0 + x8
+        x10 = cos(x9)
+        x11 = sin(x8)
+        x12 = cos(x4)
+        return mu_m*x2*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x6) - alpha_dot*x12*x3*x5 + 2*e*x11*(alpha_dot + x7)*sin(x9) - x1*x10*cos(x8))/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x12*x5 - 2*e*x10*x11 - x3*x6))*tanh(s*x2)
     return nan

@@ -126,7 +126,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -145,8 +146,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -185,32 +187,34 @@ def out_free(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = 2*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = sin(x9)
-    x16 = Theta_p*omega_c*cos(x6)
-    x17 = (1/2)*x16
-    x18 = tan(alpha)
-    x19 = (1/cos(alpha))
-    x20 = theta0 + (1/2)*x7
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (chi0*x1 - x10*x12 - x2*x5, 2*chi0*x5 - e*x12*x15 + x1*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x11*x15*(alpha_dot + (1/4)*x16) - x10*x17*cos(x8), k_s*(L_us + d_x*x18 - d_y - x13*x19), 0, 0, (1/2)*alpha_dot*w_b - e*x17*sin(alpha + x20) - r_c*x17, 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x13*log(x18 + x19)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = 2*x10
+    x12 = 2*x3
+    x13 = sin(x8)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_p*omega_c*cos(x5)
+    x18 = (1/2)*x17
+    x19 = cos(alpha)
+    x20 = 1/x19
+    x21 = x20*sin(alpha)
+    x22 = theta0 + (1/2)*x6
+    x23 = sin(alpha0)
+    x24 = cos(alpha0)
+    x25 = -chi0*x23 + e*sin(theta0) - e*sin(x22) + x15*x24
+    x26 = chi0*x24 + e*cos(theta0) - e*cos(x22) + x15*x23
+    return (2*chi0*x2*x4 - x0*x3 - x11*x9, chi0*x12 - e*x11*x13 + 2*x15*x16, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*(alpha_dot + (1/4)*x17) - x18*x9*cos(x7), k_s*(L_us + d_x*x21 - d_y - x14*x20), 0, 0, (1/2)*alpha_dot*w_b - e*x18*sin(alpha + x22) - r_c*x18, 0, asin(x15/sqrt(x25**2 + x26**2)) - atan2(x25, x26), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x19) - x14*log(x20 + x21)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -249,33 +253,35 @@ def out_free_v(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = 2*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = numpy.sin(x9)
-    x16 = Theta_p*omega_c*numpy.cos(x6)
-    x17 = (1/2)*x16
-    x18 = numpy.tan(alpha)
-    x19 = (numpy.cos(alpha)**(-1.0))
-    x20 = theta0 + (1/2)*x7
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = 2*x10
+    x12 = 2*x3
+    x13 = numpy.sin(x8)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_p*omega_c*numpy.cos(x5)
+    x18 = (1/2)*x17
+    x19 = numpy.cos(alpha)
+    x20 = x19**(-1.0)
+    x21 = x20*numpy.sin(alpha)
+    x22 = theta0 + (1/2)*x6
+    x23 = numpy.sin(alpha0)
+    x24 = numpy.cos(alpha0)
+    x25 = -chi0*x23 + e*numpy.sin(theta0) - e*numpy.sin(x22) + x15*x24
+    x26 = chi0*x24 + e*numpy.cos(theta0) - e*numpy.cos(x22) + x15*x23
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x10*x12 - x2*x5 + _zero, 2*chi0*x5 - e*x12*x15 + x1*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x11*x15*(alpha_dot + (1/4)*x16) - x10*x17*numpy.cos(x8) + _zero, k_s*(L_us + d_x*x18 - d_y - x13*x19) + _zero, 0 + _zero, 0 + _zero, (1/2)*alpha_dot*w_b - e*x17*numpy.sin(alpha + x20) - r_c*x17 + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x11*x9 + _zero, chi0*x12 - e*x11*x13 + 2*x15*x16 + _zero, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*(alpha_dot + (1/4)*x17) - x18*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x21 - d_y - x14*x20) + _zero, 0 + _zero, 0 + _zero, (1/2)*alpha_dot*w_b - e*x18*numpy.sin(alpha + x22) - r_c*x18 + _zero, 0 + _zero, numpy.arcsin(x15/numpy.sqrt(x25**2 + x26**2)) - numpy.arctan2(x25, x26) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x19) - x14*numpy.log(x20 + x21)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading(t, alpha, alpha_dot, p):
@@ -307,33 +313,34 @@ def rhs_contact_loading(t, alpha, alpha_dot, p):
     Y_e = p[16]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = (1/2)*w_b
-    x1 = r_c + x0
-    x2 = alpha - alpha0
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = (1/2)*alpha - 1/2*alpha0
     x3 = sin(x2)
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = omega_c*t
-    x8 = Theta_p*sin(x7)
-    x9 = (1/4)*x8
-    x10 = sin(x9)
-    x11 = alpha + theta0
-    x12 = x11 + x9
-    x13 = sin(x12)
-    x14 = 2*r_c + w_b
-    x15 = e*cos(x12)
-    x16 = 2*x10*x15
-    x17 = -chi0*x3 + x14*x6 + x16
-    x18 = (1/4)*pi*Y_e*l_lambda
-    x19 = cos(x2)
-    x20 = cos(x4)
-    x21 = Theta_p*omega_c*cos(x7)
-    x22 = (1/2)*x21
-    x23 = x22*cos(x9)
-    x24 = alpha_dot + (1/4)*x21
-    x25 = beta_D*x18*(alpha_dot*chi0*x19 - alpha_dot*x14*x20*x5 + 2*e*x10*x13*x24 - x15*x23)*abs(x17) - x17*x18
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x25*tanh(s*(2*alpha_dot*chi0*x20*x5 + alpha_dot*x1*x19 - e*x13*x23 - x16*x24 - (alpha_dot + x22)*(e*sin(x11 + (1/2)*x8) + r_c))) - x25*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+    x4 = x3**2
+    x5 = 2*x4
+    x6 = omega_c*t
+    x7 = Theta_p*sin(x6)
+    x8 = (1/4)*x7
+    x9 = sin(x8)
+    x10 = alpha + theta0
+    x11 = x10 + x8
+    x12 = sin(x11)
+    x13 = r_c + x1
+    x14 = cos(x2)
+    x15 = x14*x3
+    x16 = 2*r_c + w_b
+    x17 = e*cos(x11)
+    x18 = 2*x17*x9
+    x19 = -2*chi0*x14*x3 + x16*x4 + x18
+    x20 = (1/4)*pi*Y_e*l_lambda
+    x21 = 1 - x5
+    x22 = Theta_p*omega_c*cos(x6)
+    x23 = (1/2)*x22
+    x24 = x23*cos(x8)
+    x25 = alpha_dot + (1/4)*x22
+    x26 = beta_D*x20*(alpha_dot*chi0*x21 - alpha_dot*x15*x16 + 2*e*x12*x25*x9 - x17*x24)*abs(x19) - x19*x20
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x26*tanh(s*(2*alpha_dot*chi0*x14*x3 + alpha_dot*x13*x21 - e*x12*x24 - x18*x25 - (alpha_dot + x23)*(e*sin(x10 + (1/2)*x7) + r_c))) - x26*(-chi0*x5 + chi0 + 2*e*x12*x9 - 2*x13*x15))/I_Pb
 
 
 def jac_contact_loading(t, alpha, alpha_dot, p):
@@ -365,61 +372,64 @@ def jac_contact_loading(t, alpha, alpha_dot, p):
     Theta_p = p[19]
     omega_c = p[20]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
     x5 = cos(x4)
-    x6 = x3*x5
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = cos(x7)
-    x9 = sin(x7)
-    x10 = x8*x9
-    x11 = 2*chi0*x10
-    x12 = omega_c*t
-    x13 = Theta_p*sin(x12)
-    x14 = (1/4)*x13
-    x15 = alpha + theta0
-    x16 = x14 + x15
-    x17 = e*cos(x16)
-    x18 = sin(x14)
-    x19 = 2*x18
-    x20 = x17*x19
-    x21 = sin(x4)
-    x22 = 2*r_c + w_b
-    x23 = x9**2
-    x24 = x22*x23
-    x25 = -chi0*x21 + x20 + x24
-    x26 = (1/4)*pi*Y_e*l_lambda
-    x27 = x10*x22
-    x28 = Theta_p*omega_c*cos(x12)
-    x29 = alpha_dot + (1/4)*x28
-    x30 = sin(x16)
-    x31 = (1/2)*x28
-    x32 = x31*cos(x14)
-    x33 = -2*e*x18*x29*x30 + x17*x32
-    x34 = alpha_dot*chi0*x5 - alpha_dot*x27 - x33
-    x35 = abs(x25)
-    x36 = beta_D*x35
-    x37 = x26*x36
-    x38 = -x25*x26 + x34*x37
-    x39 = chi0*x23
-    x40 = x21*x3
-    x41 = alpha_dot + x31
-    x42 = (1/2)*x13 + x15
-    x43 = x8**2
-    x44 = e*sin(x42) + r_c
-    x45 = e*x30
-    x46 = x20*x29 + x32*x45
-    x47 = tanh(s*(2*alpha_dot*chi0*x8*x9 + alpha_dot*x3*x5 - x41*x44 - x46))
-    x48 = mu_m*x2
-    x49 = -s*x38*x48*(1 - x47**2)
-    x50 = x19*x45
-    x51 = chi0 - 2*x39 - x40 + x50
-    x52 = chi0*x5 - x27 + x50
-    x53 = x26*x52
-    x54 = -beta_D*x26*x34*x52*(0.0 if x25 == 0 else copysign(1, x25)) + x37*(-alpha_dot*chi0*x21 - 1/2*alpha_dot*x22*x43 + (1/2)*alpha_dot*x24 + x46) + x53
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - x38*(-x11 + x20 - x6) + x47*x48*x54 - x49*(alpha_dot*chi0*x43 - alpha_dot*x39 - alpha_dot*x40 - e*x41*cos(x42) - x33) - x51*x54), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x35*x47*x52 - x36*x51*x53 - x49*(x11 - x20 - x44 + x6)))
+    x6 = sin(x4)
+    x7 = x5*x6
+    x8 = 2*x7
+    x9 = chi0*x8
+    x10 = r_c + x3
+    x11 = x6**2
+    x12 = 2*x11
+    x13 = 1 - x12
+    x14 = x10*x13
+    x15 = omega_c*t
+    x16 = Theta_p*sin(x15)
+    x17 = (1/4)*x16
+    x18 = alpha + theta0
+    x19 = x17 + x18
+    x20 = e*cos(x19)
+    x21 = sin(x17)
+    x22 = 2*x21
+    x23 = x20*x22
+    x24 = 2*r_c + w_b
+    x25 = x11*x24
+    x26 = x23 - x9
+    x27 = x25 + x26
+    x28 = (1/4)*pi*Y_e*l_lambda
+    x29 = x24*x7
+    x30 = Theta_p*omega_c*cos(x15)
+    x31 = alpha_dot + (1/4)*x30
+    x32 = sin(x19)
+    x33 = (1/2)*x30
+    x34 = x33*cos(x17)
+    x35 = -2*e*x21*x31*x32 + x20*x34
+    x36 = alpha_dot*chi0*x13 - alpha_dot*x29 - x35
+    x37 = abs(x27)
+    x38 = beta_D*x37
+    x39 = x28*x38
+    x40 = -x27*x28 + x36*x39
+    x41 = alpha_dot*chi0
+    x42 = alpha_dot + x33
+    x43 = (1/2)*x16 + x18
+    x44 = x5**2
+    x45 = x10*x8
+    x46 = e*sin(x43) + r_c
+    x47 = e*x32
+    x48 = x23*x31 + x34*x47 - x41*x8
+    x49 = tanh(s*(alpha_dot*x10*x13 - x42*x46 - x48))
+    x50 = mu_m*x3
+    x51 = -s*x40*x50*(1 - x49**2)
+    x52 = x22*x47
+    x53 = -chi0*x12 + chi0 - x45 + x52
+    x54 = chi0*x13 - x29 + x52
+    x55 = x28*x54
+    x56 = (1/2)*alpha_dot
+    x57 = -beta_D*x28*x36*x54*(0.0 if x27 == 0 else copysign(1, x27)) + x39*(-x24*x44*x56 + x25*x56 + x48) + x55
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - x40*(-x14 + x23 - x9) + x49*x50*x57 - x51*(alpha_dot*chi0*x44 - alpha_dot*x45 - e*x42*cos(x43) - x11*x41 - x35) - x53*x57), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x37*x49*x54 - x38*x53*x55 - x51*(x14 - x26 - x46)))
 
 
 def out_contact_loading(t, alpha, alpha_dot, p):
@@ -463,61 +473,63 @@ def out_contact_loading(t, alpha, alpha_dot, p):
     Y_e = p[16]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*sin(alpha + x39)
-    x41 = 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40)
-    x42 = mu_m*x38*tanh(s*x41)
-    x43 = sin(alpha)
-    x44 = cos(alpha)
-    x45 = sin(alpha0)
-    x46 = cos(alpha0)
-    x47 = -chi0*x45 + e*sin(theta0) - e*sin(x39) + x18*x46
-    x48 = chi0*x46 + e*cos(theta0) - e*cos(x39) + x18*x45
-    x49 = x31 + x32
-    x50 = d_x*k_s
-    x51 = (1/8)*x34
-    x52 = x30**2*x36
-    x53 = x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
-    return (x16, x21, x30, x33, x38, x42, x41, -x37*x43 + x42*x44, asin(x18/sqrt(x47**2 + x48**2)) - atan2(x47, x48), (1/2)*I_Pb*alpha_dot**2 + x15**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*log(x44) - x17*log(x49)), alpha_dot*(-d_x*x33 - x17*x42 - x37*(chi0 - x21)) + x15*x51*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x50*(L_us*alpha_dot + alpha_dot*d_x*x43/x44 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x49) + x52 + x53, x52, x53)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*sin(alpha + x42)
+    x44 = 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43)
+    x45 = mu_m*x41*tanh(s*x44)
+    x46 = sin(alpha0)
+    x47 = cos(alpha0)
+    x48 = -chi0*x46 + e*sin(theta0) - e*sin(x42) + x19*x47
+    x49 = chi0*x47 + e*cos(theta0) - e*cos(x42) + x19*x46
+    x50 = x32 + x34
+    x51 = d_x*k_s
+    x52 = (1/8)*x37
+    x53 = x31**(-2)
+    x54 = x30**2*x39
+    x55 = x45*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
+    return (x15, x22, x30, x36, x41, x45, x44, x31*x45 - x33*x40, asin(x19/sqrt(x48**2 + x49**2)) - atan2(x48, x49), (1/2)*I_Pb*alpha_dot**2 + x14**2*x52 + x51*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x50)), alpha_dot*(-d_x*x36 - x18*x45 - x40*(chi0 - x22)) + x14*x52*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x51*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x53 + alpha_dot*(x33**2*x53 + 1))/x50) + x54 + x55, x54, x55)
 
 
 def out_contact_loading_v(t, alpha, alpha_dot, p):
@@ -561,62 +573,64 @@ def out_contact_loading_v(t, alpha, alpha_dot, p):
     Y_e = p[16]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_D*x35*abs(x15)
-    x37 = x16*x35 + x30*x36
-    x38 = -x37
-    x39 = theta0 + (1/2)*x7
-    x40 = e*numpy.sin(alpha + x39)
-    x41 = 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x40)
-    x42 = mu_m*x38*numpy.tanh(s*x41)
-    x43 = numpy.sin(alpha)
-    x44 = numpy.cos(alpha)
-    x45 = numpy.sin(alpha0)
-    x46 = numpy.cos(alpha0)
-    x47 = -chi0*x45 + e*numpy.sin(theta0) - e*numpy.sin(x39) + x18*x46
-    x48 = chi0*x46 + e*numpy.cos(theta0) - e*numpy.cos(x39) + x18*x45
-    x49 = x31 + x32
-    x50 = d_x*k_s
-    x51 = (1/8)*x34
-    x52 = x30**2*x36
-    x53 = x42*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x40)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = (1/4)*x37
+    x39 = beta_D*x38*abs(x14)
+    x40 = x15*x38 + x30*x39
+    x41 = -x40
+    x42 = theta0 + (1/2)*x6
+    x43 = e*numpy.sin(alpha + x42)
+    x44 = 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x43)
+    x45 = mu_m*x41*numpy.tanh(s*x44)
+    x46 = numpy.sin(alpha0)
+    x47 = numpy.cos(alpha0)
+    x48 = -chi0*x46 + e*numpy.sin(theta0) - e*numpy.sin(x42) + x19*x47
+    x49 = chi0*x47 + e*numpy.cos(theta0) - e*numpy.cos(x42) + x19*x46
+    x50 = x32 + x34
+    x51 = d_x*k_s
+    x52 = (1/8)*x37
+    x53 = x31**(-2.0)
+    x54 = x30**2*x39
+    x55 = x45*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x43)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x38 + _zero, x42 + _zero, x41 + _zero, -x37*x43 + x42*x44 + _zero, numpy.arcsin(x18/numpy.sqrt(x47**2 + x48**2)) - numpy.arctan2(x47, x48) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*numpy.log(x44) - x17*numpy.log(x49)) + _zero, alpha_dot*(-d_x*x33 - x17*x42 - x37*(chi0 - x21)) + x15*x51*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x50*(L_us*alpha_dot + alpha_dot*d_x*x43/x44 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x49) + x52 + x53 + _zero, x52 + _zero, x53 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x41 + _zero, x45 + _zero, x44 + _zero, x31*x45 - x33*x40 + _zero, numpy.arcsin(x19/numpy.sqrt(x48**2 + x49**2)) - numpy.arctan2(x48, x49) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x52 + x51*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x50)) + _zero, alpha_dot*(-d_x*x36 - x18*x45 - x40*(chi0 - x22)) + x14*x52*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x51*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x53 + alpha_dot*(x33**2*x53 + 1))/x50) + x54 + x55 + _zero, x54 + _zero, x55 + _zero)
 
 
 def rhs_contact_unloading(t, alpha, alpha_dot, p):
@@ -650,31 +664,32 @@ def rhs_contact_unloading(t, alpha, alpha_dot, p):
     vartheta = p[18]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = (1/2)*w_b
-    x1 = r_c + x0
-    x2 = alpha - alpha0
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = (1/2)*alpha - 1/2*alpha0
     x3 = sin(x2)
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = omega_c*t
-    x8 = Theta_p*sin(x7)
-    x9 = (1/4)*x8
-    x10 = sin(x9)
-    x11 = alpha + theta0
-    x12 = x11 + x9
-    x13 = sin(x12)
-    x14 = 2*r_c + w_b
-    x15 = e*cos(x12)
-    x16 = 2*x10*x15
-    x17 = cos(x2)
-    x18 = cos(x4)
-    x19 = Theta_p*omega_c*cos(x7)
-    x20 = (1/2)*x19
-    x21 = x20*cos(x9)
-    x22 = alpha_dot + (1/4)*x19
-    x23 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x17 - alpha_dot*x14*x18*x5 + 2*e*x10*x13*x22 - x15*x21)/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x3 - x14*x6 - x16)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x23*tanh(s*(2*alpha_dot*chi0*x18*x5 + alpha_dot*x1*x17 - e*x13*x21 - x16*x22 - (alpha_dot + x20)*(e*sin(x11 + (1/2)*x8) + r_c))) - x23*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+    x4 = x3**2
+    x5 = 2*x4
+    x6 = omega_c*t
+    x7 = Theta_p*sin(x6)
+    x8 = (1/4)*x7
+    x9 = sin(x8)
+    x10 = alpha + theta0
+    x11 = x10 + x8
+    x12 = sin(x11)
+    x13 = r_c + x1
+    x14 = cos(x2)
+    x15 = x14*x3
+    x16 = 2*r_c + w_b
+    x17 = e*cos(x11)
+    x18 = 2*x17*x9
+    x19 = 1 - x5
+    x20 = Theta_p*omega_c*cos(x6)
+    x21 = (1/2)*x20
+    x22 = x21*cos(x8)
+    x23 = alpha_dot + (1/4)*x20
+    x24 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x19 - alpha_dot*x15*x16 + 2*e*x12*x23*x9 - x17*x22)/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x14*x3 - x16*x4 - x18)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x24*tanh(s*(2*alpha_dot*chi0*x14*x3 + alpha_dot*x13*x19 - e*x12*x22 - x18*x23 - (alpha_dot + x21)*(e*sin(x10 + (1/2)*x7) + r_c))) - x24*(-chi0*x5 + chi0 + 2*e*x12*x9 - 2*x13*x15))/I_Pb
 
 
 def jac_contact_unloading(t, alpha, alpha_dot, p):
@@ -708,56 +723,59 @@ def jac_contact_unloading(t, alpha, alpha_dot, p):
     Theta_p = p[19]
     omega_c = p[20]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*alpha - 1/2*alpha0
     x5 = cos(x4)
-    x6 = x3*x5
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = cos(x7)
-    x9 = sin(x7)
-    x10 = x8*x9
-    x11 = 2*chi0*x10
-    x12 = omega_c*t
-    x13 = Theta_p*sin(x12)
-    x14 = (1/4)*x13
-    x15 = sin(x14)
-    x16 = 2*x15
-    x17 = alpha + theta0
-    x18 = x14 + x17
-    x19 = e*cos(x18)
-    x20 = x16*x19
-    x21 = sin(x4)
-    x22 = 2*r_c + w_b
-    x23 = x9**2
-    x24 = x22*x23
-    x25 = (1/4)*pi*Y_e*l_lambda
-    x26 = x10*x22
-    x27 = Theta_p*omega_c*cos(x12)
-    x28 = alpha_dot + (1/4)*x27
-    x29 = sin(x18)
-    x30 = (1/2)*x27
-    x31 = x30*cos(x14)
-    x32 = -2*e*x15*x28*x29 + x19*x31
-    x33 = chi_star**(-2)
-    x34 = 2*I_Pb*vartheta*x33*zeta_D
-    x35 = x25*(chi0*x21 - x20 - x24) + x34*(alpha_dot*chi0*x5 - alpha_dot*x26 - x32)
-    x36 = x21*x3
-    x37 = chi0*x23
-    x38 = chi0 + 2*e*x15*x29 - x36 - 2*x37
-    x39 = e*x29
-    x40 = chi0*x5 + x16*x39 - x26
-    x41 = x8**2
-    x42 = x20*x28 + x31*x39
-    x43 = x25*x40 + x34*(-alpha_dot*chi0*x21 - 1/2*alpha_dot*x22*x41 + (1/2)*alpha_dot*x24 + x42)
-    x44 = alpha_dot + x30
-    x45 = (1/2)*x13 + x17
-    x46 = e*sin(x45) + r_c
-    x47 = tanh(s*(2*alpha_dot*chi0*x8*x9 + alpha_dot*x3*x5 - x42 - x44*x46))
-    x48 = mu_m*x2
-    x49 = -s*x35*x48*(1 - x47**2)
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - x35*(-x11 + x20 - x6) - x38*x43 + x43*x47*x48 - x49*(alpha_dot*chi0*x41 - alpha_dot*x36 - alpha_dot*x37 - e*x44*cos(x45) - x32)), x0*(I_Pb*mu_m*vartheta*w_b*x33*x40*x47*zeta_D - x34*x38*x40 - x49*(x11 - x20 - x46 + x6)))
+    x6 = sin(x4)
+    x7 = x5*x6
+    x8 = 2*x7
+    x9 = chi0*x8
+    x10 = r_c + x3
+    x11 = x6**2
+    x12 = 2*x11
+    x13 = 1 - x12
+    x14 = x10*x13
+    x15 = omega_c*t
+    x16 = Theta_p*sin(x15)
+    x17 = (1/4)*x16
+    x18 = sin(x17)
+    x19 = 2*x18
+    x20 = alpha + theta0
+    x21 = x17 + x20
+    x22 = e*cos(x21)
+    x23 = x19*x22
+    x24 = 2*r_c + w_b
+    x25 = x11*x24
+    x26 = x23 - x9
+    x27 = (1/4)*pi*Y_e*l_lambda
+    x28 = x24*x7
+    x29 = Theta_p*omega_c*cos(x15)
+    x30 = alpha_dot + (1/4)*x29
+    x31 = sin(x21)
+    x32 = (1/2)*x29
+    x33 = x32*cos(x17)
+    x34 = -2*e*x18*x30*x31 + x22*x33
+    x35 = chi_star**(-2)
+    x36 = 2*I_Pb*vartheta*x35*zeta_D
+    x37 = x27*(-x25 - x26) + x36*(alpha_dot*chi0*x13 - alpha_dot*x28 - x34)
+    x38 = x10*x8
+    x39 = -chi0*x12 + chi0 + 2*e*x18*x31 - x38
+    x40 = e*x31
+    x41 = chi0*x13 + x19*x40 - x28
+    x42 = (1/2)*alpha_dot
+    x43 = x5**2
+    x44 = alpha_dot*chi0
+    x45 = x23*x30 + x33*x40 - x44*x8
+    x46 = x27*x41 + x36*(-x24*x42*x43 + x25*x42 + x45)
+    x47 = alpha_dot + x32
+    x48 = (1/2)*x16 + x20
+    x49 = e*sin(x48) + r_c
+    x50 = tanh(s*(alpha_dot*x10*x13 - x45 - x47*x49))
+    x51 = mu_m*x3
+    x52 = -s*x37*x51*(1 - x50**2)
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - x37*(-x14 + x23 - x9) - x39*x46 + x46*x50*x51 - x52*(alpha_dot*chi0*x43 - alpha_dot*x38 - e*x47*cos(x48) - x11*x44 - x34)), x0*(I_Pb*mu_m*vartheta*w_b*x35*x41*x50*zeta_D - x36*x39*x41 - x52*(x14 - x26 - x49)))
 
 
 def out_contact_unloading(t, alpha, alpha_dot, p):
@@ -803,60 +821,62 @@ def out_contact_unloading(t, alpha, alpha_dot, p):
     vartheta = p[18]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = cos(x9)
-    x11 = sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = cos(x0)
-    x23 = cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = cos(x8)
+    x10 = sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*cos(x5)
     x26 = (1/2)*x25
-    x27 = e*cos(x8)
-    x28 = x10*x27
+    x27 = e*cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = tan(alpha)
-    x32 = (1/cos(alpha))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = theta0 + (1/2)*x7
-    x39 = e*sin(alpha + x38)
-    x40 = 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x39)
-    x41 = mu_m*x37*tanh(s*x40)
-    x42 = sin(alpha)
-    x43 = cos(alpha)
-    x44 = sin(alpha0)
-    x45 = cos(alpha0)
-    x46 = -chi0*x44 + e*sin(theta0) - e*sin(x38) + x18*x45
-    x47 = chi0*x45 + e*cos(theta0) - e*cos(x38) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x35
-    x52 = x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x39)
-    return (x16, x21, x30, x33, x37, x41, x40, -x36*x42 + x41*x43, asin(x18/sqrt(x46**2 + x47**2)) - atan2(x46, x47), (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*log(x43) - x17*log(x48)), alpha_dot*(-d_x*x33 - x17*x41 - x36*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52, x51, x52)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = cos(alpha)
+    x32 = 1/x31
+    x33 = sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = theta0 + (1/2)*x6
+    x42 = e*sin(alpha + x41)
+    x43 = 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x42)
+    x44 = mu_m*x40*tanh(s*x43)
+    x45 = sin(alpha0)
+    x46 = cos(alpha0)
+    x47 = -chi0*x45 + e*sin(theta0) - e*sin(x41) + x19*x46
+    x48 = chi0*x46 + e*cos(theta0) - e*cos(x41) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2)
+    x53 = x30**2*x38
+    x54 = x44*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x42)
+    return (x15, x22, x30, x36, x40, x44, x43, x31*x44 - x33*x39, asin(x19/sqrt(x47**2 + x48**2)) - atan2(x47, x48), (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*log(x31) - x18*log(x49)), alpha_dot*(-d_x*x36 - x18*x44 - x39*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54, x53, x54)
 
 
 def out_contact_unloading_v(t, alpha, alpha_dot, p):
@@ -902,61 +922,63 @@ def out_contact_unloading_v(t, alpha, alpha_dot, p):
     vartheta = p[18]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = omega_c*t
-    x7 = Theta_p*numpy.sin(x6)
-    x8 = (1/4)*x7
-    x9 = alpha + theta0 + x8
-    x10 = numpy.cos(x9)
-    x11 = numpy.sin(x8)
-    x12 = e*x11
-    x13 = 2*x12
-    x14 = x10*x13
-    x15 = -chi0*x1 + x14 + x2*x5
-    x16 = -x15
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = 2*chi0
-    x20 = numpy.sin(x9)
-    x21 = x1*x18 - x13*x20 + x19*x5
-    x22 = numpy.cos(x0)
-    x23 = numpy.cos(x3)
-    x24 = alpha_dot*x2*x23*x4
-    x25 = Theta_p*omega_c*numpy.cos(x6)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = omega_c*t
+    x6 = Theta_p*numpy.sin(x5)
+    x7 = (1/4)*x6
+    x8 = alpha + theta0 + x7
+    x9 = numpy.cos(x8)
+    x10 = numpy.sin(x7)
+    x11 = e*x10
+    x12 = 2*x11
+    x13 = x12*x9
+    x14 = -2*chi0*x2*x4 + x0*x3 + x13
+    x15 = -x14
+    x16 = 2*x3
+    x17 = numpy.sin(x8)
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x16 - x12*x17 + x19*x21
+    x23 = 1 - x16
+    x24 = alpha_dot*x0
+    x25 = Theta_p*omega_c*numpy.cos(x5)
     x26 = (1/2)*x25
-    x27 = e*numpy.cos(x8)
-    x28 = x10*x27
+    x27 = e*numpy.cos(x7)
+    x28 = x27*x9
     x29 = alpha_dot + (1/4)*x25
-    x30 = alpha_dot*chi0*x22 + 2*e*x11*x20*x29 - x24 - x26*x28
-    x31 = numpy.tan(alpha)
-    x32 = (numpy.cos(alpha)**(-1.0))
-    x33 = k_s*(L_us + d_x*x31 - d_y - x17*x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x16*x34 + x30*x35
-    x37 = -x36
-    x38 = theta0 + (1/2)*x7
-    x39 = e*numpy.sin(alpha + x38)
-    x40 = 2*alpha_dot*chi0*x23*x4 + alpha_dot*x18*x22 - x14*x29 - x20*x26*x27 - (alpha_dot + x26)*(r_c + x39)
-    x41 = mu_m*x37*numpy.tanh(s*x40)
-    x42 = numpy.sin(alpha)
-    x43 = numpy.cos(alpha)
-    x44 = numpy.sin(alpha0)
-    x45 = numpy.cos(alpha0)
-    x46 = -chi0*x44 + e*numpy.sin(theta0) - e*numpy.sin(x38) + x18*x45
-    x47 = chi0*x45 + e*numpy.cos(theta0) - e*numpy.cos(x38) + x18*x44
-    x48 = x31 + x32
-    x49 = d_x*k_s
-    x50 = (1/8)*x34
-    x51 = x30**2*x35
-    x52 = x41*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x39)
+    x30 = alpha_dot*chi0*x23 + 2*e*x10*x17*x29 - x20*x24 - x26*x28
+    x31 = numpy.cos(alpha)
+    x32 = x31**(-1.0)
+    x33 = numpy.sin(alpha)
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x18*x32 + x35)
+    x37 = numpy.pi*Y_e*l_lambda
+    x38 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x39 = (1/4)*x15*x37 + x30*x38
+    x40 = -x39
+    x41 = theta0 + (1/2)*x6
+    x42 = e*numpy.sin(alpha + x41)
+    x43 = 2*alpha_dot*chi0*x2*x4 + alpha_dot*x19*x23 - x13*x29 - x17*x26*x27 - (alpha_dot + x26)*(r_c + x42)
+    x44 = mu_m*x40*numpy.tanh(s*x43)
+    x45 = numpy.sin(alpha0)
+    x46 = numpy.cos(alpha0)
+    x47 = -chi0*x45 + e*numpy.sin(theta0) - e*numpy.sin(x41) + x19*x46
+    x48 = chi0*x46 + e*numpy.cos(theta0) - e*numpy.cos(x41) + x19*x45
+    x49 = x32 + x34
+    x50 = d_x*k_s
+    x51 = (1/8)*x37
+    x52 = x31**(-2.0)
+    x53 = x30**2*x38
+    x54 = x44*((1/2)*alpha_dot*w_b - r_c*x26 - x26*x42)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x16 + _zero, x21 + _zero, x30 + _zero, x33 + _zero, x37 + _zero, x41 + _zero, x40 + _zero, -x36*x42 + x41*x43 + _zero, numpy.arcsin(x18/numpy.sqrt(x46**2 + x47**2)) - numpy.arctan2(x46, x47) + _zero, (1/2)*I_Pb*alpha_dot**2 + x15**2*x50 + x49*(L_us*alpha - alpha*d_y - d_x*numpy.log(x43) - x17*numpy.log(x48)) + _zero, alpha_dot*(-d_x*x33 - x17*x41 - x36*(chi0 - x21)) + x15*x50*(-alpha_dot*x19*x22 - 4*x12*x20*x29 + 2*x24 + x25*x28) + x49*(L_us*alpha_dot + alpha_dot*d_x*x42/x43 - alpha_dot*d_y - x17*(alpha_dot*x31*x32 + alpha_dot*(x31**2 + 1))/x48) + x51 + x52 + _zero, x51 + _zero, x52 + _zero)
+    return (x15 + _zero, x22 + _zero, x30 + _zero, x36 + _zero, x40 + _zero, x44 + _zero, x43 + _zero, x31*x44 - x33*x39 + _zero, numpy.arcsin(x19/numpy.sqrt(x47**2 + x48**2)) - numpy.arctan2(x47, x48) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x51 + x50*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x18*numpy.log(x49)) + _zero, alpha_dot*(-d_x*x36 - x18*x44 - x39*(chi0 - x22)) + x14*x51*(-2*alpha_dot*chi0*x23 - 4*x11*x17*x29 + x21*x24 + x25*x28) + x50*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x18*(alpha_dot*x33*x52 + alpha_dot*(x33**2*x52 + 1))/x49) + x53 + x54 + _zero, x53 + _zero, x54 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -978,8 +1000,10 @@ def gap(t, alpha, alpha_dot, p):
     theta0 = p[5]
     Theta_p = p[19]
     omega_c = p[20]
-    x0 = (1/4)*Theta_p*sin(omega_c*t)
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/4)*Theta_p*sin(omega_c*t)
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -1002,12 +1026,13 @@ def gap_rate(t, alpha, alpha_dot, p):
     Theta_p = p[19]
     omega_c = p[20]
     x0 = (1/2)*alpha - 1/2*alpha0
-    x1 = omega_c*t
-    x2 = (1/4)*Theta_p
-    x3 = x2*sin(x1)
-    x4 = alpha + theta0 + x3
-    x5 = omega_c*cos(x1)
-    return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+    x1 = sin(x0)
+    x2 = omega_c*t
+    x3 = (1/4)*Theta_p
+    x4 = x3*sin(x2)
+    x5 = alpha + theta0 + x4
+    x6 = omega_c*cos(x2)
+    return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
 
 
 def static_moment(alpha, p):
@@ -1033,25 +1058,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[16]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -1122,7 +1149,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1140,10 +1168,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1169,7 +1198,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1189,33 +1219,34 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         Y_e = p[16]
         Theta_p = p[19]
         omega_c = p[20]
-        x0 = (1/2)*w_b
-        x1 = r_c + x0
-        x2 = alpha - alpha0
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
         x3 = sin(x2)
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = omega_c*t
-        x8 = Theta_p*sin(x7)
-        x9 = (1/4)*x8
-        x10 = sin(x9)
-        x11 = alpha + theta0
-        x12 = x11 + x9
-        x13 = sin(x12)
-        x14 = 2*r_c + w_b
-        x15 = e*cos(x12)
-        x16 = 2*x10*x15
-        x17 = -chi0*x3 + x14*x6 + x16
-        x18 = (1/4)*pi*Y_e*l_lambda
-        x19 = cos(x2)
-        x20 = cos(x4)
-        x21 = Theta_p*omega_c*cos(x7)
-        x22 = (1/2)*x21
-        x23 = x22*cos(x9)
-        x24 = alpha_dot + (1/4)*x21
-        x25 = beta_D*x18*(alpha_dot*chi0*x19 - alpha_dot*x14*x20*x5 + 2*e*x10*x13*x24 - x15*x23)*abs(x17) - x17*x18
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x25*tanh(s*(2*alpha_dot*chi0*x20*x5 + alpha_dot*x1*x19 - e*x13*x23 - x16*x24 - (alpha_dot + x22)*(e*sin(x11 + (1/2)*x8) + r_c))) - x25*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+        x4 = x3**2
+        x5 = 2*x4
+        x6 = omega_c*t
+        x7 = Theta_p*sin(x6)
+        x8 = (1/4)*x7
+        x9 = sin(x8)
+        x10 = alpha + theta0
+        x11 = x10 + x8
+        x12 = sin(x11)
+        x13 = r_c + x1
+        x14 = cos(x2)
+        x15 = x14*x3
+        x16 = 2*r_c + w_b
+        x17 = e*cos(x11)
+        x18 = 2*x17*x9
+        x19 = -2*chi0*x14*x3 + x16*x4 + x18
+        x20 = (1/4)*pi*Y_e*l_lambda
+        x21 = 1 - x5
+        x22 = Theta_p*omega_c*cos(x6)
+        x23 = (1/2)*x22
+        x24 = x23*cos(x8)
+        x25 = alpha_dot + (1/4)*x22
+        x26 = beta_D*x20*(alpha_dot*chi0*x21 - alpha_dot*x15*x16 + 2*e*x12*x25*x9 - x17*x24)*abs(x19) - x19*x20
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x26*tanh(s*(2*alpha_dot*chi0*x14*x3 + alpha_dot*x13*x21 - e*x12*x24 - x18*x25 - (alpha_dot + x23)*(e*sin(x10 + (1/2)*x7) + r_c))) - x26*(-chi0*x5 + chi0 + 2*e*x12*x9 - 2*x13*x15))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1237,31 +1268,32 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         vartheta = p[18]
         Theta_p = p[19]
         omega_c = p[20]
-        x0 = (1/2)*w_b
-        x1 = r_c + x0
-        x2 = alpha - alpha0
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
         x3 = sin(x2)
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = omega_c*t
-        x8 = Theta_p*sin(x7)
-        x9 = (1/4)*x8
-        x10 = sin(x9)
-        x11 = alpha + theta0
-        x12 = x11 + x9
-        x13 = sin(x12)
-        x14 = 2*r_c + w_b
-        x15 = e*cos(x12)
-        x16 = 2*x10*x15
-        x17 = cos(x2)
-        x18 = cos(x4)
-        x19 = Theta_p*omega_c*cos(x7)
-        x20 = (1/2)*x19
-        x21 = x20*cos(x9)
-        x22 = alpha_dot + (1/4)*x19
-        x23 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x17 - alpha_dot*x14*x18*x5 + 2*e*x10*x13*x22 - x15*x21)/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x3 - x14*x6 - x16)
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x23*tanh(s*(2*alpha_dot*chi0*x18*x5 + alpha_dot*x1*x17 - e*x13*x21 - x16*x22 - (alpha_dot + x20)*(e*sin(x11 + (1/2)*x8) + r_c))) - x23*(-2*chi0*x6 + chi0 + 2*e*x10*x13 - x1*x3))/I_Pb
+        x4 = x3**2
+        x5 = 2*x4
+        x6 = omega_c*t
+        x7 = Theta_p*sin(x6)
+        x8 = (1/4)*x7
+        x9 = sin(x8)
+        x10 = alpha + theta0
+        x11 = x10 + x8
+        x12 = sin(x11)
+        x13 = r_c + x1
+        x14 = cos(x2)
+        x15 = x14*x3
+        x16 = 2*r_c + w_b
+        x17 = e*cos(x11)
+        x18 = 2*x17*x9
+        x19 = 1 - x5
+        x20 = Theta_p*omega_c*cos(x6)
+        x21 = (1/2)*x20
+        x22 = x21*cos(x8)
+        x23 = alpha_dot + (1/4)*x20
+        x24 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x19 - alpha_dot*x15*x16 + 2*e*x12*x23*x9 - x17*x22)/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x14*x3 - x16*x4 - x18)
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x24*tanh(s*(2*alpha_dot*chi0*x14*x3 + alpha_dot*x13*x19 - e*x12*x22 - x18*x23 - (alpha_dot + x21)*(e*sin(x10 + (1/2)*x7) + r_c))) - x24*(-chi0*x5 + chi0 + 2*e*x12*x9 - 2*x13*x15))/I_Pb
     return nan
 
 
@@ -1289,8 +1321,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         theta0 = p[5]
         Theta_p = p[19]
         omega_c = p[20]
-        x0 = (1/4)*Theta_p*sin(omega_c*t)
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/4)*Theta_p*sin(omega_c*t)
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1301,10 +1335,321 @@ def surface_index(k, t, alpha, alpha_dot, p):
         Theta_p = p[19]
         omega_c = p[20]
         x0 = (1/2)*alpha - 1/2*alpha0
-        x1 = omega_c*t
-        x2 = (1/4)*Theta_p
-        x3 = x2*sin(x1)
-        x4 = alpha + theta0 + x3
-        x5 = omega_c*cos(x1)
-        return -1/2*Theta_p*e*x5*cos(x3)*cos(x4) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x0)*cos(x0) + 2*e*(alpha_dot + x2*x5)*sin(x3)*sin(x4)
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return -1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading: P_in
+        4: contact_loading: D_c
+        5: contact_loading: D_f
+        6: contact_unloading: P_in
+        7: contact_unloading: D_c
+        8: contact_unloading: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = 2*r_c + w_b
+        x9 = (1/2)*alpha - 1/2*alpha0
+        x10 = sin(x9)
+        x11 = x10**2
+        x12 = cos(x9)
+        x13 = omega_c*t
+        x14 = Theta_p*sin(x13)
+        x15 = (1/4)*x14
+        x16 = alpha + theta0
+        x17 = x15 + x16
+        x18 = cos(x17)
+        x19 = sin(x15)
+        x20 = e*x19
+        x21 = 2*x18*x20
+        x22 = -2*chi0*x10*x12 + x11*x8 + x21
+        x23 = 2*x11
+        x24 = 1 - x23
+        x25 = x10*x12
+        x26 = 2*x25
+        x27 = alpha_dot*x8
+        x28 = Theta_p*omega_c*cos(x13)
+        x29 = e*cos(x15)
+        x30 = x18*x29
+        x31 = sin(x17)
+        x32 = alpha_dot + (1/4)*x28
+        x33 = pi*Y_e*l_lambda
+        x34 = (1/2)*x28
+        x35 = alpha_dot*chi0*x24 + 2*e*x19*x31*x32 - x25*x27 - x30*x34
+        x36 = (1/4)*x33
+        x37 = beta_D*x36*abs(x22)
+        x38 = e*sin((1/2)*x14 + x16)
+        x39 = -x22*x36 + x35*x37
+        x40 = r_c + x6
+        x41 = -mu_m*x39*tanh(s*(2*alpha_dot*chi0*x10*x12 + alpha_dot*x24*x40 - x21*x32 - x29*x31*x34 - (alpha_dot + x34)*(r_c + x38)))
+        return alpha_dot*(-x39*(-chi0*x23 + chi0 + 2*e*x19*x31 - x26*x40) - x41*x6 - x7*(L_us - d_y - x2*x6 + x4)) + (1/8)*x22*x33*(-2*alpha_dot*chi0*x24 - 4*x20*x31*x32 + x26*x27 + x28*x30) + x35**2*x37 + x41*((1/2)*alpha_dot*w_b - r_c*x34 - x34*x38) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = x2*cos(x1)
+        x5 = omega_c*t
+        x6 = (1/4)*Theta_p
+        x7 = x6*sin(x5)
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = omega_c*cos(x5)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(-1/2*Theta_p*x11*x9*cos(x7) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x4 + 2*e*x10*(alpha_dot + x11*x6)*sin(x8))**2*abs(-2*chi0*x4 + x0*x3 + 2*x10*x9)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        beta_D = p[15]
+        Y_e = p[16]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = e*sin((1/2)*x3 + x4)
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = cos(x6)
+        x9 = x7**2
+        x10 = 1 - 2*x9
+        x11 = (1/4)*x3
+        x12 = x11 + x4
+        x13 = sin(x12)
+        x14 = x2*cos(x11)
+        x15 = alpha_dot + (1/4)*x1
+        x16 = e*cos(x12)
+        x17 = sin(x11)
+        x18 = 2*x16*x17
+        x19 = 2*r_c + w_b
+        x20 = -2*chi0*x7*x8 + x18 + x19*x9
+        x21 = (1/4)*pi*Y_e*l_lambda
+        return mu_m*(-beta_D*x21*(alpha_dot*chi0*x10 - alpha_dot*x19*x7*x8 + 2*e*x13*x15*x17 - x14*x16)*abs(x20) + x20*x21)*((1/2)*alpha_dot*w_b - r_c*x2 - x2*x5)*tanh(s*(2*alpha_dot*chi0*x7*x8 + alpha_dot*x10*(r_c + (1/2)*w_b) - e*x13*x14 - x15*x18 - (alpha_dot + x2)*(r_c + x5)))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = x9**2
+        x11 = 2*x10
+        x12 = 1 - x11
+        x13 = cos(x8)
+        x14 = x13*x9
+        x15 = 2*r_c + w_b
+        x16 = alpha_dot*x15
+        x17 = omega_c*t
+        x18 = Theta_p*omega_c*cos(x17)
+        x19 = (1/2)*x18
+        x20 = Theta_p*sin(x17)
+        x21 = (1/4)*x20
+        x22 = alpha + theta0
+        x23 = x21 + x22
+        x24 = cos(x23)
+        x25 = e*cos(x21)
+        x26 = x24*x25
+        x27 = sin(x21)
+        x28 = alpha_dot + (1/4)*x18
+        x29 = sin(x23)
+        x30 = alpha_dot*chi0*x12 + 2*e*x27*x28*x29 - x14*x16 - x19*x26
+        x31 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x32 = e*x27
+        x33 = 2*x24*x32
+        x34 = -2*chi0*x13*x9 + x10*x15 + x33
+        x35 = 2*x14
+        x36 = pi*Y_e*l_lambda
+        x37 = e*sin((1/2)*x20 + x22)
+        x38 = x30*x31 - 1/4*x34*x36
+        x39 = r_c + x6
+        x40 = -mu_m*x38*tanh(s*(2*alpha_dot*chi0*x13*x9 + alpha_dot*x12*x39 - x19*x25*x29 - x28*x33 - (alpha_dot + x19)*(r_c + x37)))
+        return alpha_dot*(-x38*(-chi0*x11 + chi0 + 2*e*x27*x29 - x35*x39) - x40*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x30**2*x31 + (1/8)*x34*x36*(-2*alpha_dot*chi0*x12 + x16*x35 + x18*x26 - 4*x28*x29*x32) + x40*((1/2)*alpha_dot*w_b - r_c*x19 - x19*x37) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[14]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = omega_c*t
+        x3 = (1/4)*Theta_p
+        x4 = x3*sin(x2)
+        x5 = alpha + theta0 + x4
+        x6 = omega_c*cos(x2)
+        return 2*I_Pb*vartheta*zeta_D*(-1/2*Theta_p*e*x6*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*(alpha_dot + x3*x6)*sin(x4)*sin(x5))**2/chi_star**2
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        l_lambda = p[11]
+        mu_m = p[12]
+        s = p[13]
+        zeta_D = p[14]
+        Y_e = p[16]
+        chi_star = p[17]
+        vartheta = p[18]
+        Theta_p = p[19]
+        omega_c = p[20]
+        x0 = omega_c*t
+        x1 = Theta_p*omega_c*cos(x0)
+        x2 = (1/2)*x1
+        x3 = Theta_p*sin(x0)
+        x4 = alpha + theta0
+        x5 = e*sin((1/2)*x3 + x4)
+        x6 = (1/2)*alpha - 1/2*alpha0
+        x7 = sin(x6)
+        x8 = cos(x6)
+        x9 = x7**2
+        x10 = 1 - 2*x9
+        x11 = (1/4)*x3
+        x12 = x11 + x4
+        x13 = sin(x12)
+        x14 = x2*cos(x11)
+        x15 = alpha_dot + (1/4)*x1
+        x16 = e*cos(x12)
+        x17 = sin(x11)
+        x18 = 2*x16*x17
+        x19 = 2*r_c + w_b
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*x10 - alpha_dot*x19*x7*x8 + 2*e*x13*x15*x17 - x14*x16)/chi_star**2 - 1/4*pi*Y_e*l_lambda*(2*chi0*x7*x8 - x18 - x19*x9))*((1/2)*alpha_dot*w_b - r_c*x2 - x2*x5)*tanh(s*(2*alpha_dot*chi0*x7*x8 + alpha_dot*x10*(r_c + (1/2)*w_b) - e*x13*x14 - x15*x18 - (alpha_dot + x2)*(r_c + x5)))
     return nan

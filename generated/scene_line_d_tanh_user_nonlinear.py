@@ -85,7 +85,8 @@ def rhs_free(t, alpha, alpha_dot, p, cam):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p, cam):
@@ -106,8 +107,9 @@ def jac_free(t, alpha, alpha_dot, p, cam):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p, cam):
@@ -146,30 +148,32 @@ def out_free(t, alpha, alpha_dot, p, cam):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = alpha + x6 + x7
-    x9 = cos(x8)
-    x10 = x6 - x7
-    x11 = sin(x10)
-    x12 = 2*e*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = sin(x8)
-    x16 = Theta_dot*e
-    x17 = tan(alpha)
-    x18 = (1/cos(alpha))
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 - e*sin(Theta) + e*sin(theta0) + x14*x20
-    x22 = chi0*x20 - e*cos(Theta) + e*cos(theta0) + x14*x19
-    return (chi0*x1 - x12*x9 - x2*x5, 2*chi0*x5 + x1*x14 - x12*x15, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x11*x15*((1/2)*Theta_dot + alpha_dot) - x16*x9*cos(x10), k_s*(L_us + d_x*x17 - d_y - x13*x18), 0, 0, -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x16*sin(Theta + alpha), 0, asin(x14/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x13*log(x17 + x18)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = alpha + x5 + x6
+    x8 = cos(x7)
+    x9 = x5 - x6
+    x10 = sin(x9)
+    x11 = 2*e*x10
+    x12 = 2*x3
+    x13 = sin(x7)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_dot*e
+    x18 = cos(alpha)
+    x19 = 1/x18
+    x20 = x19*sin(alpha)
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 - e*sin(Theta) + e*sin(theta0) + x15*x22
+    x24 = chi0*x22 - e*cos(Theta) + e*cos(theta0) + x15*x21
+    return (2*chi0*x2*x4 - x0*x3 - x11*x8, chi0*x12 - x11*x13 + 2*x15*x16, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*((1/2)*Theta_dot + alpha_dot) - x17*x8*cos(x9), k_s*(L_us + d_x*x20 - d_y - x14*x19), 0, 0, -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x17*sin(Theta + alpha), 0, asin(x15/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x18) - x14*log(x19 + x20)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p, cam):
@@ -208,31 +212,33 @@ def out_free_v(t, alpha, alpha_dot, p, cam):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = alpha + x6 + x7
-    x9 = numpy.cos(x8)
-    x10 = x6 - x7
-    x11 = numpy.sin(x10)
-    x12 = 2*e*x11
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = numpy.sin(x8)
-    x16 = Theta_dot*e
-    x17 = numpy.tan(alpha)
-    x18 = (numpy.cos(alpha)**(-1.0))
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x14*x20
-    x22 = chi0*x20 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x14*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = alpha + x5 + x6
+    x8 = numpy.cos(x7)
+    x9 = x5 - x6
+    x10 = numpy.sin(x9)
+    x11 = 2*e*x10
+    x12 = 2*x3
+    x13 = numpy.sin(x7)
+    x14 = (1/2)*w_b
+    x15 = r_c + x14
+    x16 = x2*x4
+    x17 = Theta_dot*e
+    x18 = numpy.cos(alpha)
+    x19 = x18**(-1.0)
+    x20 = x19*numpy.sin(alpha)
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x15*x22
+    x24 = chi0*x22 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x15*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x12*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x14 - x12*x15 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x11*x15*((1/2)*Theta_dot + alpha_dot) - x16*x9*numpy.cos(x10) + _zero, k_s*(L_us + d_x*x17 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(Theta + alpha) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x13*numpy.log(x17 + x18)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x11*x8 + _zero, chi0*x12 - x11*x13 + 2*x15*x16 + _zero, alpha_dot*chi0*(1 - x12) - alpha_dot*x0*x16 + 2*e*x10*x13*((1/2)*Theta_dot + alpha_dot) - x17*x8*numpy.cos(x9) + _zero, k_s*(L_us + d_x*x20 - d_y - x14*x19) + _zero, 0 + _zero, 0 + _zero, -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x17*numpy.sin(Theta + alpha) + _zero, 0 + _zero, numpy.arcsin(x15/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x18) - x14*numpy.log(x19 + x20)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading(t, alpha, alpha_dot, p, cam):
@@ -264,25 +270,27 @@ def rhs_contact_loading(t, alpha, alpha_dot, p, cam):
     s = p[13]
     beta_D = p[15]
     Y_e = p[16]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = (1/2)*Theta
     x8 = (1/2)*theta0
     x9 = alpha + x7 + x8
     x10 = cos(x9)
     x11 = x7 - x8
     x12 = sin(x11)
-    x13 = -chi0*x2 + 2*e*x10*x12 + x3*x6
+    x13 = -2*chi0*x4*x6 + 2*e*x10*x12 + x2*x5
     x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = Theta_dot*e
-    x16 = sin(x9)
-    x17 = beta_D*x14*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x16*((1/2)*Theta_dot + alpha_dot) - x10*x15*cos(x11))*abs(x13) - x13*x14
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x17*tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x15*sin(Theta + alpha))) - x17*(-2*chi0*x6 + chi0 + 2*e*x12*x16 - x2*(r_c + x0)))/I_Pb
+    x15 = 2*x5
+    x16 = Theta_dot*e
+    x17 = x4*x6
+    x18 = sin(x9)
+    x19 = beta_D*x14*(alpha_dot*chi0*(1 - x15) - alpha_dot*x17*x2 + 2*e*x12*x18*((1/2)*Theta_dot + alpha_dot) - x10*x16*cos(x11))*abs(x13) - x13*x14
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x19*tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x16*sin(Theta + alpha))) - x19*(-chi0*x15 + chi0 + 2*e*x12*x18 - 2*x17*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading(t, alpha, alpha_dot, p, cam):
@@ -314,51 +322,52 @@ def jac_contact_loading(t, alpha, alpha_dot, p, cam):
     beta_D = p[15]
     Y_e = p[16]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = Theta + alpha
-    x4 = Theta_dot*e
-    x5 = tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x4*sin(x3)))
-    x6 = 1 - x5**2
-    x7 = alpha - alpha0
-    x8 = sin(x7)
-    x9 = 2*r_c + w_b
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = sin(x10)
-    x12 = x11**2
-    x13 = x12*x9
-    x14 = (1/2)*Theta
-    x15 = (1/2)*theta0
-    x16 = alpha + x14 + x15
-    x17 = cos(x16)
-    x18 = x14 - x15
-    x19 = sin(x18)
-    x20 = 2*e*x19
-    x21 = x17*x20
-    x22 = -chi0*x8 + x13 + x21
-    x23 = (1/4)*pi*Y_e*l_lambda
-    x24 = cos(x7)
-    x25 = x4*cos(x18)
-    x26 = cos(x10)
-    x27 = x11*x26
-    x28 = x27*x9
-    x29 = (1/2)*Theta_dot + alpha_dot
-    x30 = sin(x16)
-    x31 = alpha_dot*chi0*x24 - alpha_dot*x28 + 2*e*x19*x29*x30 - x17*x25
-    x32 = abs(x22)
-    x33 = beta_D*x32
-    x34 = x23*x33
-    x35 = -x22*x23 + x31*x34
-    x36 = -x35
-    x37 = r_c + x2
-    x38 = 2*chi0
-    x39 = x20*x30
-    x40 = chi0*x24 - x28 + x39
-    x41 = x23*x40
-    x42 = (1/2)*alpha_dot
-    x43 = -beta_D*x23*x31*x40*(0.0 if x22 == 0 else copysign(1, x22)) + x34*(-alpha_dot*chi0*x8 + x13*x42 + x21*x29 + x25*x30 - x26**2*x42*x9) + x41
-    x44 = chi0 - x12*x38 - x37*x8 + x39
-    return (x0*((1/2)*Theta_dot*e*mu_m*s*w_b*x36*x6*cos(x3) - d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x43*x5 - x35*(x21 - x24*x37 - x27*x38) - x43*x44), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x32*x40*x5 - 1/4*mu_m*s*w_b**2*x36*x6 - x33*x41*x44))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = Theta + alpha
+    x5 = Theta_dot*e
+    x6 = tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x5*sin(x4)))
+    x7 = 1 - x6**2
+    x8 = 2*r_c + w_b
+    x9 = (1/2)*alpha - 1/2*alpha0
+    x10 = sin(x9)
+    x11 = x10**2
+    x12 = x11*x8
+    x13 = cos(x9)
+    x14 = x10*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = (1/2)*Theta
+    x18 = (1/2)*theta0
+    x19 = alpha + x17 + x18
+    x20 = cos(x19)
+    x21 = x17 - x18
+    x22 = sin(x21)
+    x23 = 2*e*x22
+    x24 = x20*x23
+    x25 = x12 - x16 + x24
+    x26 = (1/4)*pi*Y_e*l_lambda
+    x27 = 2*x11
+    x28 = 1 - x27
+    x29 = x5*cos(x21)
+    x30 = x14*x8
+    x31 = (1/2)*Theta_dot + alpha_dot
+    x32 = sin(x19)
+    x33 = alpha_dot*chi0*x28 - alpha_dot*x30 + 2*e*x22*x31*x32 - x20*x29
+    x34 = abs(x25)
+    x35 = beta_D*x34
+    x36 = x26*x35
+    x37 = -x25*x26 + x33*x36
+    x38 = -x37
+    x39 = r_c + x3
+    x40 = x23*x32
+    x41 = chi0*x28 - x30 + x40
+    x42 = x26*x41
+    x43 = (1/2)*alpha_dot
+    x44 = -beta_D*x26*x33*x41*(0.0 if x25 == 0 else copysign(1, x25)) + x36*(-alpha_dot*x16 + x12*x43 - x13**2*x43*x8 + x24*x31 + x29*x32) + x42
+    x45 = -chi0*x27 + chi0 - x15*x39 + x40
+    return (x0*((1/2)*Theta_dot*e*mu_m*s*w_b*x38*x7*cos(x4) - d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x44*x6 - x37*(-x16 + x24 - x28*x39) - x44*x45), x0*((1/8)*pi*Y_e*beta_D*l_lambda*mu_m*w_b*x34*x41*x6 - 1/4*mu_m*s*w_b**2*x38*x7 - x35*x42*x45))
 
 
 def out_contact_loading(t, alpha, alpha_dot, p, cam):
@@ -402,56 +411,59 @@ def out_contact_loading(t, alpha, alpha_dot, p, cam):
     s = p[13]
     beta_D = p[15]
     Y_e = p[16]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = x6 - x7
-    x9 = sin(x8)
-    x10 = e*x9
-    x11 = alpha + x6 + x7
-    x12 = cos(x11)
-    x13 = 2*x12
-    x14 = -chi0*x1 + x10*x13 + x2*x5
-    x15 = -x14
-    x16 = (1/2)*w_b
-    x17 = r_c + x16
-    x18 = 2*chi0
-    x19 = sin(x11)
-    x20 = x10*x19
-    x21 = x1*x17 + x18*x5 - 2*x20
-    x22 = cos(x0)
-    x23 = Theta_dot*e
-    x24 = x23*cos(x8)
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = (1/2)*Theta_dot + alpha_dot
-    x27 = alpha_dot*chi0*x22 + 2*e*x19*x26*x9 - x12*x24 - x25
-    x28 = tan(alpha)
-    x29 = (1/cos(alpha))
-    x30 = k_s*(L_us + d_x*x28 - d_y - x16*x29)
-    x31 = pi*Y_e*l_lambda
-    x32 = (1/4)*x31
-    x33 = beta_D*x32*abs(x14)
-    x34 = x15*x32 + x27*x33
-    x35 = -x34
-    x36 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x23*sin(Theta + alpha)
-    x37 = mu_m*x35*tanh(s*x36)
-    x38 = sin(alpha)
-    x39 = cos(alpha)
-    x40 = sin(alpha0)
-    x41 = cos(alpha0)
-    x42 = -chi0*x40 - e*sin(Theta) + e*sin(theta0) + x17*x41
-    x43 = chi0*x41 - e*cos(Theta) + e*cos(theta0) + x17*x40
-    x44 = x28 + x29
-    x45 = d_x*k_s
-    x46 = (1/8)*x31
-    x47 = x27**2*x33
-    x48 = x36*x37
-    return (x15, x21, x27, x30, x35, x37, x36, -x34*x38 + x37*x39, asin(x17/sqrt(x42**2 + x43**2)) - atan2(x42, x43), (1/2)*I_Pb*alpha_dot**2 + x14**2*x46 + x45*(L_us*alpha - alpha*d_y - d_x*log(x39) - x16*log(x44)), alpha_dot*(-d_x*x30 - x16*x37 - x34*(chi0 - x21)) + x14*x46*(-alpha_dot*x18*x22 + x13*x24 - 4*x20*x26 + 2*x25) + x45*(L_us*alpha_dot + alpha_dot*d_x*x38/x39 - alpha_dot*d_y - x16*(alpha_dot*x28*x29 + alpha_dot*(x28**2 + 1))/x44) + x47 + x48, x47, x48)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = x5 - x6
+    x8 = sin(x7)
+    x9 = e*x8
+    x10 = alpha + x5 + x6
+    x11 = cos(x10)
+    x12 = 2*x11
+    x13 = -2*chi0*x2*x4 + x0*x3 + x12*x9
+    x14 = -x13
+    x15 = 2*x3
+    x16 = sin(x10)
+    x17 = x16*x9
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x15 - 2*x17 + x19*x21
+    x23 = 1 - x15
+    x24 = Theta_dot*e
+    x25 = x24*cos(x7)
+    x26 = alpha_dot*x0
+    x27 = (1/2)*Theta_dot + alpha_dot
+    x28 = alpha_dot*chi0*x23 + 2*e*x16*x27*x8 - x11*x25 - x20*x26
+    x29 = cos(alpha)
+    x30 = 1/x29
+    x31 = sin(alpha)
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x18*x30 + x33)
+    x35 = pi*Y_e*l_lambda
+    x36 = (1/4)*x35
+    x37 = beta_D*x36*abs(x13)
+    x38 = x14*x36 + x28*x37
+    x39 = -x38
+    x40 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x24*sin(Theta + alpha)
+    x41 = mu_m*x39*tanh(s*x40)
+    x42 = sin(alpha0)
+    x43 = cos(alpha0)
+    x44 = -chi0*x42 - e*sin(Theta) + e*sin(theta0) + x19*x43
+    x45 = chi0*x43 - e*cos(Theta) + e*cos(theta0) + x19*x42
+    x46 = x30 + x32
+    x47 = d_x*k_s
+    x48 = (1/8)*x35
+    x49 = x29**(-2)
+    x50 = x28**2*x37
+    x51 = x40*x41
+    return (x14, x22, x28, x34, x39, x41, x40, x29*x41 - x31*x38, asin(x19/sqrt(x44**2 + x45**2)) - atan2(x44, x45), (1/2)*I_Pb*alpha_dot**2 + x13**2*x48 + x47*(L_us*alpha - alpha*d_y - d_x*log(x29) - x18*log(x46)), alpha_dot*(-d_x*x34 - x18*x41 - x38*(chi0 - x22)) + x13*x48*(-2*alpha_dot*chi0*x23 + x12*x25 - 4*x17*x27 + x21*x26) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x18*(alpha_dot*x31*x49 + alpha_dot*(x31**2*x49 + 1))/x46) + x50 + x51, x50, x51)
 
 
 def out_contact_loading_v(t, alpha, alpha_dot, p, cam):
@@ -495,57 +507,60 @@ def out_contact_loading_v(t, alpha, alpha_dot, p, cam):
     s = p[13]
     beta_D = p[15]
     Y_e = p[16]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = x6 - x7
-    x9 = numpy.sin(x8)
-    x10 = e*x9
-    x11 = alpha + x6 + x7
-    x12 = numpy.cos(x11)
-    x13 = 2*x12
-    x14 = -chi0*x1 + x10*x13 + x2*x5
-    x15 = -x14
-    x16 = (1/2)*w_b
-    x17 = r_c + x16
-    x18 = 2*chi0
-    x19 = numpy.sin(x11)
-    x20 = x10*x19
-    x21 = x1*x17 + x18*x5 - 2*x20
-    x22 = numpy.cos(x0)
-    x23 = Theta_dot*e
-    x24 = x23*numpy.cos(x8)
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = (1/2)*Theta_dot + alpha_dot
-    x27 = alpha_dot*chi0*x22 + 2*e*x19*x26*x9 - x12*x24 - x25
-    x28 = numpy.tan(alpha)
-    x29 = (numpy.cos(alpha)**(-1.0))
-    x30 = k_s*(L_us + d_x*x28 - d_y - x16*x29)
-    x31 = numpy.pi*Y_e*l_lambda
-    x32 = (1/4)*x31
-    x33 = beta_D*x32*abs(x14)
-    x34 = x15*x32 + x27*x33
-    x35 = -x34
-    x36 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x23*numpy.sin(Theta + alpha)
-    x37 = mu_m*x35*numpy.tanh(s*x36)
-    x38 = numpy.sin(alpha)
-    x39 = numpy.cos(alpha)
-    x40 = numpy.sin(alpha0)
-    x41 = numpy.cos(alpha0)
-    x42 = -chi0*x40 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x17*x41
-    x43 = chi0*x41 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x17*x40
-    x44 = x28 + x29
-    x45 = d_x*k_s
-    x46 = (1/8)*x31
-    x47 = x27**2*x33
-    x48 = x36*x37
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = x5 - x6
+    x8 = numpy.sin(x7)
+    x9 = e*x8
+    x10 = alpha + x5 + x6
+    x11 = numpy.cos(x10)
+    x12 = 2*x11
+    x13 = -2*chi0*x2*x4 + x0*x3 + x12*x9
+    x14 = -x13
+    x15 = 2*x3
+    x16 = numpy.sin(x10)
+    x17 = x16*x9
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x15 - 2*x17 + x19*x21
+    x23 = 1 - x15
+    x24 = Theta_dot*e
+    x25 = x24*numpy.cos(x7)
+    x26 = alpha_dot*x0
+    x27 = (1/2)*Theta_dot + alpha_dot
+    x28 = alpha_dot*chi0*x23 + 2*e*x16*x27*x8 - x11*x25 - x20*x26
+    x29 = numpy.cos(alpha)
+    x30 = x29**(-1.0)
+    x31 = numpy.sin(alpha)
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x18*x30 + x33)
+    x35 = numpy.pi*Y_e*l_lambda
+    x36 = (1/4)*x35
+    x37 = beta_D*x36*abs(x13)
+    x38 = x14*x36 + x28*x37
+    x39 = -x38
+    x40 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x24*numpy.sin(Theta + alpha)
+    x41 = mu_m*x39*numpy.tanh(s*x40)
+    x42 = numpy.sin(alpha0)
+    x43 = numpy.cos(alpha0)
+    x44 = -chi0*x42 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x19*x43
+    x45 = chi0*x43 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x19*x42
+    x46 = x30 + x32
+    x47 = d_x*k_s
+    x48 = (1/8)*x35
+    x49 = x29**(-2.0)
+    x50 = x28**2*x37
+    x51 = x40*x41
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x15 + _zero, x21 + _zero, x27 + _zero, x30 + _zero, x35 + _zero, x37 + _zero, x36 + _zero, -x34*x38 + x37*x39 + _zero, numpy.arcsin(x17/numpy.sqrt(x42**2 + x43**2)) - numpy.arctan2(x42, x43) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x46 + x45*(L_us*alpha - alpha*d_y - d_x*numpy.log(x39) - x16*numpy.log(x44)) + _zero, alpha_dot*(-d_x*x30 - x16*x37 - x34*(chi0 - x21)) + x14*x46*(-alpha_dot*x18*x22 + x13*x24 - 4*x20*x26 + 2*x25) + x45*(L_us*alpha_dot + alpha_dot*d_x*x38/x39 - alpha_dot*d_y - x16*(alpha_dot*x28*x29 + alpha_dot*(x28**2 + 1))/x44) + x47 + x48 + _zero, x47 + _zero, x48 + _zero)
+    return (x14 + _zero, x22 + _zero, x28 + _zero, x34 + _zero, x39 + _zero, x41 + _zero, x40 + _zero, x29*x41 - x31*x38 + _zero, numpy.arcsin(x19/numpy.sqrt(x44**2 + x45**2)) - numpy.arctan2(x44, x45) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x48 + x47*(L_us*alpha - alpha*d_y - d_x*numpy.log(x29) - x18*numpy.log(x46)) + _zero, alpha_dot*(-d_x*x34 - x18*x41 - x38*(chi0 - x22)) + x13*x48*(-2*alpha_dot*chi0*x23 + x12*x25 - 4*x17*x27 + x21*x26) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x18*(alpha_dot*x31*x49 + alpha_dot*(x31**2*x49 + 1))/x46) + x50 + x51 + _zero, x50 + _zero, x51 + _zero)
 
 
 def rhs_contact_unloading(t, alpha, alpha_dot, p, cam):
@@ -579,23 +594,25 @@ def rhs_contact_unloading(t, alpha, alpha_dot, p, cam):
     Y_e = p[16]
     chi_star = p[17]
     vartheta = p[18]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = cos(x3)
     x7 = (1/2)*Theta
     x8 = (1/2)*theta0
     x9 = alpha + x7 + x8
     x10 = cos(x9)
     x11 = x7 - x8
     x12 = sin(x11)
-    x13 = Theta_dot*e
-    x14 = sin(x9)
-    x15 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x12*x14*((1/2)*Theta_dot + alpha_dot) - x10*x13*cos(x11))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(chi0*x2 - 2*e*x10*x12 - x3*x6)
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15*tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x13*sin(Theta + alpha))) - x15*(-2*chi0*x6 + chi0 + 2*e*x12*x14 - x2*(r_c + x0)))/I_Pb
+    x13 = 2*x5
+    x14 = Theta_dot*e
+    x15 = x4*x6
+    x16 = sin(x9)
+    x17 = 2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - x13) - alpha_dot*x15*x2 + 2*e*x12*x16*((1/2)*Theta_dot + alpha_dot) - x10*x14*cos(x11))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x4*x6 - 2*e*x10*x12 - x2*x5)
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17*tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x14*sin(Theta + alpha))) - x17*(-chi0*x13 + chi0 + 2*e*x12*x16 - 2*x15*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading(t, alpha, alpha_dot, p, cam):
@@ -629,46 +646,47 @@ def jac_contact_unloading(t, alpha, alpha_dot, p, cam):
     chi_star = p[17]
     vartheta = p[18]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = Theta + alpha
-    x4 = Theta_dot*e
-    x5 = tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x4*sin(x3)))
-    x6 = 1 - x5**2
-    x7 = alpha - alpha0
-    x8 = sin(x7)
-    x9 = 2*r_c + w_b
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = sin(x10)
-    x12 = x11**2
-    x13 = x12*x9
-    x14 = (1/2)*Theta
-    x15 = (1/2)*theta0
-    x16 = alpha + x14 + x15
-    x17 = cos(x16)
-    x18 = x14 - x15
-    x19 = sin(x18)
-    x20 = 2*e*x19
-    x21 = x17*x20
-    x22 = (1/4)*pi*Y_e*l_lambda
-    x23 = cos(x7)
-    x24 = x4*cos(x18)
-    x25 = cos(x10)
-    x26 = x11*x25
-    x27 = x26*x9
-    x28 = (1/2)*Theta_dot + alpha_dot
-    x29 = sin(x16)
-    x30 = chi_star**(-2)
-    x31 = 2*I_Pb*vartheta*x30*zeta_D
-    x32 = x22*(chi0*x8 - x13 - x21) + x31*(alpha_dot*chi0*x23 - alpha_dot*x27 + 2*e*x19*x28*x29 - x17*x24)
-    x33 = -x32
-    x34 = chi0*x23 + x20*x29 - x27
-    x35 = (1/2)*alpha_dot
-    x36 = x22*x34 + x31*(-alpha_dot*chi0*x8 + x13*x35 + x21*x28 + x24*x29 - x25**2*x35*x9)
-    x37 = r_c + x2
-    x38 = 2*chi0
-    x39 = chi0 + 2*e*x19*x29 - x12*x38 - x37*x8
-    return (x0*((1/2)*Theta_dot*e*mu_m*s*w_b*x33*x6*cos(x3) - d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x36*x5 - x32*(x21 - x23*x37 - x26*x38) - x36*x39), x0*(I_Pb*mu_m*vartheta*w_b*x30*x34*x5*zeta_D - 1/4*mu_m*s*w_b**2*x33*x6 - x31*x34*x39))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = Theta + alpha
+    x5 = Theta_dot*e
+    x6 = tanh(s*(-Theta_dot*r_c + (1/2)*alpha_dot*w_b - x5*sin(x4)))
+    x7 = 1 - x6**2
+    x8 = 2*r_c + w_b
+    x9 = (1/2)*alpha - 1/2*alpha0
+    x10 = sin(x9)
+    x11 = x10**2
+    x12 = x11*x8
+    x13 = cos(x9)
+    x14 = x10*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = (1/2)*Theta
+    x18 = (1/2)*theta0
+    x19 = alpha + x17 + x18
+    x20 = cos(x19)
+    x21 = x17 - x18
+    x22 = sin(x21)
+    x23 = 2*e*x22
+    x24 = x20*x23
+    x25 = (1/4)*pi*Y_e*l_lambda
+    x26 = 2*x11
+    x27 = 1 - x26
+    x28 = x5*cos(x21)
+    x29 = x14*x8
+    x30 = (1/2)*Theta_dot + alpha_dot
+    x31 = sin(x19)
+    x32 = chi_star**(-2)
+    x33 = 2*I_Pb*vartheta*x32*zeta_D
+    x34 = x25*(-x12 + x16 - x24) + x33*(alpha_dot*chi0*x27 - alpha_dot*x29 + 2*e*x22*x30*x31 - x20*x28)
+    x35 = -x34
+    x36 = chi0*x27 + x23*x31 - x29
+    x37 = (1/2)*alpha_dot
+    x38 = x25*x36 + x33*(-alpha_dot*x16 + x12*x37 - x13**2*x37*x8 + x24*x30 + x28*x31)
+    x39 = r_c + x3
+    x40 = -chi0*x26 + chi0 + 2*e*x22*x31 - x15*x39
+    return (x0*((1/2)*Theta_dot*e*mu_m*s*w_b*x35*x7*cos(x4) - d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x38*x6 - x34*(-x16 + x24 - x27*x39) - x38*x40), x0*(I_Pb*mu_m*vartheta*w_b*x32*x36*x6*zeta_D - 1/4*mu_m*s*w_b**2*x35*x7 - x33*x36*x40))
 
 
 def out_contact_unloading(t, alpha, alpha_dot, p, cam):
@@ -714,55 +732,58 @@ def out_contact_unloading(t, alpha, alpha_dot, p, cam):
     Y_e = p[16]
     chi_star = p[17]
     vartheta = p[18]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = x6 - x7
-    x9 = sin(x8)
-    x10 = e*x9
-    x11 = alpha + x6 + x7
-    x12 = cos(x11)
-    x13 = 2*x12
-    x14 = -chi0*x1 + x10*x13 + x2*x5
-    x15 = -x14
-    x16 = (1/2)*w_b
-    x17 = r_c + x16
-    x18 = 2*chi0
-    x19 = sin(x11)
-    x20 = x10*x19
-    x21 = x1*x17 + x18*x5 - 2*x20
-    x22 = cos(x0)
-    x23 = Theta_dot*e
-    x24 = x23*cos(x8)
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = (1/2)*Theta_dot + alpha_dot
-    x27 = alpha_dot*chi0*x22 + 2*e*x19*x26*x9 - x12*x24 - x25
-    x28 = tan(alpha)
-    x29 = (1/cos(alpha))
-    x30 = k_s*(L_us + d_x*x28 - d_y - x16*x29)
-    x31 = pi*Y_e*l_lambda
-    x32 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x33 = (1/4)*x15*x31 + x27*x32
-    x34 = -x33
-    x35 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x23*sin(Theta + alpha)
-    x36 = mu_m*x34*tanh(s*x35)
-    x37 = sin(alpha)
-    x38 = cos(alpha)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 - e*sin(Theta) + e*sin(theta0) + x17*x40
-    x42 = chi0*x40 - e*cos(Theta) + e*cos(theta0) + x17*x39
-    x43 = x28 + x29
-    x44 = d_x*k_s
-    x45 = (1/8)*x31
-    x46 = x27**2*x32
-    x47 = x35*x36
-    return (x15, x21, x27, x30, x34, x36, x35, -x33*x37 + x36*x38, asin(x17/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x14**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x38) - x16*log(x43)), alpha_dot*(-d_x*x30 - x16*x36 - x33*(chi0 - x21)) + x14*x45*(-alpha_dot*x18*x22 + x13*x24 - 4*x20*x26 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x16*(alpha_dot*x28*x29 + alpha_dot*(x28**2 + 1))/x43) + x46 + x47, x46, x47)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = x5 - x6
+    x8 = sin(x7)
+    x9 = e*x8
+    x10 = alpha + x5 + x6
+    x11 = cos(x10)
+    x12 = 2*x11
+    x13 = -2*chi0*x2*x4 + x0*x3 + x12*x9
+    x14 = -x13
+    x15 = 2*x3
+    x16 = sin(x10)
+    x17 = x16*x9
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x15 - 2*x17 + x19*x21
+    x23 = 1 - x15
+    x24 = Theta_dot*e
+    x25 = x24*cos(x7)
+    x26 = alpha_dot*x0
+    x27 = (1/2)*Theta_dot + alpha_dot
+    x28 = alpha_dot*chi0*x23 + 2*e*x16*x27*x8 - x11*x25 - x20*x26
+    x29 = cos(alpha)
+    x30 = 1/x29
+    x31 = sin(alpha)
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x18*x30 + x33)
+    x35 = pi*Y_e*l_lambda
+    x36 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x37 = (1/4)*x14*x35 + x28*x36
+    x38 = -x37
+    x39 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x24*sin(Theta + alpha)
+    x40 = mu_m*x38*tanh(s*x39)
+    x41 = sin(alpha0)
+    x42 = cos(alpha0)
+    x43 = -chi0*x41 - e*sin(Theta) + e*sin(theta0) + x19*x42
+    x44 = chi0*x42 - e*cos(Theta) + e*cos(theta0) + x19*x41
+    x45 = x30 + x32
+    x46 = d_x*k_s
+    x47 = (1/8)*x35
+    x48 = x29**(-2)
+    x49 = x28**2*x36
+    x50 = x39*x40
+    return (x14, x22, x28, x34, x38, x40, x39, x29*x40 - x31*x37, asin(x19/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x13**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*log(x29) - x18*log(x45)), alpha_dot*(-d_x*x34 - x18*x40 - x37*(chi0 - x22)) + x13*x47*(-2*alpha_dot*chi0*x23 + x12*x25 - 4*x17*x27 + x21*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x18*(alpha_dot*x31*x48 + alpha_dot*(x31**2*x48 + 1))/x45) + x49 + x50, x49, x50)
 
 
 def out_contact_unloading_v(t, alpha, alpha_dot, p, cam):
@@ -808,56 +829,59 @@ def out_contact_unloading_v(t, alpha, alpha_dot, p, cam):
     Y_e = p[16]
     chi_star = p[17]
     vartheta = p[18]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Theta
-    x7 = (1/2)*theta0
-    x8 = x6 - x7
-    x9 = numpy.sin(x8)
-    x10 = e*x9
-    x11 = alpha + x6 + x7
-    x12 = numpy.cos(x11)
-    x13 = 2*x12
-    x14 = -chi0*x1 + x10*x13 + x2*x5
-    x15 = -x14
-    x16 = (1/2)*w_b
-    x17 = r_c + x16
-    x18 = 2*chi0
-    x19 = numpy.sin(x11)
-    x20 = x10*x19
-    x21 = x1*x17 + x18*x5 - 2*x20
-    x22 = numpy.cos(x0)
-    x23 = Theta_dot*e
-    x24 = x23*numpy.cos(x8)
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = (1/2)*Theta_dot + alpha_dot
-    x27 = alpha_dot*chi0*x22 + 2*e*x19*x26*x9 - x12*x24 - x25
-    x28 = numpy.tan(alpha)
-    x29 = (numpy.cos(alpha)**(-1.0))
-    x30 = k_s*(L_us + d_x*x28 - d_y - x16*x29)
-    x31 = numpy.pi*Y_e*l_lambda
-    x32 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x33 = (1/4)*x15*x31 + x27*x32
-    x34 = -x33
-    x35 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x23*numpy.sin(Theta + alpha)
-    x36 = mu_m*x34*numpy.tanh(s*x35)
-    x37 = numpy.sin(alpha)
-    x38 = numpy.cos(alpha)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x17*x40
-    x42 = chi0*x40 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x17*x39
-    x43 = x28 + x29
-    x44 = d_x*k_s
-    x45 = (1/8)*x31
-    x46 = x27**2*x32
-    x47 = x35*x36
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Theta
+    x6 = (1/2)*theta0
+    x7 = x5 - x6
+    x8 = numpy.sin(x7)
+    x9 = e*x8
+    x10 = alpha + x5 + x6
+    x11 = numpy.cos(x10)
+    x12 = 2*x11
+    x13 = -2*chi0*x2*x4 + x0*x3 + x12*x9
+    x14 = -x13
+    x15 = 2*x3
+    x16 = numpy.sin(x10)
+    x17 = x16*x9
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = x2*x4
+    x21 = 2*x20
+    x22 = chi0*x15 - 2*x17 + x19*x21
+    x23 = 1 - x15
+    x24 = Theta_dot*e
+    x25 = x24*numpy.cos(x7)
+    x26 = alpha_dot*x0
+    x27 = (1/2)*Theta_dot + alpha_dot
+    x28 = alpha_dot*chi0*x23 + 2*e*x16*x27*x8 - x11*x25 - x20*x26
+    x29 = numpy.cos(alpha)
+    x30 = x29**(-1.0)
+    x31 = numpy.sin(alpha)
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x18*x30 + x33)
+    x35 = numpy.pi*Y_e*l_lambda
+    x36 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x37 = (1/4)*x14*x35 + x28*x36
+    x38 = -x37
+    x39 = -Theta_dot*r_c + (1/2)*alpha_dot*w_b - x24*numpy.sin(Theta + alpha)
+    x40 = mu_m*x38*numpy.tanh(s*x39)
+    x41 = numpy.sin(alpha0)
+    x42 = numpy.cos(alpha0)
+    x43 = -chi0*x41 - e*numpy.sin(Theta) + e*numpy.sin(theta0) + x19*x42
+    x44 = chi0*x42 - e*numpy.cos(Theta) + e*numpy.cos(theta0) + x19*x41
+    x45 = x30 + x32
+    x46 = d_x*k_s
+    x47 = (1/8)*x35
+    x48 = x29**(-2.0)
+    x49 = x28**2*x36
+    x50 = x39*x40
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x15 + _zero, x21 + _zero, x27 + _zero, x30 + _zero, x34 + _zero, x36 + _zero, x35 + _zero, -x33*x37 + x36*x38 + _zero, numpy.arcsin(x17/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x14**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x38) - x16*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x30 - x16*x36 - x33*(chi0 - x21)) + x14*x45*(-alpha_dot*x18*x22 + x13*x24 - 4*x20*x26 + 2*x25) + x44*(L_us*alpha_dot + alpha_dot*d_x*x37/x38 - alpha_dot*d_y - x16*(alpha_dot*x28*x29 + alpha_dot*(x28**2 + 1))/x43) + x46 + x47 + _zero, x46 + _zero, x47 + _zero)
+    return (x14 + _zero, x22 + _zero, x28 + _zero, x34 + _zero, x38 + _zero, x40 + _zero, x39 + _zero, x29*x40 - x31*x37 + _zero, numpy.arcsin(x19/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x47 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x29) - x18*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x34 - x18*x40 - x37*(chi0 - x22)) + x13*x47*(-2*alpha_dot*chi0*x23 + x12*x25 - 4*x17*x27 + x21*x26) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x18*(alpha_dot*x31*x48 + alpha_dot*(x31**2*x48 + 1))/x45) + x49 + x50 + _zero, x49 + _zero, x50 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p, cam):
@@ -879,9 +903,11 @@ def gap(t, alpha, alpha_dot, p, cam):
     chi0 = p[3]
     alpha0 = p[4]
     theta0 = p[5]
-    x0 = (1/2)*Theta
-    x1 = (1/2)*theta0
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0 - x1)*cos(alpha + x0 + x1) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Theta
+    x3 = (1/2)*theta0
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2 - x3)*cos(alpha + x2 + x3) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p, cam):
@@ -903,12 +929,13 @@ def gap_rate(t, alpha, alpha_dot, p, cam):
     chi0 = p[3]
     alpha0 = p[4]
     theta0 = p[5]
-    x0 = (1/2)*Theta
-    x1 = (1/2)*theta0
-    x2 = x0 - x1
-    x3 = alpha + x0 + x1
-    x4 = (1/2)*alpha - 1/2*alpha0
-    return -Theta_dot*e*cos(x2)*cos(x3) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x4)*cos(x4) + 2*e*((1/2)*Theta_dot + alpha_dot)*sin(x2)*sin(x3)
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Theta
+    x3 = (1/2)*theta0
+    x4 = x2 - x3
+    x5 = alpha + x2 + x3
+    return -Theta_dot*e*cos(x4)*cos(x5) + alpha_dot*chi0*(1 - 2*x1**2) - alpha_dot*x1*(2*r_c + w_b)*cos(x0) + 2*e*((1/2)*Theta_dot + alpha_dot)*sin(x4)*sin(x5)
 
 
 def static_moment(alpha, p):
@@ -934,25 +961,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[16]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -1023,7 +1052,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1041,7 +1071,8 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)

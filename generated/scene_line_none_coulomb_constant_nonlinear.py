@@ -112,7 +112,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -131,8 +132,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -170,30 +172,32 @@ def out_free(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = sin(x8)
-    x15 = Omega_c*e
-    x16 = tan(alpha)
-    x17 = (1/cos(alpha))
-    x18 = Omega_c*t + theta0
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 + e*sin(theta0) - e*sin(x18) + x13*x20
-    x22 = chi0*x20 + e*cos(theta0) - e*cos(x18) + x13*x19
-    return (chi0*x1 - x11*x9 - x2*x5, 2*chi0*x5 + x1*x13 - x11*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*cos(x7), k_s*(L_us + d_x*x16 - d_y - x12*x17), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(alpha + x18), 0, asin(x13/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x12*log(x16 + x17)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = 2*x3
+    x12 = sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = cos(alpha)
+    x18 = 1/x17
+    x19 = x18*sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
+    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -231,31 +235,33 @@ def out_free_v(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = numpy.sin(x8)
-    x15 = Omega_c*e
-    x16 = numpy.tan(alpha)
-    x17 = (numpy.cos(alpha)**(-1.0))
-    x18 = Omega_c*t + theta0
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 + e*numpy.sin(theta0) - e*numpy.sin(x18) + x13*x20
-    x22 = chi0*x20 + e*numpy.cos(theta0) - e*numpy.cos(x18) + x13*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = 2*x3
+    x12 = numpy.sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = numpy.cos(alpha)
+    x18 = x17**(-1.0)
+    x19 = x18*numpy.sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
+    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x11*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x13 - x11*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x16 - d_y - x12*x17) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*numpy.sin(alpha + x18) + _zero, 0 + _zero, numpy.arcsin(x13/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x12*numpy.log(x16 + x17)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_fwd(t, alpha, alpha_dot, p):
@@ -284,14 +290,17 @@ def rhs_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = (1/2)*w_b
-    x1 = sin(alpha - alpha0)
-    x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-    x3 = (1/2)*Omega_c*t
-    x4 = alpha + theta0 + x3
-    x5 = sin(x3)
-    x6 = chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b)
-    return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x6 - 1/4*pi*Y_e*l_lambda*x6*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0)) - d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = (1/2)*alpha - 1/2*alpha0
+    x3 = sin(x2)
+    x4 = x3**2
+    x5 = (1/2)*Omega_c*t
+    x6 = alpha + theta0 + x5
+    x7 = sin(x5)
+    x8 = cos(x2)
+    x9 = 2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b)
+    return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x9 - 1/4*pi*Y_e*l_lambda*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
 
 
 def jac_contact_fwd(t, alpha, alpha_dot, p):
@@ -319,27 +328,28 @@ def jac_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = alpha - alpha0
-    x3 = cos(x2)
-    x4 = (1/2)*Omega_c*t
-    x5 = alpha + theta0 + x4
-    x6 = sin(x5)
-    x7 = sin(x4)
-    x8 = 2*e*x7
-    x9 = 2*r_c + w_b
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = sin(x10)
-    x12 = x11*cos(x10)
-    x13 = chi0*x3 - x12*x9 + x6*x8
-    x14 = sin(x2)
-    x15 = x11**2
-    x16 = x8*cos(x5)
-    x17 = r_c + x1
-    x18 = 2*chi0
-    x19 = (1/4)*pi*Y_e*l_lambda
-    return (((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*k_s*(d_x*(x0**2 + 1) - x0*x1*(1/cos(alpha))) - x13*x19*(chi0 + 2*e*x6*x7 - x14*x17 - x15*x18) - x19*(chi0*x14 - x15*x9 - x16)*(-x12*x18 + x16 - x17*x3))/I_Pb, 0)
+    x0 = cos(alpha)**(-2)
+    x1 = sin(alpha)
+    x2 = (1/2)*w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = 2*x5
+    x7 = 1 - x6
+    x8 = (1/2)*Omega_c*t
+    x9 = alpha + theta0 + x8
+    x10 = sin(x9)
+    x11 = sin(x8)
+    x12 = 2*e*x11
+    x13 = 2*r_c + w_b
+    x14 = x4*cos(x3)
+    x15 = chi0*x7 + x10*x12 - x13*x14
+    x16 = r_c + x2
+    x17 = 2*x14
+    x18 = (1/4)*pi*Y_e*l_lambda
+    x19 = x12*cos(x9)
+    x20 = chi0*x17
+    return (((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - x15*x18*(-chi0*x6 + chi0 + 2*e*x10*x11 - x16*x17) - x18*(-x13*x5 - x19 + x20)*(-x16*x7 + x19 - x20))/I_Pb, 0)
 
 
 def out_contact_fwd(t, alpha, alpha_dot, p):
@@ -380,51 +390,54 @@ def out_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = tan(alpha)
-    x27 = (1/cos(alpha))
-    x28 = k_s*(L_us + d_x*x26 - d_y - x15*x27)
-    x29 = pi*Y_e*l_lambda
-    x30 = (1/4)*x14*x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x32)
-    x34 = sin(alpha)
-    x35 = cos(alpha)
-    x36 = sin(alpha0)
-    x37 = cos(alpha0)
-    x38 = -chi0*x36 + e*sin(theta0) - e*sin(x32) + x16*x37
-    x39 = chi0*x37 + e*cos(theta0) - e*cos(x32) + x16*x36
-    x40 = x26 + x27
-    x41 = d_x*k_s
-    x42 = (1/8)*x29
-    x43 = -x31*x33
-    return (x14, x20, alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25, x28, -x30, -x31, x33, -x30*x34 - x31*x35, asin(x16/sqrt(x38**2 + x39**2)) - atan2(x38, x39), (1/2)*I_Pb*alpha_dot**2 + x13**2*x42 + x41*(L_us*alpha - alpha*d_y - d_x*log(x35) - x15*log(x40)), alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x14 - d_x*x28 - x30*(chi0 - x20)) + x13*x42*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x15*(alpha_dot*x26*x27 + alpha_dot*(x26**2 + 1))/x40) + x43, 0, x43)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = cos(alpha)
+    x28 = 1/x27
+    x29 = sin(alpha)
+    x30 = x28*x29
+    x31 = d_x*x30
+    x32 = k_s*(L_us - d_y - x17*x28 + x31)
+    x33 = pi*Y_e*l_lambda
+    x34 = (1/4)*x13*x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x36)
+    x38 = sin(alpha0)
+    x39 = cos(alpha0)
+    x40 = -chi0*x38 + e*sin(theta0) - e*sin(x36) + x18*x39
+    x41 = chi0*x39 + e*cos(theta0) - e*cos(x36) + x18*x38
+    x42 = x28 + x30
+    x43 = d_x*k_s
+    x44 = (1/8)*x33
+    x45 = x27**(-2)
+    x46 = -x35*x37
+    return (x13, x21, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9, x32, -x34, -x35, x37, -x27*x35 - x29*x34, asin(x18/sqrt(x40**2 + x41**2)) - atan2(x40, x41), (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*log(x27) - x17*log(x42)), alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*x32 - x34*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x45 + alpha_dot*(x29**2*x45 + 1))/x42) + x46, 0, x46)
 
 
 def out_contact_fwd_v(t, alpha, alpha_dot, p):
@@ -465,52 +478,55 @@ def out_contact_fwd_v(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = numpy.tan(alpha)
-    x27 = (numpy.cos(alpha)**(-1.0))
-    x28 = k_s*(L_us + d_x*x26 - d_y - x15*x27)
-    x29 = numpy.pi*Y_e*l_lambda
-    x30 = (1/4)*x14*x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x32)
-    x34 = numpy.sin(alpha)
-    x35 = numpy.cos(alpha)
-    x36 = numpy.sin(alpha0)
-    x37 = numpy.cos(alpha0)
-    x38 = -chi0*x36 + e*numpy.sin(theta0) - e*numpy.sin(x32) + x16*x37
-    x39 = chi0*x37 + e*numpy.cos(theta0) - e*numpy.cos(x32) + x16*x36
-    x40 = x26 + x27
-    x41 = d_x*k_s
-    x42 = (1/8)*x29
-    x43 = -x31*x33
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = numpy.cos(alpha)
+    x28 = x27**(-1.0)
+    x29 = numpy.sin(alpha)
+    x30 = x28*x29
+    x31 = d_x*x30
+    x32 = k_s*(L_us - d_y - x17*x28 + x31)
+    x33 = numpy.pi*Y_e*l_lambda
+    x34 = (1/4)*x13*x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x36)
+    x38 = numpy.sin(alpha0)
+    x39 = numpy.cos(alpha0)
+    x40 = -chi0*x38 + e*numpy.sin(theta0) - e*numpy.sin(x36) + x18*x39
+    x41 = chi0*x39 + e*numpy.cos(theta0) - e*numpy.cos(x36) + x18*x38
+    x42 = x28 + x30
+    x43 = d_x*k_s
+    x44 = (1/8)*x33
+    x45 = x27**(-2.0)
+    x46 = -x35*x37
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25 + _zero, x28 + _zero, -x30 + _zero, -x31 + _zero, x33 + _zero, -x30*x34 - x31*x35 + _zero, numpy.arcsin(x16/numpy.sqrt(x38**2 + x39**2)) - numpy.arctan2(x38, x39) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x42 + x41*(L_us*alpha - alpha*d_y - d_x*numpy.log(x35) - x15*numpy.log(x40)) + _zero, alpha_dot*((1/8)*numpy.pi*Y_e*l_lambda*mu_m*w_b*x14 - d_x*x28 - x30*(chi0 - x20)) + x13*x42*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x15*(alpha_dot*x26*x27 + alpha_dot*(x26**2 + 1))/x40) + x43 + _zero, 0 + _zero, x43 + _zero)
+    return (x13 + _zero, x21 + _zero, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9 + _zero, x32 + _zero, -x34 + _zero, -x35 + _zero, x37 + _zero, -x27*x35 - x29*x34 + _zero, numpy.arcsin(x18/numpy.sqrt(x40**2 + x41**2)) - numpy.arctan2(x40, x41) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*numpy.log(x27) - x17*numpy.log(x42)) + _zero, alpha_dot*((1/8)*numpy.pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*x32 - x34*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x45 + alpha_dot*(x29**2*x45 + 1))/x42) + x46 + _zero, 0 + _zero, x46 + _zero)
 
 
 def rhs_contact_bwd(t, alpha, alpha_dot, p):
@@ -539,14 +555,17 @@ def rhs_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = (1/2)*w_b
-    x1 = sin(alpha - alpha0)
-    x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-    x3 = (1/2)*Omega_c*t
-    x4 = alpha + theta0 + x3
-    x5 = sin(x3)
-    x6 = pi*Y_e*l_lambda*(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/8*mu_m*w_b*x6 - 1/4*x6*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0)))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = (1/2)*alpha - 1/2*alpha0
+    x3 = sin(x2)
+    x4 = x3**2
+    x5 = (1/2)*Omega_c*t
+    x6 = alpha + theta0 + x5
+    x7 = sin(x5)
+    x8 = cos(x2)
+    x9 = pi*Y_e*l_lambda*(2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b))
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/8*mu_m*w_b*x9 - 1/4*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)))/I_Pb
 
 
 def jac_contact_bwd(t, alpha, alpha_dot, p):
@@ -574,27 +593,28 @@ def jac_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = alpha - alpha0
-    x3 = cos(x2)
-    x4 = (1/2)*Omega_c*t
-    x5 = alpha + theta0 + x4
-    x6 = sin(x5)
-    x7 = sin(x4)
-    x8 = 2*e*x7
-    x9 = 2*r_c + w_b
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = sin(x10)
-    x12 = x11*cos(x10)
-    x13 = chi0*x3 - x12*x9 + x6*x8
-    x14 = sin(x2)
-    x15 = x11**2
-    x16 = x8*cos(x5)
-    x17 = r_c + x1
-    x18 = 2*chi0
-    x19 = (1/4)*pi*Y_e*l_lambda
-    return ((-1/8*pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*k_s*(d_x*(x0**2 + 1) - x0*x1*(1/cos(alpha))) - x13*x19*(chi0 + 2*e*x6*x7 - x14*x17 - x15*x18) - x19*(chi0*x14 - x15*x9 - x16)*(-x12*x18 + x16 - x17*x3))/I_Pb, 0)
+    x0 = cos(alpha)**(-2)
+    x1 = sin(alpha)
+    x2 = (1/2)*w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = 2*x5
+    x7 = 1 - x6
+    x8 = (1/2)*Omega_c*t
+    x9 = alpha + theta0 + x8
+    x10 = sin(x9)
+    x11 = sin(x8)
+    x12 = 2*e*x11
+    x13 = 2*r_c + w_b
+    x14 = x4*cos(x3)
+    x15 = chi0*x7 + x10*x12 - x13*x14
+    x16 = r_c + x2
+    x17 = 2*x14
+    x18 = (1/4)*pi*Y_e*l_lambda
+    x19 = x12*cos(x9)
+    x20 = chi0*x17
+    return ((-1/8*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - x15*x18*(-chi0*x6 + chi0 + 2*e*x10*x11 - x16*x17) - x18*(-x13*x5 - x19 + x20)*(-x16*x7 + x19 - x20))/I_Pb, 0)
 
 
 def out_contact_bwd(t, alpha, alpha_dot, p):
@@ -635,52 +655,55 @@ def out_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = cos(x8)
+    x10 = 2*x9
+    x11 = cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*cos(x3)
-    x26 = tan(alpha)
-    x27 = (1/cos(alpha))
-    x28 = k_s*(L_us + d_x*x26 - d_y - x15*x27)
-    x29 = pi*Y_e*l_lambda
-    x30 = x14*x29
-    x31 = (1/4)*x30
-    x32 = mu_m*x31
-    x33 = Omega_c*t + theta0
-    x34 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x33)
-    x35 = sin(alpha)
-    x36 = cos(alpha)
-    x37 = sin(alpha0)
-    x38 = cos(alpha0)
-    x39 = -chi0*x37 + e*sin(theta0) - e*sin(x33) + x16*x38
-    x40 = chi0*x38 + e*cos(theta0) - e*cos(x33) + x16*x37
-    x41 = x26 + x27
-    x42 = d_x*k_s
-    x43 = (1/8)*x29
-    x44 = x32*x34
-    return (x14, x20, alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25, x28, -x31, x32, x34, -x31*x35 + x32*x36, asin(x16/sqrt(x39**2 + x40**2)) - atan2(x39, x40), (1/2)*I_Pb*alpha_dot**2 + x13**2*x43 + x42*(L_us*alpha - alpha*d_y - d_x*log(x36) - x15*log(x41)), alpha_dot*(-d_x*x28 - 1/8*mu_m*w_b*x30 - x31*(chi0 - x20)) + x13*x43*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x42*(L_us*alpha_dot + alpha_dot*d_x*x35/x36 - alpha_dot*d_y - x15*(alpha_dot*x26*x27 + alpha_dot*(x26**2 + 1))/x41) + x44, 0, x44)
+    x23 = x22*cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = cos(alpha)
+    x28 = 1/x27
+    x29 = sin(alpha)
+    x30 = x28*x29
+    x31 = d_x*x30
+    x32 = k_s*(L_us - d_y - x17*x28 + x31)
+    x33 = pi*Y_e*l_lambda
+    x34 = x13*x33
+    x35 = (1/4)*x34
+    x36 = mu_m*x35
+    x37 = Omega_c*t + theta0
+    x38 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x37)
+    x39 = sin(alpha0)
+    x40 = cos(alpha0)
+    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x37) + x18*x40
+    x42 = chi0*x40 + e*cos(theta0) - e*cos(x37) + x18*x39
+    x43 = x28 + x30
+    x44 = d_x*k_s
+    x45 = (1/8)*x33
+    x46 = x27**(-2)
+    x47 = x36*x38
+    return (x13, x21, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9, x32, -x35, x36, x38, x27*x36 - x29*x35, asin(x18/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x27) - x17*log(x43)), alpha_dot*(-d_x*x32 - 1/8*mu_m*w_b*x34 - x35*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x46 + alpha_dot*(x29**2*x46 + 1))/x43) + x47, 0, x47)
 
 
 def out_contact_bwd_v(t, alpha, alpha_dot, p):
@@ -721,53 +744,56 @@ def out_contact_bwd_v(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = numpy.sin(x7)
-    x9 = e*x8
-    x10 = alpha + theta0 + x7
-    x11 = numpy.cos(x10)
-    x12 = 2*x11
-    x13 = -chi0*x1 + x12*x9 + x2*x5
-    x14 = -x13
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = 2*chi0
-    x18 = numpy.sin(x10)
-    x19 = x18*x9
-    x20 = x1*x16 + x17*x5 - 2*x19
-    x21 = numpy.cos(x0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = numpy.sin(x5)
+    x7 = e*x6
+    x8 = alpha + theta0 + x5
+    x9 = numpy.cos(x8)
+    x10 = 2*x9
+    x11 = numpy.cos(x1)
+    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
+    x13 = -x12
+    x14 = 2*x3
+    x15 = numpy.sin(x8)
+    x16 = x15*x7
+    x17 = (1/2)*w_b
+    x18 = r_c + x17
+    x19 = x11*x2
+    x20 = 2*x19
+    x21 = chi0*x14 - 2*x16 + x18*x20
     x22 = Omega_c*e
-    x23 = x22*numpy.cos(x7)
-    x24 = alpha_dot + x6
-    x25 = alpha_dot*x2*x4*numpy.cos(x3)
-    x26 = numpy.tan(alpha)
-    x27 = (numpy.cos(alpha)**(-1.0))
-    x28 = k_s*(L_us + d_x*x26 - d_y - x15*x27)
-    x29 = numpy.pi*Y_e*l_lambda
-    x30 = x14*x29
-    x31 = (1/4)*x30
-    x32 = mu_m*x31
-    x33 = Omega_c*t + theta0
-    x34 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x33)
-    x35 = numpy.sin(alpha)
-    x36 = numpy.cos(alpha)
-    x37 = numpy.sin(alpha0)
-    x38 = numpy.cos(alpha0)
-    x39 = -chi0*x37 + e*numpy.sin(theta0) - e*numpy.sin(x33) + x16*x38
-    x40 = chi0*x38 + e*numpy.cos(theta0) - e*numpy.cos(x33) + x16*x37
-    x41 = x26 + x27
-    x42 = d_x*k_s
-    x43 = (1/8)*x29
-    x44 = x32*x34
+    x23 = x22*numpy.cos(x5)
+    x24 = 1 - x14
+    x25 = alpha_dot + x4
+    x26 = alpha_dot*x0
+    x27 = numpy.cos(alpha)
+    x28 = x27**(-1.0)
+    x29 = numpy.sin(alpha)
+    x30 = x28*x29
+    x31 = d_x*x30
+    x32 = k_s*(L_us - d_y - x17*x28 + x31)
+    x33 = numpy.pi*Y_e*l_lambda
+    x34 = x13*x33
+    x35 = (1/4)*x34
+    x36 = mu_m*x35
+    x37 = Omega_c*t + theta0
+    x38 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x37)
+    x39 = numpy.sin(alpha0)
+    x40 = numpy.cos(alpha0)
+    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x37) + x18*x40
+    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x37) + x18*x39
+    x43 = x28 + x30
+    x44 = d_x*k_s
+    x45 = (1/8)*x33
+    x46 = x27**(-2.0)
+    x47 = x36*x38
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x14 + _zero, x20 + _zero, alpha_dot*chi0*x21 + 2*e*x18*x24*x8 - x11*x23 - x25 + _zero, x28 + _zero, -x31 + _zero, x32 + _zero, x34 + _zero, -x31*x35 + x32*x36 + _zero, numpy.arcsin(x16/numpy.sqrt(x39**2 + x40**2)) - numpy.arctan2(x39, x40) + _zero, (1/2)*I_Pb*alpha_dot**2 + x13**2*x43 + x42*(L_us*alpha - alpha*d_y - d_x*numpy.log(x36) - x15*numpy.log(x41)) + _zero, alpha_dot*(-d_x*x28 - 1/8*mu_m*w_b*x30 - x31*(chi0 - x20)) + x13*x43*(-alpha_dot*x17*x21 + x12*x23 - 4*x19*x24 + 2*x25) + x42*(L_us*alpha_dot + alpha_dot*d_x*x35/x36 - alpha_dot*d_y - x15*(alpha_dot*x26*x27 + alpha_dot*(x26**2 + 1))/x41) + x44 + _zero, 0 + _zero, x44 + _zero)
+    return (x13 + _zero, x21 + _zero, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9 + _zero, x32 + _zero, -x35 + _zero, x36 + _zero, x38 + _zero, x27*x36 - x29*x35 + _zero, numpy.arcsin(x18/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x27) - x17*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x32 - 1/8*mu_m*w_b*x34 - x35*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x46 + alpha_dot*(x29**2*x46 + 1))/x43) + x47 + _zero, 0 + _zero, x47 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -788,8 +814,10 @@ def gap(t, alpha, alpha_dot, p):
     alpha0 = p[4]
     theta0 = p[5]
     Omega_c = p[14]
-    x0 = (1/2)*Omega_c*t
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Omega_c*t
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -814,7 +842,8 @@ def gap_rate(t, alpha, alpha_dot, p):
     x1 = t*x0
     x2 = alpha + theta0 + x1
     x3 = (1/2)*alpha - 1/2*alpha0
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    x4 = sin(x3)
+    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
 
 
 def slip(t, alpha, alpha_dot, p):
@@ -880,25 +909,27 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[13]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = alpha - alpha0
-    x5 = sin(x4)
-    x6 = 2*r_c + w_b
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = chi0*x5 - x6*x9
-    x11 = r_c + x1
-    x12 = 2*chi0
-    x13 = x11*x5 + x12*x9
-    x14 = (1/4)*pi*Y_e*l_lambda
-    x15 = x14*(chi0 - x13)
-    x16 = cos(x4)
-    x17 = x8*cos(x7)
-    return (-x10*x15 - x3*(L_us + d_x*x0 - d_y - x2), -x10*x14*(-x11*x16 - x12*x17) - x15*(chi0*x16 - x17*x6) - x3*(d_x*(x0**2 + 1) - x0*x2), x10, x13, x14)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = 2*r_c + w_b
+    x6 = (1/2)*alpha - 1/2*alpha0
+    x7 = sin(x6)
+    x8 = x7**2
+    x9 = x7*cos(x6)
+    x10 = 2*x9
+    x11 = chi0*x10
+    x12 = x11 - x5*x8
+    x13 = 2*x8
+    x14 = r_c + x2
+    x15 = chi0*x13 + x10*x14
+    x16 = (1/4)*pi*Y_e*l_lambda
+    x17 = x16*(chi0 - x15)
+    x18 = x0**(-2)
+    x19 = 1 - x13
+    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
 
 
 def reach(Theta, p):
@@ -969,7 +1000,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -987,10 +1019,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1016,7 +1049,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1033,14 +1067,17 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = (1/2)*w_b
-        x1 = sin(alpha - alpha0)
-        x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-        x3 = (1/2)*Omega_c*t
-        x4 = alpha + theta0 + x3
-        x5 = sin(x3)
-        x6 = chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b)
-        return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x6 - 1/4*pi*Y_e*l_lambda*x6*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0)) - d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = x3**2
+        x5 = (1/2)*Omega_c*t
+        x6 = alpha + theta0 + x5
+        x7 = sin(x5)
+        x8 = cos(x2)
+        x9 = 2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b)
+        return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x9 - 1/4*pi*Y_e*l_lambda*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1057,14 +1094,17 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = (1/2)*w_b
-        x1 = sin(alpha - alpha0)
-        x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-        x3 = (1/2)*Omega_c*t
-        x4 = alpha + theta0 + x3
-        x5 = sin(x3)
-        x6 = pi*Y_e*l_lambda*(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/8*mu_m*w_b*x6 - 1/4*x6*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0)))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = x3**2
+        x5 = (1/2)*Omega_c*t
+        x6 = alpha + theta0 + x5
+        x7 = sin(x5)
+        x8 = cos(x2)
+        x9 = pi*Y_e*l_lambda*(2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b))
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/8*mu_m*w_b*x9 - 1/4*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)))/I_Pb
     return nan
 
 
@@ -1091,8 +1131,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         alpha0 = p[4]
         theta0 = p[5]
         Omega_c = p[14]
-        x0 = (1/2)*Omega_c*t
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/2)*Omega_c*t
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1100,4 +1142,208 @@ def surface_index(k, t, alpha, alpha_dot, p):
         theta0 = p[5]
         Omega_c = p[14]
         return -Omega_c*e*sin(Omega_c*t + alpha + theta0) - Omega_c*r_c + (1/2)*alpha_dot*w_b
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[14]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    elif j == 1:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[14]
+        return -Omega_c**2*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[14]
+        return -Omega_c*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_fwd: P_in
+        4: contact_fwd: D_c
+        5: contact_fwd: D_f
+        6: contact_bwd: P_in
+        7: contact_bwd: D_c
+        8: contact_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = alpha + theta0
+        x9 = Omega_c*e
+        x10 = 2*r_c + w_b
+        x11 = (1/2)*alpha - 1/2*alpha0
+        x12 = sin(x11)
+        x13 = x12**2
+        x14 = (1/2)*Omega_c
+        x15 = t*x14
+        x16 = sin(x15)
+        x17 = e*x16
+        x18 = x15 + x8
+        x19 = 2*cos(x18)
+        x20 = cos(x11)
+        x21 = -2*chi0*x12*x20 + x10*x13 + x17*x19
+        x22 = -x21
+        x23 = pi*Y_e*l_lambda
+        x24 = (1/4)*x22*x23
+        x25 = 2*x13
+        x26 = sin(x18)
+        x27 = 2*x12*x20
+        return alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x22 - x24*(-chi0*x25 + chi0 + 2*e*x16*x26 - x27*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x9*sin(Omega_c*t + x8)) + (1/8)*x21*x23*(-2*alpha_dot*chi0*(1 - x25) + alpha_dot*x10*x27 - 4*x17*x26*(alpha_dot + x14) + x19*x9*cos(x15)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        return 0
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = Omega_c*t
+        x1 = alpha + theta0
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*x0
+        return -1/4*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x3*cos(x2) - 2*e*sin(x4)*cos(x1 + x4) - x3**2*(2*r_c + w_b))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = alpha + theta0
+        x9 = Omega_c*e
+        x10 = 2*r_c + w_b
+        x11 = (1/2)*alpha - 1/2*alpha0
+        x12 = sin(x11)
+        x13 = x12**2
+        x14 = (1/2)*Omega_c
+        x15 = t*x14
+        x16 = sin(x15)
+        x17 = e*x16
+        x18 = x15 + x8
+        x19 = 2*cos(x18)
+        x20 = cos(x11)
+        x21 = -2*chi0*x12*x20 + x10*x13 + x17*x19
+        x22 = pi*Y_e*l_lambda
+        x23 = -x21*x22
+        x24 = (1/4)*x23
+        x25 = 2*x13
+        x26 = sin(x18)
+        x27 = 2*x12*x20
+        return alpha_dot*(-1/8*mu_m*w_b*x23 - x24*(-chi0*x25 + chi0 + 2*e*x16*x26 - x27*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) + mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x9*sin(Omega_c*t + x8)) + (1/8)*x21*x22*(-2*alpha_dot*chi0*(1 - x25) + alpha_dot*x10*x27 - 4*x17*x26*(alpha_dot + x14) + x19*x9*cos(x15)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        return 0
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        l_lambda = p[11]
+        mu_m = p[12]
+        Y_e = p[13]
+        Omega_c = p[14]
+        x0 = Omega_c*t
+        x1 = alpha + theta0
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = (1/2)*x0
+        return (1/4)*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x3*cos(x2) - 2*e*sin(x4)*cos(x1 + x4) - x3**2*(2*r_c + w_b))
     return nan

@@ -115,7 +115,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -134,8 +135,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -173,30 +175,32 @@ def out_free(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = sin(x8)
-    x15 = Omega_c*e
-    x16 = tan(alpha)
-    x17 = (1/cos(alpha))
-    x18 = Omega_c*t + theta0
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 + e*sin(theta0) - e*sin(x18) + x13*x20
-    x22 = chi0*x20 + e*cos(theta0) - e*cos(x18) + x13*x19
-    return (chi0*x1 - x11*x9 - x2*x5, 2*chi0*x5 + x1*x13 - x11*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*cos(x7), k_s*(L_us + d_x*x16 - d_y - x12*x17), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(alpha + x18), 0, asin(x13/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x12*log(x16 + x17)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = 2*x3
+    x12 = sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = cos(alpha)
+    x18 = 1/x17
+    x19 = x18*sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
+    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -234,31 +238,33 @@ def out_free_v(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = numpy.sin(x8)
-    x15 = Omega_c*e
-    x16 = numpy.tan(alpha)
-    x17 = (numpy.cos(alpha)**(-1.0))
-    x18 = Omega_c*t + theta0
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 + e*numpy.sin(theta0) - e*numpy.sin(x18) + x13*x20
-    x22 = chi0*x20 + e*numpy.cos(theta0) - e*numpy.cos(x18) + x13*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = 2*x3
+    x12 = numpy.sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = numpy.cos(alpha)
+    x18 = x17**(-1.0)
+    x19 = x18*numpy.sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
+    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x11*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x13 - x11*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x16 - d_y - x12*x17) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*numpy.sin(alpha + x18) + _zero, 0 + _zero, numpy.arcsin(x13/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x12*numpy.log(x16 + x17)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -287,23 +293,25 @@ def rhs_contact_loading_fwd(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = -chi0*x2 + 2*x10*x11 + x3*x6
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = cos(x3)
+    x12 = -2*chi0*x11*x4 + 2*x10*x9 + x2*x5
     x13 = (4/3)*Y_e*sqrt(r_c)
-    x14 = sin(x9)
-    x15 = beta_D*x13*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x14*(alpha_dot + x7))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x11*x14 - x2*(r_c + x0)))/I_Pb
+    x14 = 2*x5
+    x15 = sin(x8)
+    x16 = x11*x4
+    x17 = beta_D*x13*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17 - x17*(-chi0*x14 + chi0 + 2*e*x10*x15 - 2*x16*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -332,48 +340,49 @@ def jac_contact_loading_fwd(t, alpha, alpha_dot, p):
     Y_e = p[14]
     Omega_c = p[17]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = 2*r_c + w_b
-    x20 = x15**2
-    x21 = x19*x20
-    x22 = -chi0*x18 + x12 + x21
-    x23 = Y_e*sqrt(r_c)
-    x24 = (4/3)*x23
-    x25 = Omega_c*cos(x7)
-    x26 = alpha_dot + x6
-    x27 = sin(x8)
-    x28 = x16*x19
-    x29 = beta_D*(alpha_dot*chi0*x5 - alpha_dot*x28 + 2*e*x10*x26*x27 - x25*x9)
-    x30 = abs(x22)
-    x31 = x30**(3/2)
-    x32 = x24*x31
-    x33 = e*x27
-    x34 = x11*x33
-    x35 = chi0*x5 - x28 + x34
-    x36 = x23*x35
-    x37 = 2*sqrt(x30)
-    x38 = (1/2)*alpha_dot
-    x39 = beta_D*x32
-    x40 = -x23*x29*x35*x37*(0.0 if x22 == 0 else copysign(1, x22)) + x36*x37 + x39*(-alpha_dot*chi0*x18 + x12*x26 - x14**2*x19*x38 + x21*x38 + x25*x33)
-    x41 = chi0 - x17*x20 - x18*x3 + x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x40 - x40*x41 - (x24*(-x22)*sqrt(abs(-x22)) + x29*x32)*(x12 - x16*x17 - x3*x5)), x0*((2/3)*beta_D*mu_m*w_b*x31*x36 - x35*x39*x41))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
+    x24 = Y_e*sqrt(r_c)
+    x25 = (4/3)*x24
+    x26 = Omega_c*cos(x5)
+    x27 = alpha_dot + x4
+    x28 = sin(x6)
+    x29 = x14*x21
+    x30 = beta_D*(alpha_dot*chi0*x20 - alpha_dot*x29 + 2*e*x27*x28*x8 - x26*x7)
+    x31 = abs(x23)
+    x32 = x31**(3/2)
+    x33 = x25*x32
+    x34 = e*x28
+    x35 = x34*x9
+    x36 = chi0*x20 - x29 + x35
+    x37 = x24*x36
+    x38 = 2*sqrt(x31)
+    x39 = (1/2)*alpha_dot
+    x40 = beta_D*x33
+    x41 = -x24*x30*x36*x38*(0.0 if x23 == 0 else copysign(1, x23)) + x37*x38 + x40*(-alpha_dot*x16 + x10*x27 - x12**2*x21*x39 + x22*x39 + x26*x34)
+    x42 = -chi0*x19 + chi0 - x15*x17 + x35
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x41 - x41*x42 - (x25*(-x23)*sqrt(abs(-x23)) + x30*x33)*(x10 - x16 - x17*x20)), x0*((2/3)*beta_D*mu_m*w_b*x32*x37 - x36*x40*x42))
 
 
 def out_contact_loading_fwd(t, alpha, alpha_dot, p):
@@ -414,51 +423,54 @@ def out_contact_loading_fwd(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*cos(x0) + alpha_dot*x2*x4*cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*cos(x7)
-    x20 = -x19
-    x21 = tan(alpha)
-    x22 = (1/cos(alpha))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = abs(x12)
-    x27 = x25*x26**(3/2)
-    x28 = beta_D*x27
-    x29 = x20*x28 + x25*(x13)*sqrt(abs(x13))
-    x30 = -x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*sin(alpha + x32)
-    x34 = sin(alpha)
-    x35 = cos(alpha)
-    x36 = sin(alpha0)
-    x37 = cos(alpha0)
-    x38 = -chi0*x36 + e*sin(theta0) - e*sin(x32) + x15*x37
-    x39 = chi0*x37 + e*cos(theta0) - e*cos(x32) + x15*x36
-    x40 = x21 + x22
-    x41 = d_x*k_s
-    x42 = x20**2*x28
-    x43 = x31*x33
-    return (x13, x17, x20, x23, x30, x31, x33, -x29*x34 + x31*x35, asin(x15/sqrt(x38**2 + x39**2)) - atan2(x38, x39), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x26**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*log(x35) - x14*log(x40)), alpha_dot*(-d_x*x23 - x14*x31 - x29*(chi0 - x17)) + x19*x27*(0.0 if x12 == 0 else copysign(1, x12)) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x40) + x42 + x43, x42, x43)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
+    x21 = -x20
+    x22 = cos(alpha)
+    x23 = 1/x22
+    x24 = sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = abs(x11)
+    x31 = x29*x30**(3/2)
+    x32 = beta_D*x31
+    x33 = x21*x32 + x29*(x12)*sqrt(abs(x12))
+    x34 = -x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x36)
+    x38 = sin(alpha0)
+    x39 = cos(alpha0)
+    x40 = -chi0*x38 + e*sin(theta0) - e*sin(x36) + x16*x39
+    x41 = chi0*x39 + e*cos(theta0) - e*cos(x36) + x16*x38
+    x42 = x23 + x25
+    x43 = d_x*k_s
+    x44 = x22**(-2)
+    x45 = x21**2*x32
+    x46 = x35*x37
+    return (x12, x18, x21, x27, x34, x35, x37, x22*x35 - x24*x33, asin(x16/sqrt(x40**2 + x41**2)) - atan2(x40, x41), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x30**(5/2) + x43*(L_us*alpha - alpha*d_y - d_x*log(x22) - x15*log(x42)), alpha_dot*(-d_x*x27 - x15*x35 - x33*(chi0 - x18)) + x20*x31*(0.0 if x11 == 0 else copysign(1, x11)) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x44 + alpha_dot*(x24**2*x44 + 1))/x42) + x45 + x46, x45, x46)
 
 
 def out_contact_loading_fwd_v(t, alpha, alpha_dot, p):
@@ -499,52 +511,55 @@ def out_contact_loading_fwd_v(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = numpy.sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*numpy.cos(x0) + alpha_dot*x2*x4*numpy.cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*numpy.cos(x7)
-    x20 = -x19
-    x21 = numpy.tan(alpha)
-    x22 = (numpy.cos(alpha)**(-1.0))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*numpy.sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = abs(x12)
-    x27 = x25*x26**(3/2)
-    x28 = beta_D*x27
-    x29 = x20*x28 + x25*(x13)*numpy.sqrt(numpy.abs(x13))
-    x30 = -x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*numpy.sin(alpha + x32)
-    x34 = numpy.sin(alpha)
-    x35 = numpy.cos(alpha)
-    x36 = numpy.sin(alpha0)
-    x37 = numpy.cos(alpha0)
-    x38 = -chi0*x36 + e*numpy.sin(theta0) - e*numpy.sin(x32) + x15*x37
-    x39 = chi0*x37 + e*numpy.cos(theta0) - e*numpy.cos(x32) + x15*x36
-    x40 = x21 + x22
-    x41 = d_x*k_s
-    x42 = x20**2*x28
-    x43 = x31*x33
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = numpy.sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
+    x21 = -x20
+    x22 = numpy.cos(alpha)
+    x23 = x22**(-1.0)
+    x24 = numpy.sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*numpy.sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = abs(x11)
+    x31 = x29*x30**(3/2)
+    x32 = beta_D*x31
+    x33 = x21*x32 + x29*(x12)*numpy.sqrt(numpy.abs(x12))
+    x34 = -x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x36)
+    x38 = numpy.sin(alpha0)
+    x39 = numpy.cos(alpha0)
+    x40 = -chi0*x38 + e*numpy.sin(theta0) - e*numpy.sin(x36) + x16*x39
+    x41 = chi0*x39 + e*numpy.cos(theta0) - e*numpy.cos(x36) + x16*x38
+    x42 = x23 + x25
+    x43 = d_x*k_s
+    x44 = x22**(-2.0)
+    x45 = x21**2*x32
+    x46 = x35*x37
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x17 + _zero, x20 + _zero, x23 + _zero, x30 + _zero, x31 + _zero, x33 + _zero, -x29*x34 + x31*x35 + _zero, numpy.arcsin(x15/numpy.sqrt(x38**2 + x39**2)) - numpy.arctan2(x38, x39) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x26**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*numpy.log(x35) - x14*numpy.log(x40)) + _zero, alpha_dot*(-d_x*x23 - x14*x31 - x29*(chi0 - x17)) + x19*x27*numpy.sign(x12) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x40) + x42 + x43 + _zero, x42 + _zero, x43 + _zero)
+    return (x12 + _zero, x18 + _zero, x21 + _zero, x27 + _zero, x34 + _zero, x35 + _zero, x37 + _zero, x22*x35 - x24*x33 + _zero, numpy.arcsin(x16/numpy.sqrt(x40**2 + x41**2)) - numpy.arctan2(x40, x41) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x30**(5/2) + x43*(L_us*alpha - alpha*d_y - d_x*numpy.log(x22) - x15*numpy.log(x42)) + _zero, alpha_dot*(-d_x*x27 - x15*x35 - x33*(chi0 - x18)) + x20*x31*numpy.sign(x11) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x44 + alpha_dot*(x24**2*x44 + 1))/x42) + x45 + x46 + _zero, x45 + _zero, x46 + _zero)
 
 
 def rhs_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -573,23 +588,25 @@ def rhs_contact_loading_bwd(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = -chi0*x2 + 2*x10*x11 + x3*x6
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = cos(x3)
+    x12 = -2*chi0*x11*x4 + 2*x10*x9 + x2*x5
     x13 = (4/3)*Y_e*sqrt(r_c)
-    x14 = sin(x9)
-    x15 = beta_D*x13*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x14*(alpha_dot + x7))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x11*x14 - x2*(r_c + x0)))/I_Pb
+    x14 = 2*x5
+    x15 = sin(x8)
+    x16 = x11*x4
+    x17 = beta_D*x13*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x17 - x17*(-chi0*x14 + chi0 + 2*e*x10*x15 - 2*x16*(r_c + x1)))/I_Pb
 
 
 def jac_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -618,48 +635,49 @@ def jac_contact_loading_bwd(t, alpha, alpha_dot, p):
     Y_e = p[14]
     Omega_c = p[17]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = 2*r_c + w_b
-    x20 = x15**2
-    x21 = x19*x20
-    x22 = -chi0*x18 + x12 + x21
-    x23 = Y_e*sqrt(r_c)
-    x24 = (4/3)*x23
-    x25 = Omega_c*cos(x7)
-    x26 = alpha_dot + x6
-    x27 = sin(x8)
-    x28 = x16*x19
-    x29 = beta_D*(alpha_dot*chi0*x5 - alpha_dot*x28 + 2*e*x10*x26*x27 - x25*x9)
-    x30 = abs(x22)
-    x31 = x30**(3/2)
-    x32 = x24*x31
-    x33 = e*x27
-    x34 = x11*x33
-    x35 = chi0*x5 - x28 + x34
-    x36 = x23*x35
-    x37 = 2*sqrt(x30)
-    x38 = (1/2)*alpha_dot
-    x39 = beta_D*x32
-    x40 = -x23*x29*x35*x37*(0.0 if x22 == 0 else copysign(1, x22)) + x36*x37 + x39*(-alpha_dot*chi0*x18 + x12*x26 - x14**2*x19*x38 + x21*x38 + x25*x33)
-    x41 = chi0 - x17*x20 - x18*x3 + x34
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - 1/2*mu_m*w_b*x40 - x40*x41 - (x24*(-x22)*sqrt(abs(-x22)) + x29*x32)*(x12 - x16*x17 - x3*x5)), x0*(-2/3*beta_D*mu_m*w_b*x31*x36 - x35*x39*x41))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
+    x24 = Y_e*sqrt(r_c)
+    x25 = (4/3)*x24
+    x26 = Omega_c*cos(x5)
+    x27 = alpha_dot + x4
+    x28 = sin(x6)
+    x29 = x14*x21
+    x30 = beta_D*(alpha_dot*chi0*x20 - alpha_dot*x29 + 2*e*x27*x28*x8 - x26*x7)
+    x31 = abs(x23)
+    x32 = x31**(3/2)
+    x33 = x25*x32
+    x34 = e*x28
+    x35 = x34*x9
+    x36 = chi0*x20 - x29 + x35
+    x37 = x24*x36
+    x38 = 2*sqrt(x31)
+    x39 = (1/2)*alpha_dot
+    x40 = beta_D*x33
+    x41 = -x24*x30*x36*x38*(0.0 if x23 == 0 else copysign(1, x23)) + x37*x38 + x40*(-alpha_dot*x16 + x10*x27 - x12**2*x21*x39 + x22*x39 + x26*x34)
+    x42 = -chi0*x19 + chi0 - x15*x17 + x35
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - 1/2*mu_m*w_b*x41 - x41*x42 - (x25*(-x23)*sqrt(abs(-x23)) + x30*x33)*(x10 - x16 - x17*x20)), x0*(-2/3*beta_D*mu_m*w_b*x32*x37 - x36*x40*x42))
 
 
 def out_contact_loading_bwd(t, alpha, alpha_dot, p):
@@ -700,51 +718,54 @@ def out_contact_loading_bwd(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*cos(x0) + alpha_dot*x2*x4*cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*cos(x7)
-    x20 = -x19
-    x21 = tan(alpha)
-    x22 = (1/cos(alpha))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = abs(x12)
-    x27 = x25*x26**(3/2)
-    x28 = beta_D*x27
-    x29 = x20*x28 + x25*(x13)*sqrt(abs(x13))
-    x30 = -x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*sin(alpha + x32)
-    x34 = sin(alpha)
-    x35 = cos(alpha)
-    x36 = sin(alpha0)
-    x37 = cos(alpha0)
-    x38 = -chi0*x36 + e*sin(theta0) - e*sin(x32) + x15*x37
-    x39 = chi0*x37 + e*cos(theta0) - e*cos(x32) + x15*x36
-    x40 = x21 + x22
-    x41 = d_x*k_s
-    x42 = x20**2*x28
-    x43 = -x31*x33
-    return (x13, x17, x20, x23, x30, -x31, x33, -x29*x34 - x31*x35, asin(x15/sqrt(x38**2 + x39**2)) - atan2(x38, x39), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x26**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*log(x35) - x14*log(x40)), alpha_dot*(-d_x*x23 + (1/2)*mu_m*w_b*x30 - x29*(chi0 - x17)) + x19*x27*(0.0 if x12 == 0 else copysign(1, x12)) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x40) + x42 + x43, x42, x43)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
+    x21 = -x20
+    x22 = cos(alpha)
+    x23 = 1/x22
+    x24 = sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = abs(x11)
+    x31 = x29*x30**(3/2)
+    x32 = beta_D*x31
+    x33 = x21*x32 + x29*(x12)*sqrt(abs(x12))
+    x34 = -x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x36)
+    x38 = sin(alpha0)
+    x39 = cos(alpha0)
+    x40 = -chi0*x38 + e*sin(theta0) - e*sin(x36) + x16*x39
+    x41 = chi0*x39 + e*cos(theta0) - e*cos(x36) + x16*x38
+    x42 = x23 + x25
+    x43 = d_x*k_s
+    x44 = x22**(-2)
+    x45 = x21**2*x32
+    x46 = -x35*x37
+    return (x12, x18, x21, x27, x34, -x35, x37, -x22*x35 - x24*x33, asin(x16/sqrt(x40**2 + x41**2)) - atan2(x40, x41), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x30**(5/2) + x43*(L_us*alpha - alpha*d_y - d_x*log(x22) - x15*log(x42)), alpha_dot*(-d_x*x27 + (1/2)*mu_m*w_b*x34 - x33*(chi0 - x18)) + x20*x31*(0.0 if x11 == 0 else copysign(1, x11)) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x44 + alpha_dot*(x24**2*x44 + 1))/x42) + x45 + x46, x45, x46)
 
 
 def out_contact_loading_bwd_v(t, alpha, alpha_dot, p):
@@ -785,52 +806,55 @@ def out_contact_loading_bwd_v(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = numpy.sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*numpy.cos(x0) + alpha_dot*x2*x4*numpy.cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*numpy.cos(x7)
-    x20 = -x19
-    x21 = numpy.tan(alpha)
-    x22 = (numpy.cos(alpha)**(-1.0))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*numpy.sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = abs(x12)
-    x27 = x25*x26**(3/2)
-    x28 = beta_D*x27
-    x29 = x20*x28 + x25*(x13)*numpy.sqrt(numpy.abs(x13))
-    x30 = -x29
-    x31 = mu_m*x30
-    x32 = Omega_c*t + theta0
-    x33 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*numpy.sin(alpha + x32)
-    x34 = numpy.sin(alpha)
-    x35 = numpy.cos(alpha)
-    x36 = numpy.sin(alpha0)
-    x37 = numpy.cos(alpha0)
-    x38 = -chi0*x36 + e*numpy.sin(theta0) - e*numpy.sin(x32) + x15*x37
-    x39 = chi0*x37 + e*numpy.cos(theta0) - e*numpy.cos(x32) + x15*x36
-    x40 = x21 + x22
-    x41 = d_x*k_s
-    x42 = x20**2*x28
-    x43 = -x31*x33
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = numpy.sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
+    x21 = -x20
+    x22 = numpy.cos(alpha)
+    x23 = x22**(-1.0)
+    x24 = numpy.sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*numpy.sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = abs(x11)
+    x31 = x29*x30**(3/2)
+    x32 = beta_D*x31
+    x33 = x21*x32 + x29*(x12)*numpy.sqrt(numpy.abs(x12))
+    x34 = -x33
+    x35 = mu_m*x34
+    x36 = Omega_c*t + theta0
+    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x36)
+    x38 = numpy.sin(alpha0)
+    x39 = numpy.cos(alpha0)
+    x40 = -chi0*x38 + e*numpy.sin(theta0) - e*numpy.sin(x36) + x16*x39
+    x41 = chi0*x39 + e*numpy.cos(theta0) - e*numpy.cos(x36) + x16*x38
+    x42 = x23 + x25
+    x43 = d_x*k_s
+    x44 = x22**(-2.0)
+    x45 = x21**2*x32
+    x46 = -x35*x37
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x17 + _zero, x20 + _zero, x23 + _zero, x30 + _zero, -x31 + _zero, x33 + _zero, -x29*x34 - x31*x35 + _zero, numpy.arcsin(x15/numpy.sqrt(x38**2 + x39**2)) - numpy.arctan2(x38, x39) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x26**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*numpy.log(x35) - x14*numpy.log(x40)) + _zero, alpha_dot*(-d_x*x23 + (1/2)*mu_m*w_b*x30 - x29*(chi0 - x17)) + x19*x27*numpy.sign(x12) + x41*(L_us*alpha_dot + alpha_dot*d_x*x34/x35 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x40) + x42 + x43 + _zero, x42 + _zero, x43 + _zero)
+    return (x12 + _zero, x18 + _zero, x21 + _zero, x27 + _zero, x34 + _zero, -x35 + _zero, x37 + _zero, -x22*x35 - x24*x33 + _zero, numpy.arcsin(x16/numpy.sqrt(x40**2 + x41**2)) - numpy.arctan2(x40, x41) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x30**(5/2) + x43*(L_us*alpha - alpha*d_y - d_x*numpy.log(x22) - x15*numpy.log(x42)) + _zero, alpha_dot*(-d_x*x27 + (1/2)*mu_m*w_b*x34 - x33*(chi0 - x18)) + x20*x31*numpy.sign(x11) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x44 + alpha_dot*(x24**2*x44 + 1))/x42) + x45 + x46 + _zero, x45 + _zero, x46 + _zero)
 
 
 def rhs_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -861,21 +885,23 @@ def rhs_contact_unloading_fwd(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = sin(x9)
-    x13 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x12*(alpha_dot + x7))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(chi0*x2 - 2*x10*x11 - x3*x6)*sqrt(abs(chi0*x2 - 2*x10*x11 - x3*x6))
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x13 - x13*(-2*chi0*x6 + chi0 + 2*e*x11*x12 - x2*(r_c + x0)))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = cos(x3)
+    x12 = 2*x5
+    x13 = sin(x8)
+    x14 = x11*x4
+    x15 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x12) - alpha_dot*x14*x2 + 2*e*x10*x13*(alpha_dot + x6))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*x10*x9 - x2*x5))
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x15 - x15*(-chi0*x12 + chi0 + 2*e*x10*x13 - 2*x14*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -906,42 +932,43 @@ def jac_contact_unloading_fwd(t, alpha, alpha_dot, p):
     vartheta = p[16]
     Omega_c = p[17]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = 2*r_c + w_b
-    x20 = x15**2
-    x21 = x19*x20
-    x22 = -chi0*x18 + x12 + x21
-    x23 = Y_e*sqrt(r_c)
-    x24 = Omega_c*cos(x7)
-    x25 = alpha_dot + x6
-    x26 = sin(x8)
-    x27 = x16*x19
-    x28 = I_Pb*vartheta*zeta_D/chi_star**2
-    x29 = 2*x28
-    x30 = e*x26
-    x31 = (1/2)*alpha_dot
-    x32 = chi0*x5 + x11*x30 - x27
-    x33 = 2*x32
-    x34 = x23*x33*sqrt(abs(x22)) + x29*(-alpha_dot*chi0*x18 + x12*x25 - x14**2*x19*x31 + x21*x31 + x24*x30)
-    x35 = chi0 + 2*e*x10*x26 - x17*x20 - x18*x3
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) + mu_m*x2*x34 - x34*x35 - ((4/3)*x23*(-x22)*sqrt(abs(-x22)) + x29*(alpha_dot*chi0*x5 - alpha_dot*x27 + 2*e*x10*x25*x26 - x24*x9))*(x12 - x16*x17 - x3*x5)), x0*(mu_m*w_b*x28*x32 - x28*x33*x35))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
+    x24 = Y_e*sqrt(r_c)
+    x25 = Omega_c*cos(x5)
+    x26 = alpha_dot + x4
+    x27 = sin(x6)
+    x28 = x14*x21
+    x29 = I_Pb*vartheta*zeta_D/chi_star**2
+    x30 = 2*x29
+    x31 = e*x27
+    x32 = (1/2)*alpha_dot
+    x33 = chi0*x20 - x28 + x31*x9
+    x34 = 2*x33
+    x35 = x24*x34*sqrt(abs(x23)) + x30*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x32 + x22*x32 + x25*x31)
+    x36 = -chi0*x19 + chi0 + 2*e*x27*x8 - x15*x17
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) + mu_m*x3*x35 - x35*x36 - ((4/3)*x24*(-x23)*sqrt(abs(-x23)) + x30*(alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7))*(x10 - x16 - x17*x20)), x0*(mu_m*w_b*x29*x33 - x29*x34*x36))
 
 
 def out_contact_unloading_fwd(t, alpha, alpha_dot, p):
@@ -984,50 +1011,53 @@ def out_contact_unloading_fwd(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*cos(x0) + alpha_dot*x2*x4*cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*cos(x7)
-    x20 = -x19
-    x21 = tan(alpha)
-    x22 = (1/cos(alpha))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x27 = x20*x26 + x25*(x13)*sqrt(abs(x13))
-    x28 = -x27
-    x29 = mu_m*x28
-    x30 = Omega_c*t + theta0
-    x31 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*sin(alpha + x30)
-    x32 = sin(alpha)
-    x33 = cos(alpha)
-    x34 = sin(alpha0)
-    x35 = cos(alpha0)
-    x36 = -chi0*x34 + e*sin(theta0) - e*sin(x30) + x15*x35
-    x37 = chi0*x35 + e*cos(theta0) - e*cos(x30) + x15*x34
-    x38 = x21 + x22
-    x39 = d_x*k_s
-    x40 = abs(x12)
-    x41 = x20**2*x26
-    x42 = x29*x31
-    return (x13, x17, x20, x23, x28, x29, x31, -x27*x32 + x29*x33, asin(x15/sqrt(x36**2 + x37**2)) - atan2(x36, x37), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x40**(5/2) + x39*(L_us*alpha - alpha*d_y - d_x*log(x33) - x14*log(x38)), alpha_dot*(-d_x*x23 - x14*x29 - x27*(chi0 - x17)) + x19*x25*x40**(3/2)*(0.0 if x12 == 0 else copysign(1, x12)) + x39*(L_us*alpha_dot + alpha_dot*d_x*x32/x33 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x38) + x41 + x42, x41, x42)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
+    x21 = -x20
+    x22 = cos(alpha)
+    x23 = 1/x22
+    x24 = sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x31 = x21*x30 + x29*(x12)*sqrt(abs(x12))
+    x32 = -x31
+    x33 = mu_m*x32
+    x34 = Omega_c*t + theta0
+    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x34)
+    x36 = sin(alpha0)
+    x37 = cos(alpha0)
+    x38 = -chi0*x36 + e*sin(theta0) - e*sin(x34) + x16*x37
+    x39 = chi0*x37 + e*cos(theta0) - e*cos(x34) + x16*x36
+    x40 = x23 + x25
+    x41 = d_x*k_s
+    x42 = abs(x11)
+    x43 = x22**(-2)
+    x44 = x21**2*x30
+    x45 = x33*x35
+    return (x12, x18, x21, x27, x32, x33, x35, x22*x33 - x24*x31, asin(x16/sqrt(x38**2 + x39**2)) - atan2(x38, x39), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x42**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*log(x22) - x15*log(x40)), alpha_dot*(-d_x*x27 - x15*x33 - x31*(chi0 - x18)) + x20*x29*x42**(3/2)*(0.0 if x11 == 0 else copysign(1, x11)) + x41*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x43 + alpha_dot*(x24**2*x43 + 1))/x40) + x44 + x45, x44, x45)
 
 
 def out_contact_unloading_fwd_v(t, alpha, alpha_dot, p):
@@ -1070,51 +1100,54 @@ def out_contact_unloading_fwd_v(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = numpy.sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*numpy.cos(x0) + alpha_dot*x2*x4*numpy.cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*numpy.cos(x7)
-    x20 = -x19
-    x21 = numpy.tan(alpha)
-    x22 = (numpy.cos(alpha)**(-1.0))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*numpy.sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x27 = x20*x26 + x25*(x13)*numpy.sqrt(numpy.abs(x13))
-    x28 = -x27
-    x29 = mu_m*x28
-    x30 = Omega_c*t + theta0
-    x31 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*numpy.sin(alpha + x30)
-    x32 = numpy.sin(alpha)
-    x33 = numpy.cos(alpha)
-    x34 = numpy.sin(alpha0)
-    x35 = numpy.cos(alpha0)
-    x36 = -chi0*x34 + e*numpy.sin(theta0) - e*numpy.sin(x30) + x15*x35
-    x37 = chi0*x35 + e*numpy.cos(theta0) - e*numpy.cos(x30) + x15*x34
-    x38 = x21 + x22
-    x39 = d_x*k_s
-    x40 = abs(x12)
-    x41 = x20**2*x26
-    x42 = x29*x31
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = numpy.sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
+    x21 = -x20
+    x22 = numpy.cos(alpha)
+    x23 = x22**(-1.0)
+    x24 = numpy.sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*numpy.sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x31 = x21*x30 + x29*(x12)*numpy.sqrt(numpy.abs(x12))
+    x32 = -x31
+    x33 = mu_m*x32
+    x34 = Omega_c*t + theta0
+    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x34)
+    x36 = numpy.sin(alpha0)
+    x37 = numpy.cos(alpha0)
+    x38 = -chi0*x36 + e*numpy.sin(theta0) - e*numpy.sin(x34) + x16*x37
+    x39 = chi0*x37 + e*numpy.cos(theta0) - e*numpy.cos(x34) + x16*x36
+    x40 = x23 + x25
+    x41 = d_x*k_s
+    x42 = abs(x11)
+    x43 = x22**(-2.0)
+    x44 = x21**2*x30
+    x45 = x33*x35
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x17 + _zero, x20 + _zero, x23 + _zero, x28 + _zero, x29 + _zero, x31 + _zero, -x27*x32 + x29*x33 + _zero, numpy.arcsin(x15/numpy.sqrt(x36**2 + x37**2)) - numpy.arctan2(x36, x37) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x40**(5/2) + x39*(L_us*alpha - alpha*d_y - d_x*numpy.log(x33) - x14*numpy.log(x38)) + _zero, alpha_dot*(-d_x*x23 - x14*x29 - x27*(chi0 - x17)) + x19*x25*x40**(3/2)*numpy.sign(x12) + x39*(L_us*alpha_dot + alpha_dot*d_x*x32/x33 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x38) + x41 + x42 + _zero, x41 + _zero, x42 + _zero)
+    return (x12 + _zero, x18 + _zero, x21 + _zero, x27 + _zero, x32 + _zero, x33 + _zero, x35 + _zero, x22*x33 - x24*x31 + _zero, numpy.arcsin(x16/numpy.sqrt(x38**2 + x39**2)) - numpy.arctan2(x38, x39) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x42**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*numpy.log(x22) - x15*numpy.log(x40)) + _zero, alpha_dot*(-d_x*x27 - x15*x33 - x31*(chi0 - x18)) + x20*x29*x42**(3/2)*numpy.sign(x11) + x41*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x43 + alpha_dot*(x24**2*x43 + 1))/x40) + x44 + x45 + _zero, x44 + _zero, x45 + _zero)
 
 
 def rhs_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1145,21 +1178,23 @@ def rhs_contact_unloading_bwd(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = (1/2)*w_b
-    x1 = alpha - alpha0
-    x2 = sin(x1)
-    x3 = 2*r_c + w_b
-    x4 = (1/2)*alpha - 1/2*alpha0
-    x5 = sin(x4)
-    x6 = x5**2
-    x7 = (1/2)*Omega_c
-    x8 = t*x7
-    x9 = alpha + theta0 + x8
-    x10 = e*cos(x9)
-    x11 = sin(x8)
-    x12 = sin(x9)
-    x13 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x12*(alpha_dot + x7))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(chi0*x2 - 2*x10*x11 - x3*x6)*sqrt(abs(chi0*x2 - 2*x10*x11 - x3*x6))
-    return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x13 - x13*(-2*chi0*x6 + chi0 + 2*e*x11*x12 - x2*(r_c + x0)))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = 2*r_c + w_b
+    x3 = (1/2)*alpha - 1/2*alpha0
+    x4 = sin(x3)
+    x5 = x4**2
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = alpha + theta0 + x7
+    x9 = e*cos(x8)
+    x10 = sin(x7)
+    x11 = cos(x3)
+    x12 = 2*x5
+    x13 = sin(x8)
+    x14 = x11*x4
+    x15 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x12) - alpha_dot*x14*x2 + 2*e*x10*x13*(alpha_dot + x6))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*x10*x9 - x2*x5))
+    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x15 - x15*(-chi0*x12 + chi0 + 2*e*x10*x13 - 2*x14*(r_c + x1)))/I_Pb
 
 
 def jac_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1190,42 +1225,43 @@ def jac_contact_unloading_bwd(t, alpha, alpha_dot, p):
     vartheta = p[16]
     Omega_c = p[17]
     x0 = 1/I_Pb
-    x1 = tan(alpha)
-    x2 = (1/2)*w_b
-    x3 = r_c + x2
-    x4 = alpha - alpha0
-    x5 = cos(x4)
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = e*cos(x8)
-    x10 = sin(x7)
-    x11 = 2*x10
-    x12 = x11*x9
-    x13 = (1/2)*alpha - 1/2*alpha0
-    x14 = cos(x13)
-    x15 = sin(x13)
-    x16 = x14*x15
-    x17 = 2*chi0
-    x18 = sin(x4)
-    x19 = 2*r_c + w_b
-    x20 = x15**2
-    x21 = x19*x20
-    x22 = -chi0*x18 + x12 + x21
-    x23 = Y_e*sqrt(r_c)
-    x24 = Omega_c*cos(x7)
-    x25 = alpha_dot + x6
-    x26 = sin(x8)
-    x27 = x16*x19
-    x28 = I_Pb*vartheta*zeta_D/chi_star**2
-    x29 = 2*x28
-    x30 = e*x26
-    x31 = (1/2)*alpha_dot
-    x32 = chi0*x5 + x11*x30 - x27
-    x33 = 2*x32
-    x34 = x23*x33*sqrt(abs(x22)) + x29*(-alpha_dot*chi0*x18 + x12*x25 - x14**2*x19*x31 + x21*x31 + x24*x30)
-    x35 = chi0 + 2*e*x10*x26 - x17*x20 - x18*x3
-    return (x0*(-d_x*k_s*(d_x*(x1**2 + 1) - x1*x2*(1/cos(alpha))) - 1/2*mu_m*w_b*x34 - x34*x35 - ((4/3)*x23*(-x22)*sqrt(abs(-x22)) + x29*(alpha_dot*chi0*x5 - alpha_dot*x27 + 2*e*x10*x25*x26 - x24*x9))*(x12 - x16*x17 - x3*x5)), x0*(-mu_m*w_b*x28*x32 - x28*x33*x35))
+    x1 = cos(alpha)**(-2)
+    x2 = sin(alpha)
+    x3 = (1/2)*w_b
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = e*cos(x6)
+    x8 = sin(x5)
+    x9 = 2*x8
+    x10 = x7*x9
+    x11 = (1/2)*alpha - 1/2*alpha0
+    x12 = cos(x11)
+    x13 = sin(x11)
+    x14 = x12*x13
+    x15 = 2*x14
+    x16 = chi0*x15
+    x17 = r_c + x3
+    x18 = x13**2
+    x19 = 2*x18
+    x20 = 1 - x19
+    x21 = 2*r_c + w_b
+    x22 = x18*x21
+    x23 = x10 - x16 + x22
+    x24 = Y_e*sqrt(r_c)
+    x25 = Omega_c*cos(x5)
+    x26 = alpha_dot + x4
+    x27 = sin(x6)
+    x28 = x14*x21
+    x29 = I_Pb*vartheta*zeta_D/chi_star**2
+    x30 = 2*x29
+    x31 = e*x27
+    x32 = (1/2)*alpha_dot
+    x33 = chi0*x20 - x28 + x31*x9
+    x34 = 2*x33
+    x35 = x24*x34*sqrt(abs(x23)) + x30*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x32 + x22*x32 + x25*x31)
+    x36 = -chi0*x19 + chi0 + 2*e*x27*x8 - x15*x17
+    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - 1/2*mu_m*w_b*x35 - x35*x36 - ((4/3)*x24*(-x23)*sqrt(abs(-x23)) + x30*(alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7))*(x10 - x16 - x17*x20)), x0*(-mu_m*w_b*x29*x33 - x29*x34*x36))
 
 
 def out_contact_unloading_bwd(t, alpha, alpha_dot, p):
@@ -1268,50 +1304,53 @@ def out_contact_unloading_bwd(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*cos(x0) + alpha_dot*x2*x4*cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*cos(x7)
-    x20 = -x19
-    x21 = tan(alpha)
-    x22 = (1/cos(alpha))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x27 = x20*x26 + x25*(x13)*sqrt(abs(x13))
-    x28 = -x27
-    x29 = mu_m*x28
-    x30 = Omega_c*t + theta0
-    x31 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*sin(alpha + x30)
-    x32 = sin(alpha)
-    x33 = cos(alpha)
-    x34 = sin(alpha0)
-    x35 = cos(alpha0)
-    x36 = -chi0*x34 + e*sin(theta0) - e*sin(x30) + x15*x35
-    x37 = chi0*x35 + e*cos(theta0) - e*cos(x30) + x15*x34
-    x38 = x21 + x22
-    x39 = d_x*k_s
-    x40 = abs(x12)
-    x41 = x20**2*x26
-    x42 = -x29*x31
-    return (x13, x17, x20, x23, x28, -x29, x31, -x27*x32 - x29*x33, asin(x15/sqrt(x36**2 + x37**2)) - atan2(x36, x37), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x40**(5/2) + x39*(L_us*alpha - alpha*d_y - d_x*log(x33) - x14*log(x38)), alpha_dot*(-d_x*x23 + (1/2)*mu_m*w_b*x28 - x27*(chi0 - x17)) + x19*x25*x40**(3/2)*(0.0 if x12 == 0 else copysign(1, x12)) + x39*(L_us*alpha_dot + alpha_dot*d_x*x32/x33 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x38) + x41 + x42, x41, x42)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
+    x21 = -x20
+    x22 = cos(alpha)
+    x23 = 1/x22
+    x24 = sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x31 = x21*x30 + x29*(x12)*sqrt(abs(x12))
+    x32 = -x31
+    x33 = mu_m*x32
+    x34 = Omega_c*t + theta0
+    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x34)
+    x36 = sin(alpha0)
+    x37 = cos(alpha0)
+    x38 = -chi0*x36 + e*sin(theta0) - e*sin(x34) + x16*x37
+    x39 = chi0*x37 + e*cos(theta0) - e*cos(x34) + x16*x36
+    x40 = x23 + x25
+    x41 = d_x*k_s
+    x42 = abs(x11)
+    x43 = x22**(-2)
+    x44 = x21**2*x30
+    x45 = -x33*x35
+    return (x12, x18, x21, x27, x32, -x33, x35, -x22*x33 - x24*x31, asin(x16/sqrt(x38**2 + x39**2)) - atan2(x38, x39), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x42**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*log(x22) - x15*log(x40)), alpha_dot*(-d_x*x27 + (1/2)*mu_m*w_b*x32 - x31*(chi0 - x18)) + x20*x29*x42**(3/2)*(0.0 if x11 == 0 else copysign(1, x11)) + x41*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x43 + alpha_dot*(x24**2*x43 + 1))/x40) + x44 + x45, x44, x45)
 
 
 def out_contact_unloading_bwd_v(t, alpha, alpha_dot, p):
@@ -1354,51 +1393,54 @@ def out_contact_unloading_bwd_v(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = numpy.sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*numpy.cos(x0) + alpha_dot*x2*x4*numpy.cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*numpy.cos(x7)
-    x20 = -x19
-    x21 = numpy.tan(alpha)
-    x22 = (numpy.cos(alpha)**(-1.0))
-    x23 = k_s*(L_us + d_x*x21 - d_y - x14*x22)
-    x24 = Y_e*numpy.sqrt(r_c)
-    x25 = (4/3)*x24
-    x26 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x27 = x20*x26 + x25*(x13)*numpy.sqrt(numpy.abs(x13))
-    x28 = -x27
-    x29 = mu_m*x28
-    x30 = Omega_c*t + theta0
-    x31 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*numpy.sin(alpha + x30)
-    x32 = numpy.sin(alpha)
-    x33 = numpy.cos(alpha)
-    x34 = numpy.sin(alpha0)
-    x35 = numpy.cos(alpha0)
-    x36 = -chi0*x34 + e*numpy.sin(theta0) - e*numpy.sin(x30) + x15*x35
-    x37 = chi0*x35 + e*numpy.cos(theta0) - e*numpy.cos(x30) + x15*x34
-    x38 = x21 + x22
-    x39 = d_x*k_s
-    x40 = abs(x12)
-    x41 = x20**2*x26
-    x42 = -x29*x31
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = numpy.sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
+    x21 = -x20
+    x22 = numpy.cos(alpha)
+    x23 = x22**(-1.0)
+    x24 = numpy.sin(alpha)
+    x25 = x23*x24
+    x26 = d_x*x25
+    x27 = k_s*(L_us - d_y - x15*x23 + x26)
+    x28 = Y_e*numpy.sqrt(r_c)
+    x29 = (4/3)*x28
+    x30 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x31 = x21*x30 + x29*(x12)*numpy.sqrt(numpy.abs(x12))
+    x32 = -x31
+    x33 = mu_m*x32
+    x34 = Omega_c*t + theta0
+    x35 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x34)
+    x36 = numpy.sin(alpha0)
+    x37 = numpy.cos(alpha0)
+    x38 = -chi0*x36 + e*numpy.sin(theta0) - e*numpy.sin(x34) + x16*x37
+    x39 = chi0*x37 + e*numpy.cos(theta0) - e*numpy.cos(x34) + x16*x36
+    x40 = x23 + x25
+    x41 = d_x*k_s
+    x42 = abs(x11)
+    x43 = x22**(-2.0)
+    x44 = x21**2*x30
+    x45 = -x33*x35
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x17 + _zero, x20 + _zero, x23 + _zero, x28 + _zero, -x29 + _zero, x31 + _zero, -x27*x32 - x29*x33 + _zero, numpy.arcsin(x15/numpy.sqrt(x36**2 + x37**2)) - numpy.arctan2(x36, x37) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x24*x40**(5/2) + x39*(L_us*alpha - alpha*d_y - d_x*numpy.log(x33) - x14*numpy.log(x38)) + _zero, alpha_dot*(-d_x*x23 + (1/2)*mu_m*w_b*x28 - x27*(chi0 - x17)) + x19*x25*x40**(3/2)*numpy.sign(x12) + x39*(L_us*alpha_dot + alpha_dot*d_x*x32/x33 - alpha_dot*d_y - x14*(alpha_dot*x21*x22 + alpha_dot*(x21**2 + 1))/x38) + x41 + x42 + _zero, x41 + _zero, x42 + _zero)
+    return (x12 + _zero, x18 + _zero, x21 + _zero, x27 + _zero, x32 + _zero, -x33 + _zero, x35 + _zero, -x22*x33 - x24*x31 + _zero, numpy.arcsin(x16/numpy.sqrt(x38**2 + x39**2)) - numpy.arctan2(x38, x39) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x28*x42**(5/2) + x41*(L_us*alpha - alpha*d_y - d_x*numpy.log(x22) - x15*numpy.log(x40)) + _zero, alpha_dot*(-d_x*x27 + (1/2)*mu_m*w_b*x32 - x31*(chi0 - x18)) + x20*x29*x42**(3/2)*numpy.sign(x11) + x41*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x26 - x15*(alpha_dot*x24*x43 + alpha_dot*(x24**2*x43 + 1))/x40) + x44 + x45 + _zero, x44 + _zero, x45 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -1419,8 +1461,10 @@ def gap(t, alpha, alpha_dot, p):
     alpha0 = p[4]
     theta0 = p[5]
     Omega_c = p[17]
-    x0 = (1/2)*Omega_c*t
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Omega_c*t
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -1445,7 +1489,8 @@ def gap_rate(t, alpha, alpha_dot, p):
     x1 = t*x0
     x2 = alpha + theta0 + x1
     x3 = (1/2)*alpha - 1/2*alpha0
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    x4 = sin(x3)
+    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
 
 
 def slip(t, alpha, alpha_dot, p):
@@ -1510,28 +1555,30 @@ def static_moment(alpha, p):
     L_us = p[8]
     k_s = p[9]
     Y_e = p[14]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = r_c + x1
-    x5 = alpha - alpha0
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = (1/2)*alpha - 1/2*alpha0
     x6 = sin(x5)
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = 2*chi0
-    x11 = x10*x9 + x4*x6
-    x12 = chi0 - x11
-    x13 = 2*r_c + w_b
-    x14 = chi0*x6 - x13*x9
-    x15 = sqrt(r_c)
-    x16 = (4/3)*Y_e*x15
-    x17 = x16*(x14)*sqrt(abs(x14))
-    x18 = cos(x5)
-    x19 = x8*cos(x7)
-    x20 = sqrt(abs(x14))
-    return (-x12*x17 - x3*(L_us + d_x*x0 - d_y - x2), -2*Y_e*x12*x15*x20*(chi0*x18 - x13*x19) - x17*(-x10*x19 - x18*x4) - x3*(d_x*(x0**2 + 1) - x0*x2), x14, x11, x16*x20)
+    x7 = x6**2
+    x8 = 2*x7
+    x9 = r_c + x2
+    x10 = x6*cos(x5)
+    x11 = 2*x10
+    x12 = chi0*x8 + x11*x9
+    x13 = chi0 - x12
+    x14 = 2*r_c + w_b
+    x15 = chi0*x11
+    x16 = -x14*x7 + x15
+    x17 = sqrt(r_c)
+    x18 = (4/3)*Y_e*x17
+    x19 = x18*(x16)*sqrt(abs(x16))
+    x20 = x0**(-2)
+    x21 = 1 - x8
+    x22 = sqrt(abs(x16))
+    return (-x13*x19 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -2*Y_e*x13*x17*x22*(chi0*x21 - x10*x14) - x19*(-x15 - x21*x9) - x4*(d_x*(x20*x3**2 + 1) - x2*x20*x3), x16, x12, x18*x22)
 
 
 def reach(Theta, p):
@@ -1602,7 +1649,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -1620,10 +1668,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -1651,7 +1700,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -1668,23 +1718,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_D = p[13]
         Y_e = p[14]
         Omega_c = p[17]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = -chi0*x2 + 2*x10*x11 + x3*x6
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = -2*chi0*x11*x4 + 2*x10*x9 + x2*x5
         x13 = (4/3)*Y_e*sqrt(r_c)
-        x14 = sin(x9)
-        x15 = beta_D*x13*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x14*(alpha_dot + x7))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x11*x14 - x2*(r_c + x0)))/I_Pb
+        x14 = 2*x5
+        x15 = sin(x8)
+        x16 = x11*x4
+        x17 = beta_D*x13*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x17 - x17*(-chi0*x14 + chi0 + 2*e*x10*x15 - 2*x16*(r_c + x1)))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
@@ -1701,23 +1753,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_D = p[13]
         Y_e = p[14]
         Omega_c = p[17]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = -chi0*x2 + 2*x10*x11 + x3*x6
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = -2*chi0*x11*x4 + 2*x10*x9 + x2*x5
         x13 = (4/3)*Y_e*sqrt(r_c)
-        x14 = sin(x9)
-        x15 = beta_D*x13*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x14*(alpha_dot + x7))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x15 - x15*(-2*chi0*x6 + chi0 + 2*e*x11*x14 - x2*(r_c + x0)))/I_Pb
+        x14 = 2*x5
+        x15 = sin(x8)
+        x16 = x11*x4
+        x17 = beta_D*x13*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x14) - alpha_dot*x16*x2 + 2*e*x10*x15*(alpha_dot + x6))*abs(x12)**(3/2) + x13*(-x12)*sqrt(abs(-x12))
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x17 - x17*(-chi0*x14 + chi0 + 2*e*x10*x15 - 2*x16*(r_c + x1)))/I_Pb
     elif r == 3:
         r_c = p[0]
         e = p[1]
@@ -1736,21 +1790,23 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[15]
         vartheta = p[16]
         Omega_c = p[17]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = sin(x9)
-        x13 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x12*(alpha_dot + x7))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(chi0*x2 - 2*x10*x11 - x3*x6)*sqrt(abs(chi0*x2 - 2*x10*x11 - x3*x6))
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) + mu_m*x0*x13 - x13*(-2*chi0*x6 + chi0 + 2*e*x11*x12 - x2*(r_c + x0)))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = 2*x5
+        x13 = sin(x8)
+        x14 = x11*x4
+        x15 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x12) - alpha_dot*x14*x2 + 2*e*x10*x13*(alpha_dot + x6))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*x10*x9 - x2*x5))
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) + mu_m*x1*x15 - x15*(-chi0*x12 + chi0 + 2*e*x10*x13 - 2*x14*(r_c + x1)))/I_Pb
     elif r == 4:
         r_c = p[0]
         e = p[1]
@@ -1769,21 +1825,23 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[15]
         vartheta = p[16]
         Omega_c = p[17]
-        x0 = (1/2)*w_b
-        x1 = alpha - alpha0
-        x2 = sin(x1)
-        x3 = 2*r_c + w_b
-        x4 = (1/2)*alpha - 1/2*alpha0
-        x5 = sin(x4)
-        x6 = x5**2
-        x7 = (1/2)*Omega_c
-        x8 = t*x7
-        x9 = alpha + theta0 + x8
-        x10 = e*cos(x9)
-        x11 = sin(x8)
-        x12 = sin(x9)
-        x13 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x10*cos(x8) + alpha_dot*chi0*cos(x1) - alpha_dot*x3*x5*cos(x4) + 2*e*x11*x12*(alpha_dot + x7))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(chi0*x2 - 2*x10*x11 - x3*x6)*sqrt(abs(chi0*x2 - 2*x10*x11 - x3*x6))
-        return (-d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))) - 1/2*mu_m*w_b*x13 - x13*(-2*chi0*x6 + chi0 + 2*e*x11*x12 - x2*(r_c + x0)))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = alpha + theta0 + x7
+        x9 = e*cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = 2*x5
+        x13 = sin(x8)
+        x14 = x11*x4
+        x15 = 2*I_Pb*vartheta*zeta_D*(-Omega_c*x9*cos(x7) + alpha_dot*chi0*(1 - x12) - alpha_dot*x14*x2 + 2*e*x10*x13*(alpha_dot + x6))/chi_star**2 + (4/3)*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*x10*x9 - x2*x5))
+        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/2*mu_m*w_b*x15 - x15*(-chi0*x12 + chi0 + 2*e*x10*x13 - 2*x14*(r_c + x1)))/I_Pb
     return nan
 
 
@@ -1811,8 +1869,10 @@ def surface_index(k, t, alpha, alpha_dot, p):
         alpha0 = p[4]
         theta0 = p[5]
         Omega_c = p[17]
-        x0 = (1/2)*Omega_c*t
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/2)*Omega_c*t
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1825,7 +1885,8 @@ def surface_index(k, t, alpha, alpha_dot, p):
         x1 = t*x0
         x2 = alpha + theta0 + x1
         x3 = (1/2)*alpha - 1/2*alpha0
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
     elif k == 2:
         r_c = p[0]
         e = p[1]
@@ -1833,4 +1894,464 @@ def surface_index(k, t, alpha, alpha_dot, p):
         theta0 = p[5]
         Omega_c = p[17]
         return -Omega_c*e*sin(Omega_c*t + alpha + theta0) - Omega_c*r_c + (1/2)*alpha_dot*w_b
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+        1: dv_r_dt
+        2: dv_r_dalpha
+        3: dv_r_dalpha_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[17]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    elif j == 1:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[17]
+        return -Omega_c**2*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 2:
+        e = p[1]
+        theta0 = p[5]
+        Omega_c = p[17]
+        return -Omega_c*e*cos(Omega_c*t + alpha + theta0)
+    elif j == 3:
+        w_b = p[2]
+        return (1/2)*w_b
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact_loading_fwd: P_in
+        4: contact_loading_fwd: D_c
+        5: contact_loading_fwd: D_f
+        6: contact_loading_bwd: P_in
+        7: contact_loading_bwd: D_c
+        8: contact_loading_bwd: D_f
+        9: contact_unloading_fwd: P_in
+        10: contact_unloading_fwd: D_c
+        11: contact_unloading_fwd: D_f
+        12: contact_unloading_bwd: P_in
+        13: contact_unloading_bwd: D_c
+        14: contact_unloading_bwd: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        mu_m = p[11]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = (1/2)*alpha - 1/2*alpha0
+        x15 = sin(x14)
+        x16 = x15**2
+        x17 = 2*x16
+        x18 = sin(x9)
+        x19 = sin(x11)
+        x20 = 2*r_c + w_b
+        x21 = cos(x14)
+        x22 = x15*x21
+        x23 = -alpha_dot*chi0*(1 - x17) + alpha_dot*x20*x22 - 2*e*x18*x19*(alpha_dot + x8) + x12*x13*cos(x9)
+        x24 = -x23
+        x25 = -2*chi0*x15*x21 + 2*e*x12*x18 + x16*x20
+        x26 = (4/3)*Y_e*sqrt(r_c)
+        x27 = x26*abs(x25)**(3/2)
+        x28 = beta_D*x27
+        x29 = x24*x28 + x26*(-x25)*sqrt(abs(-x25))
+        x30 = -mu_m*x29
+        return alpha_dot*(-x29*(-chi0*x17 + chi0 + 2*e*x18*x19 - 2*x22*(r_c + x6)) - x30*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x23*x27*(0.0 if x25 == 0 else copysign(1, x25)) + x24**2*x28 + x30*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        x9 = x2*cos(x1)
+        return (4/3)*Y_e*beta_D*sqrt(r_c)*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)**(3/2)
+    elif c == 5:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        mu_m = p[11]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = -2*chi0*x11*x4 + 2*e*x10*x9 + x2*x5
+        x13 = (4/3)*Y_e*sqrt(r_c)
+        return mu_m*(-beta_D*x13*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x12)**(3/2) - x13*(-x12)*sqrt(abs(-x12)))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 6:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        mu_m = p[11]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = (1/2)*alpha - 1/2*alpha0
+        x15 = sin(x14)
+        x16 = x15**2
+        x17 = 2*x16
+        x18 = sin(x9)
+        x19 = sin(x11)
+        x20 = 2*r_c + w_b
+        x21 = cos(x14)
+        x22 = x15*x21
+        x23 = -alpha_dot*chi0*(1 - x17) + alpha_dot*x20*x22 - 2*e*x18*x19*(alpha_dot + x8) + x12*x13*cos(x9)
+        x24 = -x23
+        x25 = -2*chi0*x15*x21 + 2*e*x12*x18 + x16*x20
+        x26 = (4/3)*Y_e*sqrt(r_c)
+        x27 = x26*abs(x25)**(3/2)
+        x28 = beta_D*x27
+        x29 = x24*x28 + x26*(-x25)*sqrt(abs(-x25))
+        x30 = -x29
+        return alpha_dot*((1/2)*mu_m*w_b*x30 - x29*(-chi0*x17 + chi0 + 2*e*x18*x19 - 2*x22*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x30*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x23*x27*(0.0 if x25 == 0 else copysign(1, x25)) + x24**2*x28 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 7:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = 2*r_c + w_b
+        x1 = (1/2)*alpha - 1/2*alpha0
+        x2 = sin(x1)
+        x3 = x2**2
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = alpha + theta0 + x5
+        x7 = e*cos(x6)
+        x8 = sin(x5)
+        x9 = x2*cos(x1)
+        return (4/3)*Y_e*beta_D*sqrt(r_c)*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)**(3/2)
+    elif c == 8:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        mu_m = p[11]
+        beta_D = p[13]
+        Y_e = p[14]
+        Omega_c = p[17]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        x12 = -2*chi0*x11*x4 + 2*e*x10*x9 + x2*x5
+        x13 = (4/3)*Y_e*sqrt(r_c)
+        return -mu_m*(-beta_D*x13*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))*abs(x12)**(3/2) - x13*(-x12)*sqrt(abs(-x12)))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 9:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        mu_m = p[11]
+        zeta_D = p[12]
+        Y_e = p[14]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = (1/2)*alpha - 1/2*alpha0
+        x15 = sin(x14)
+        x16 = x15**2
+        x17 = 2*x16
+        x18 = sin(x9)
+        x19 = sin(x11)
+        x20 = 2*r_c + w_b
+        x21 = cos(x14)
+        x22 = x15*x21
+        x23 = -alpha_dot*chi0*(1 - x17) + alpha_dot*x20*x22 - 2*e*x18*x19*(alpha_dot + x8) + x12*x13*cos(x9)
+        x24 = -x23
+        x25 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x26 = -2*chi0*x15*x21 + 2*e*x12*x18 + x16*x20
+        x27 = (4/3)*Y_e*sqrt(r_c)
+        x28 = x24*x25 + x27*(-x26)*sqrt(abs(-x26))
+        x29 = -mu_m*x28
+        return alpha_dot*(-x28*(-chi0*x17 + chi0 + 2*e*x18*x19 - 2*x22*(r_c + x6)) - x29*x6 - x7*(L_us - d_y - x2*x6 + x4)) + x23*x27*abs(x26)**(3/2)*(0.0 if x26 == 0 else copysign(1, x26)) + x24**2*x25 + x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 10:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[12]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 11:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        mu_m = p[11]
+        zeta_D = p[12]
+        Y_e = p[14]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        return mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 4/3*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5)))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
+    elif c == 12:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        I_Pb = p[10]
+        mu_m = p[11]
+        zeta_D = p[12]
+        Y_e = p[14]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*Omega_c
+        x9 = t*x8
+        x10 = alpha + theta0
+        x11 = x10 + x9
+        x12 = cos(x11)
+        x13 = Omega_c*e
+        x14 = (1/2)*alpha - 1/2*alpha0
+        x15 = sin(x14)
+        x16 = x15**2
+        x17 = 2*x16
+        x18 = sin(x9)
+        x19 = sin(x11)
+        x20 = 2*r_c + w_b
+        x21 = cos(x14)
+        x22 = x15*x21
+        x23 = -alpha_dot*chi0*(1 - x17) + alpha_dot*x20*x22 - 2*e*x18*x19*(alpha_dot + x8) + x12*x13*cos(x9)
+        x24 = -x23
+        x25 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x26 = -2*chi0*x15*x21 + 2*e*x12*x18 + x16*x20
+        x27 = (4/3)*Y_e*sqrt(r_c)
+        x28 = x24*x25 + x27*(-x26)*sqrt(abs(-x26))
+        x29 = -x28
+        return alpha_dot*((1/2)*mu_m*w_b*x29 - x28*(-chi0*x17 + chi0 + 2*e*x18*x19 - 2*x22*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x29*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x13*sin(Omega_c*t + x10)) + x23*x27*abs(x26)**(3/2)*(0.0 if x26 == 0 else copysign(1, x26)) + x24**2*x25 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 13:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        zeta_D = p[12]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+    elif c == 14:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        I_Pb = p[10]
+        mu_m = p[11]
+        zeta_D = p[12]
+        Y_e = p[14]
+        chi_star = p[15]
+        vartheta = p[16]
+        Omega_c = p[17]
+        x0 = alpha + theta0
+        x1 = Omega_c*e
+        x2 = 2*r_c + w_b
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = x0 + x7
+        x9 = cos(x8)
+        x10 = sin(x7)
+        x11 = cos(x3)
+        return -mu_m*(-2*I_Pb*vartheta*zeta_D*(alpha_dot*chi0*(1 - 2*x5) - alpha_dot*x11*x2*x4 + 2*e*x10*(alpha_dot + x6)*sin(x8) - x1*x9*cos(x7))/chi_star**2 - 4/3*Y_e*sqrt(r_c)*(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5)*sqrt(abs(2*chi0*x11*x4 - 2*e*x10*x9 - x2*x5)))*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x1*sin(Omega_c*t + x0))
     return nan

@@ -110,7 +110,8 @@ def rhs_free(t, alpha, alpha_dot, p):
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
-    return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+    x0 = 1/cos(alpha)
+    return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
 
 
 def jac_free(t, alpha, alpha_dot, p):
@@ -129,8 +130,9 @@ def jac_free(t, alpha, alpha_dot, p):
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
-    x0 = tan(alpha)
-    return (-d_x*k_s*(d_x*(x0**2 + 1) - 1/2*w_b*x0*(1/cos(alpha)))/I_Pb, 0)
+    x0 = sin(alpha)
+    x1 = cos(alpha)**(-2)
+    return (-d_x*k_s*(d_x*(x0**2*x1 + 1) - 1/2*w_b*x0*x1)/I_Pb, 0)
 
 
 def out_free(t, alpha, alpha_dot, p):
@@ -168,30 +170,32 @@ def out_free(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[12]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = sin(x8)
-    x15 = Omega_c*e
-    x16 = tan(alpha)
-    x17 = (1/cos(alpha))
-    x18 = Omega_c*t + theta0
-    x19 = sin(alpha0)
-    x20 = cos(alpha0)
-    x21 = -chi0*x19 + e*sin(theta0) - e*sin(x18) + x13*x20
-    x22 = chi0*x20 + e*cos(theta0) - e*cos(x18) + x13*x19
-    return (chi0*x1 - x11*x9 - x2*x5, 2*chi0*x5 + x1*x13 - x11*x14, alpha_dot*chi0*cos(x0) - alpha_dot*x2*x4*cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*cos(x7), k_s*(L_us + d_x*x16 - d_y - x12*x17), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*sin(alpha + x18), 0, asin(x13/sqrt(x21**2 + x22**2)) - atan2(x21, x22), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x12*log(x16 + x17)), 0, 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = 2*x3
+    x12 = sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = cos(alpha)
+    x18 = 1/x17
+    x19 = x18*sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = sin(alpha0)
+    x22 = cos(alpha0)
+    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
+    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -229,31 +233,33 @@ def out_free_v(t, alpha, alpha_dot, p):
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[12]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = (1/2)*w_b
-    x13 = r_c + x12
-    x14 = numpy.sin(x8)
-    x15 = Omega_c*e
-    x16 = numpy.tan(alpha)
-    x17 = (numpy.cos(alpha)**(-1.0))
-    x18 = Omega_c*t + theta0
-    x19 = numpy.sin(alpha0)
-    x20 = numpy.cos(alpha0)
-    x21 = -chi0*x19 + e*numpy.sin(theta0) - e*numpy.sin(x18) + x13*x20
-    x22 = chi0*x20 + e*numpy.cos(theta0) - e*numpy.cos(x18) + x13*x19
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = 2*x3
+    x12 = numpy.sin(x6)
+    x13 = (1/2)*w_b
+    x14 = r_c + x13
+    x15 = x10*x2
+    x16 = Omega_c*e
+    x17 = numpy.cos(alpha)
+    x18 = x17**(-1.0)
+    x19 = x18*numpy.sin(alpha)
+    x20 = Omega_c*t + theta0
+    x21 = numpy.sin(alpha0)
+    x22 = numpy.cos(alpha0)
+    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
+    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (chi0*x1 - x11*x9 - x2*x5 + _zero, 2*chi0*x5 + x1*x13 - x11*x14 + _zero, alpha_dot*chi0*numpy.cos(x0) - alpha_dot*x2*x4*numpy.cos(x3) + 2*e*x10*x14*(alpha_dot + x6) - x15*x9*numpy.cos(x7) + _zero, k_s*(L_us + d_x*x16 - d_y - x12*x17) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x15*numpy.sin(alpha + x18) + _zero, 0 + _zero, numpy.arcsin(x13/numpy.sqrt(x21**2 + x22**2)) - numpy.arctan2(x21, x22) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(numpy.cos(alpha)) - x12*numpy.log(x16 + x17)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact(t, alpha, alpha_dot, p):
@@ -280,13 +286,16 @@ def rhs_contact(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = (1/2)*w_b
-    x1 = sin(alpha - alpha0)
-    x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-    x3 = (1/2)*Omega_c*t
-    x4 = alpha + theta0 + x3
-    x5 = sin(x3)
-    return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0))*(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))*sqrt(abs(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))))/I_Pb
+    x0 = 1/cos(alpha)
+    x1 = (1/2)*w_b
+    x2 = (1/2)*alpha - 1/2*alpha0
+    x3 = sin(x2)
+    x4 = x3**2
+    x5 = (1/2)*Omega_c*t
+    x6 = sin(x5)
+    x7 = alpha + theta0 + x5
+    x8 = cos(x2)
+    return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x4 + chi0 + 2*e*x6*sin(x7) - 2*x3*x8*(r_c + x1))*(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))*sqrt(abs(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
 
 
 def jac_contact(t, alpha, alpha_dot, p):
@@ -312,27 +321,28 @@ def jac_contact(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = r_c + x1
-    x3 = alpha - alpha0
-    x4 = cos(x3)
-    x5 = (1/2)*Omega_c*t
-    x6 = alpha + theta0 + x5
-    x7 = sin(x5)
-    x8 = 2*e*x7
-    x9 = x8*cos(x6)
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = sin(x10)
-    x12 = x11*cos(x10)
-    x13 = 2*chi0
-    x14 = sin(x3)
-    x15 = 2*r_c + w_b
-    x16 = x11**2
-    x17 = -chi0*x14 + x15*x16 + x9
-    x18 = Y_e*sqrt(r_c)
-    x19 = sin(x6)
-    return ((-d_x*k_s*(d_x*(x0**2 + 1) - x0*x1*(1/cos(alpha))) - 2*x18*(chi0*x4 - x12*x15 + x19*x8)*(chi0 + 2*e*x19*x7 - x13*x16 - x14*x2)*sqrt(abs(x17)) - 4/3*x18*(-x12*x13 - x2*x4 + x9)*(-x17)*sqrt(abs(-x17)))/I_Pb, 0)
+    x0 = cos(alpha)**(-2)
+    x1 = sin(alpha)
+    x2 = (1/2)*w_b
+    x3 = (1/2)*Omega_c*t
+    x4 = alpha + theta0 + x3
+    x5 = sin(x3)
+    x6 = 2*e*x5
+    x7 = x6*cos(x4)
+    x8 = (1/2)*alpha - 1/2*alpha0
+    x9 = sin(x8)
+    x10 = x9*cos(x8)
+    x11 = 2*x10
+    x12 = chi0*x11
+    x13 = r_c + x2
+    x14 = x9**2
+    x15 = 2*x14
+    x16 = 1 - x15
+    x17 = 2*r_c + w_b
+    x18 = -x12 + x14*x17 + x7
+    x19 = Y_e*sqrt(r_c)
+    x20 = sin(x4)
+    return ((-d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - 4/3*x19*(-x12 - x13*x16 + x7)*(-x18)*sqrt(abs(-x18)) - 2*x19*(chi0*x16 - x10*x17 + x20*x6)*(-chi0*x15 + chi0 + 2*e*x20*x5 - x11*x13)*sqrt(abs(x18)))/I_Pb, 0)
 
 
 def out_contact(t, alpha, alpha_dot, p):
@@ -371,43 +381,46 @@ def out_contact(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = alpha - alpha0
-    x1 = sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = cos(x8)
-    x10 = sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*cos(x0) + alpha_dot*x2*x4*cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*cos(x7)
-    x20 = tan(alpha)
-    x21 = (1/cos(alpha))
-    x22 = k_s*(L_us + d_x*x20 - d_y - x14*x21)
-    x23 = Y_e*sqrt(r_c)
-    x24 = (4/3)*x23
-    x25 = x24*(x13)*sqrt(abs(x13))
-    x26 = Omega_c*t + theta0
-    x27 = sin(alpha)
-    x28 = sin(alpha0)
-    x29 = cos(alpha0)
-    x30 = -chi0*x28 + e*sin(theta0) - e*sin(x26) + x15*x29
-    x31 = chi0*x29 + e*cos(theta0) - e*cos(x26) + x15*x28
-    x32 = cos(alpha)
-    x33 = x20 + x21
-    x34 = d_x*k_s
-    x35 = abs(x12)
-    return (x13, x17, -x19, x22, -x25, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*sin(alpha + x26), -x25*x27, asin(x15/sqrt(x30**2 + x31**2)) - atan2(x30, x31), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x23*x35**(5/2) + x34*(L_us*alpha - alpha*d_y - d_x*log(x32) - x14*log(x33)), alpha_dot*(-d_x*x22 - x25*(chi0 - x17)) + x19*x24*x35**(3/2)*(0.0 if x12 == 0 else copysign(1, x12)) + x34*(L_us*alpha_dot + alpha_dot*d_x*x27/x32 - alpha_dot*d_y - x14*(alpha_dot*x20*x21 + alpha_dot*(x20**2 + 1))/x33), 0, 0)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = cos(x6)
+    x8 = sin(x5)
+    x9 = 2*e*x8
+    x10 = cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
+    x21 = cos(alpha)
+    x22 = 1/x21
+    x23 = sin(alpha)
+    x24 = x22*x23
+    x25 = d_x*x24
+    x26 = k_s*(L_us - d_y - x15*x22 + x25)
+    x27 = Y_e*sqrt(r_c)
+    x28 = (4/3)*x27
+    x29 = x28*(x12)*sqrt(abs(x12))
+    x30 = Omega_c*t + theta0
+    x31 = sin(alpha0)
+    x32 = cos(alpha0)
+    x33 = -chi0*x31 + e*sin(theta0) - e*sin(x30) + x16*x32
+    x34 = chi0*x32 + e*cos(theta0) - e*cos(x30) + x16*x31
+    x35 = x22 + x24
+    x36 = d_x*k_s
+    x37 = abs(x11)
+    x38 = x21**(-2)
+    return (x12, x18, -x20, x26, -x29, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x30), -x23*x29, asin(x16/sqrt(x33**2 + x34**2)) - atan2(x33, x34), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x27*x37**(5/2) + x36*(L_us*alpha - alpha*d_y - d_x*log(x21) - x15*log(x35)), alpha_dot*(-d_x*x26 - x29*(chi0 - x18)) + x20*x28*x37**(3/2)*(0.0 if x11 == 0 else copysign(1, x11)) + x36*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x25 - x15*(alpha_dot*x23*x38 + alpha_dot*(x23**2*x38 + 1))/x35), 0, 0)
 
 
 def out_contact_v(t, alpha, alpha_dot, p):
@@ -446,44 +459,47 @@ def out_contact_v(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = alpha - alpha0
-    x1 = numpy.sin(x0)
-    x2 = 2*r_c + w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = numpy.sin(x3)
-    x5 = x4**2
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = alpha + theta0 + x7
-    x9 = numpy.cos(x8)
-    x10 = numpy.sin(x7)
-    x11 = 2*e*x10
-    x12 = -chi0*x1 + x11*x9 + x2*x5
-    x13 = -x12
-    x14 = (1/2)*w_b
-    x15 = r_c + x14
-    x16 = numpy.sin(x8)
-    x17 = 2*chi0*x5 + x1*x15 - x11*x16
-    x18 = Omega_c*e
-    x19 = -alpha_dot*chi0*numpy.cos(x0) + alpha_dot*x2*x4*numpy.cos(x3) - 2*e*x10*x16*(alpha_dot + x6) + x18*x9*numpy.cos(x7)
-    x20 = numpy.tan(alpha)
-    x21 = (numpy.cos(alpha)**(-1.0))
-    x22 = k_s*(L_us + d_x*x20 - d_y - x14*x21)
-    x23 = Y_e*numpy.sqrt(r_c)
-    x24 = (4/3)*x23
-    x25 = x24*(x13)*numpy.sqrt(numpy.abs(x13))
-    x26 = Omega_c*t + theta0
-    x27 = numpy.sin(alpha)
-    x28 = numpy.sin(alpha0)
-    x29 = numpy.cos(alpha0)
-    x30 = -chi0*x28 + e*numpy.sin(theta0) - e*numpy.sin(x26) + x15*x29
-    x31 = chi0*x29 + e*numpy.cos(theta0) - e*numpy.cos(x26) + x15*x28
-    x32 = numpy.cos(alpha)
-    x33 = x20 + x21
-    x34 = d_x*k_s
-    x35 = abs(x12)
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = numpy.sin(x1)
+    x3 = x2**2
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = alpha + theta0 + x5
+    x7 = numpy.cos(x6)
+    x8 = numpy.sin(x5)
+    x9 = 2*e*x8
+    x10 = numpy.cos(x1)
+    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
+    x12 = -x11
+    x13 = 2*x3
+    x14 = numpy.sin(x6)
+    x15 = (1/2)*w_b
+    x16 = r_c + x15
+    x17 = x10*x2
+    x18 = chi0*x13 - x14*x9 + 2*x16*x17
+    x19 = Omega_c*e
+    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
+    x21 = numpy.cos(alpha)
+    x22 = x21**(-1.0)
+    x23 = numpy.sin(alpha)
+    x24 = x22*x23
+    x25 = d_x*x24
+    x26 = k_s*(L_us - d_y - x15*x22 + x25)
+    x27 = Y_e*numpy.sqrt(r_c)
+    x28 = (4/3)*x27
+    x29 = x28*(x12)*numpy.sqrt(numpy.abs(x12))
+    x30 = Omega_c*t + theta0
+    x31 = numpy.sin(alpha0)
+    x32 = numpy.cos(alpha0)
+    x33 = -chi0*x31 + e*numpy.sin(theta0) - e*numpy.sin(x30) + x16*x32
+    x34 = chi0*x32 + e*numpy.cos(theta0) - e*numpy.cos(x30) + x16*x31
+    x35 = x22 + x24
+    x36 = d_x*k_s
+    x37 = abs(x11)
+    x38 = x21**(-2.0)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x17 + _zero, -x19 + _zero, x22 + _zero, -x25 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x18*numpy.sin(alpha + x26) + _zero, -x25*x27 + _zero, numpy.arcsin(x15/numpy.sqrt(x30**2 + x31**2)) - numpy.arctan2(x30, x31) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x23*x35**(5/2) + x34*(L_us*alpha - alpha*d_y - d_x*numpy.log(x32) - x14*numpy.log(x33)) + _zero, alpha_dot*(-d_x*x22 - x25*(chi0 - x17)) + x19*x24*x35**(3/2)*numpy.sign(x12) + x34*(L_us*alpha_dot + alpha_dot*d_x*x27/x32 - alpha_dot*d_y - x14*(alpha_dot*x20*x21 + alpha_dot*(x20**2 + 1))/x33) + _zero, 0 + _zero, 0 + _zero)
+    return (x12 + _zero, x18 + _zero, -x20 + _zero, x26 + _zero, -x29 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x30) + _zero, -x23*x29 + _zero, numpy.arcsin(x16/numpy.sqrt(x33**2 + x34**2)) - numpy.arctan2(x33, x34) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x27*x37**(5/2) + x36*(L_us*alpha - alpha*d_y - d_x*numpy.log(x21) - x15*numpy.log(x35)) + _zero, alpha_dot*(-d_x*x26 - x29*(chi0 - x18)) + x20*x28*x37**(3/2)*numpy.sign(x11) + x36*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x25 - x15*(alpha_dot*x23*x38 + alpha_dot*(x23**2*x38 + 1))/x35) + _zero, 0 + _zero, 0 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -504,8 +520,10 @@ def gap(t, alpha, alpha_dot, p):
     alpha0 = p[4]
     theta0 = p[5]
     Omega_c = p[12]
-    x0 = (1/2)*Omega_c*t
-    return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = (1/2)*Omega_c*t
+    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -530,7 +548,8 @@ def gap_rate(t, alpha, alpha_dot, p):
     x1 = t*x0
     x2 = alpha + theta0 + x1
     x3 = (1/2)*alpha - 1/2*alpha0
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*cos(alpha - alpha0) - alpha_dot*(2*r_c + w_b)*sin(x3)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    x4 = sin(x3)
+    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
 
 
 def static_moment(alpha, p):
@@ -555,28 +574,30 @@ def static_moment(alpha, p):
     L_us = p[8]
     k_s = p[9]
     Y_e = p[11]
-    x0 = tan(alpha)
-    x1 = (1/2)*w_b
-    x2 = x1*(1/cos(alpha))
-    x3 = d_x*k_s
-    x4 = r_c + x1
-    x5 = alpha - alpha0
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = (1/2)*w_b
+    x3 = sin(alpha)
+    x4 = d_x*k_s
+    x5 = (1/2)*alpha - 1/2*alpha0
     x6 = sin(x5)
-    x7 = (1/2)*alpha - 1/2*alpha0
-    x8 = sin(x7)
-    x9 = x8**2
-    x10 = 2*chi0
-    x11 = x10*x9 + x4*x6
-    x12 = chi0 - x11
-    x13 = 2*r_c + w_b
-    x14 = chi0*x6 - x13*x9
-    x15 = sqrt(r_c)
-    x16 = (4/3)*Y_e*x15
-    x17 = x16*(x14)*sqrt(abs(x14))
-    x18 = cos(x5)
-    x19 = x8*cos(x7)
-    x20 = sqrt(abs(x14))
-    return (-x12*x17 - x3*(L_us + d_x*x0 - d_y - x2), -2*Y_e*x12*x15*x20*(chi0*x18 - x13*x19) - x17*(-x10*x19 - x18*x4) - x3*(d_x*(x0**2 + 1) - x0*x2), x14, x11, x16*x20)
+    x7 = x6**2
+    x8 = 2*x7
+    x9 = r_c + x2
+    x10 = x6*cos(x5)
+    x11 = 2*x10
+    x12 = chi0*x8 + x11*x9
+    x13 = chi0 - x12
+    x14 = 2*r_c + w_b
+    x15 = chi0*x11
+    x16 = -x14*x7 + x15
+    x17 = sqrt(r_c)
+    x18 = (4/3)*Y_e*x17
+    x19 = x18*(x16)*sqrt(abs(x16))
+    x20 = x0**(-2)
+    x21 = 1 - x8
+    x22 = sqrt(abs(x16))
+    return (-x13*x19 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -2*Y_e*x13*x17*x22*(chi0*x21 - x10*x14) - x19*(-x15 - x21*x9) - x4*(d_x*(x20*x3**2 + 1) - x2*x20*x3), x16, x12, x18*x22)
 
 
 def reach(Theta, p):
@@ -647,7 +668,8 @@ def rigid_contact(Theta, p):
     x22 = 2*x16 - 2*x17
     x23 = x22/x11**2
     x24 = e**2
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*tan(x12) - d_y - x4*(1/cos(x12))))
+    x25 = 1/cos(x12)
+    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
 
 
 def spring_potential(alpha, p):
@@ -665,10 +687,11 @@ def spring_potential(alpha, p):
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = tan(alpha)
-    x1 = (1/cos(alpha))
-    x2 = (1/2)*w_b
-    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(cos(alpha)) - x2*log(x0 + x1)), (1/2)*k_s*(L_us + d_x*x0 - d_y - x1*x2)**2)
+    x0 = cos(alpha)
+    x1 = 1/x0
+    x2 = x1*sin(alpha)
+    x3 = (1/2)*w_b
+    return (d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x0) - x3*log(x1 + x2)), (1/2)*k_s*(L_us + d_x*x2 - d_y - x1*x3)**2)
 
 
 def rhs_index(r, t, alpha, alpha_dot, p):
@@ -693,7 +716,8 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         L_us = p[8]
         k_s = p[9]
         I_Pb = p[10]
-        return -d_x*k_s*(L_us + d_x*tan(alpha) - d_y - 1/2*w_b*(1/cos(alpha)))/I_Pb
+        x0 = 1/cos(alpha)
+        return -d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - 1/2*w_b*x0)/I_Pb
     elif r == 1:
         r_c = p[0]
         e = p[1]
@@ -708,13 +732,16 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         I_Pb = p[10]
         Y_e = p[11]
         Omega_c = p[12]
-        x0 = (1/2)*w_b
-        x1 = sin(alpha - alpha0)
-        x2 = sin((1/2)*alpha - 1/2*alpha0)**2
-        x3 = (1/2)*Omega_c*t
-        x4 = alpha + theta0 + x3
-        x5 = sin(x3)
-        return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x2 + chi0 + 2*e*x5*sin(x4) - x1*(r_c + x0))*(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))*sqrt(abs(chi0*x1 - 2*e*x5*cos(x4) - x2*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*tan(alpha) - d_y - x0*(1/cos(alpha))))/I_Pb
+        x0 = 1/cos(alpha)
+        x1 = (1/2)*w_b
+        x2 = (1/2)*alpha - 1/2*alpha0
+        x3 = sin(x2)
+        x4 = x3**2
+        x5 = (1/2)*Omega_c*t
+        x6 = sin(x5)
+        x7 = alpha + theta0 + x5
+        x8 = cos(x2)
+        return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x4 + chi0 + 2*e*x6*sin(x7) - 2*x3*x8*(r_c + x1))*(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))*sqrt(abs(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
     return nan
 
 
@@ -740,6 +767,109 @@ def surface_index(k, t, alpha, alpha_dot, p):
         alpha0 = p[4]
         theta0 = p[5]
         Omega_c = p[12]
-        x0 = (1/2)*Omega_c*t
-        return chi0*sin(alpha - alpha0) - 2*e*sin(x0)*cos(alpha + theta0 + x0) - (2*r_c + w_b)*sin((1/2)*alpha - 1/2*alpha0)**2
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = (1/2)*Omega_c*t
+        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+    return nan
+
+
+def aux_index(j, t, alpha, alpha_dot, p):
+    """Auxiliary scalars of the hybrid loop by index: the gap rate and, with Coulomb friction, the partials of v_r.
+
+    Arguments:
+        j: auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: psi_i_dot
+    Returns:
+        auxiliary (m/s, m/s^2, m/s/rad or m/rad); nan for an index out of range
+    """
+    if j == 0:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        Omega_c = p[12]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = alpha + theta0 + x1
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    return nan
+
+
+def power_index(c, t, alpha, alpha_dot, p):
+    """Power flows of the energy ledger by index: P_in (cam drive), D_c (contact damping), D_f (friction) of each regime.
+
+    Arguments:
+        c: 3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]
+        t: time (s)
+        alpha: follower angle alpha (rad, clockwise)
+        alpha_dot: follower angular velocity (rad/s)
+        p: parameter vector, laid out as PARAMS (SI units); build it with pack()
+    Branches:
+        0: free: P_in
+        1: free: D_c
+        2: free: D_f
+        3: contact: P_in
+        4: contact: D_c
+        5: contact: D_f
+    Returns:
+        power (W); nan for an index out of range
+    """
+    if c == 0:
+        return 0
+    elif c == 1:
+        return 0
+    elif c == 2:
+        return 0
+    elif c == 3:
+        r_c = p[0]
+        e = p[1]
+        w_b = p[2]
+        chi0 = p[3]
+        alpha0 = p[4]
+        theta0 = p[5]
+        d_x = p[6]
+        d_y = p[7]
+        L_us = p[8]
+        k_s = p[9]
+        Y_e = p[11]
+        Omega_c = p[12]
+        x0 = sin(alpha)
+        x1 = cos(alpha)
+        x2 = 1/x1
+        x3 = x0*x2
+        x4 = d_x*x3
+        x5 = x1**(-2)
+        x6 = (1/2)*w_b
+        x7 = d_x*k_s
+        x8 = (1/2)*alpha - 1/2*alpha0
+        x9 = sin(x8)
+        x10 = x9**2
+        x11 = 2*x10
+        x12 = (1/2)*Omega_c
+        x13 = t*x12
+        x14 = sin(x13)
+        x15 = alpha + theta0 + x13
+        x16 = sin(x15)
+        x17 = cos(x8)
+        x18 = x17*x9
+        x19 = 2*r_c + w_b
+        x20 = cos(x15)
+        x21 = 2*e*x14
+        x22 = -2*chi0*x17*x9 + x10*x19 + x20*x21
+        x23 = (4/3)*Y_e*sqrt(r_c)
+        return alpha_dot*(-x23*(-chi0*x11 + chi0 + 2*e*x14*x16 - 2*x18*(r_c + x6))*(-x22)*sqrt(abs(-x22)) - x7*(L_us - d_y - x2*x6 + x4)) + x23*(Omega_c*e*x20*cos(x13) - alpha_dot*chi0*(1 - x11) + alpha_dot*x18*x19 - x16*x21*(alpha_dot + x12))*abs(x22)**(3/2)*(0.0 if x22 == 0 else copysign(1, x22)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+    elif c == 4:
+        return 0
+    elif c == 5:
+        return 0
     return nan

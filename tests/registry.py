@@ -5,6 +5,7 @@ import math
 
 import camdyn
 from camdyn import generated
+from camdyn.simulation import BACKENDS as _BACKENDS
 
 RIG = camdyn.example_rig()
 
@@ -31,3 +32,5 @@ def cam_for(scene: camdyn.Scene, speed_rpm: float = 300.0):
 SCENES = sorted(generated.SCENES)
 #: SciPy methods the reference backend supports with events
 METHODS = ["DOP853", "RK45", "Radau", "BDF", "LSODA"]
+#: every backend of camdyn.simulate: the hard cases run on each (issue 5)
+BACKENDS = list(_BACKENDS)

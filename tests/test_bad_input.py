@@ -14,7 +14,7 @@ import camdyn
 from camdyn.cli import main as cli_main
 from camdyn.errors import CamdynError
 from camdyn.rig import PARAMETERS
-from registry import RIG
+from registry import BACKENDS, RIG
 
 hostile_numbers = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
@@ -33,38 +33,42 @@ def _check_result(r):
         assert np.all(np.isfinite(values)), name
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @SLOW
 @given(name=st.sampled_from([p.name for p in PARAMETERS]), value=hostile_numbers)
 @example(name="I_Pb", value=1e-300)  # found by this test: a contact mode at 1e152 Hz, a near-endless run
 @example(name="k_s", value=1e300)
-def test_one_hostile_rig_parameter(name, value):
+@example(name="zeta_D", value=1e300)  # found by this test: a trial stage at alpha = inf raised from math.sin
+def test_one_hostile_rig_parameter(name, value, backend):
     """Any one parameter replaced by anything: a valid rig that simulates, or a camdyn error."""
     try:
         rig = RIG.replace(**{name: value})
-        r = camdyn.simulate(rig, camdyn.Scene(), speed_rpm=300, t_end=0.002, sample_rate_Hz=5000)
+        r = camdyn.simulate(rig, camdyn.Scene(), speed_rpm=300, t_end=0.002, sample_rate_Hz=5000, backend=backend)
     except CamdynError as exc:
         assert str(exc)
         return
     _check_result(r)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @SLOW
 @given(factors=st.lists(st.floats(0.2, 5.0), min_size=6, max_size=6),
        speed=st.floats(-3000, 3000), scene=st.sampled_from(camdyn.Scene.available()))
-def test_random_plausible_rigs_and_scenes(factors, speed, scene):
+def test_random_plausible_rigs_and_scenes(factors, speed, scene, backend):
     """Geometry scaled at random (some impossible): valid result or a named camdyn error."""
     names = ["r_c", "e", "chi0", "d_x", "L_us", "k_s"]
     from registry import cam_for, scene_from_slug
     sc = scene_from_slug(scene)
     try:
         rig = RIG.replace(**{n: getattr(RIG, n) * f for n, f in zip(names, factors)})
-        r = camdyn.simulate(rig, sc, cam_for(sc, speed), t_end=0.002, sample_rate_Hz=5000)
+        r = camdyn.simulate(rig, sc, cam_for(sc, speed), t_end=0.002, sample_rate_Hz=5000, backend=backend)
     except CamdynError as exc:
         assert str(exc)
         return
     _check_result(r)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @SLOW
 @given(kwargs=st.fixed_dictionaries({}, optional={
     "speed_rpm": hostile_numbers, "t_end": hostile_numbers, "revolutions": hostile_numbers,
@@ -72,9 +76,9 @@ def test_random_plausible_rigs_and_scenes(factors, speed, scene):
     "max_step": hostile_numbers, "t_start": hostile_numbers, "method": st.text(max_size=8),
     "y0": st.one_of(hostile_numbers, st.tuples(st.floats(-2, 2), st.floats(-50, 50))),
 }))
-def test_hostile_simulate_arguments(kwargs):
+def test_hostile_simulate_arguments(kwargs, backend):
     try:
-        r = camdyn.simulate(RIG, camdyn.Scene(), **kwargs)
+        r = camdyn.simulate(RIG, camdyn.Scene(), backend=backend, **kwargs)
     except CamdynError as exc:
         assert str(exc)
         return

@@ -287,3 +287,24 @@ def test_rate_finds_an_excursion_between_samples():
     # a maximum that stays below the surface is no crossing
     low = lambda t, y: -1e-6 - (y[0] - 0.3) ** 2  # noqa: E731
     assert first_crossing((Event("gap", low, +1, rate),), dense, 0.0, 1.0, y0, y1, settings) is None
+
+
+def test_rate_tells_rounding_noise_at_a_restart_from_a_crossing():
+    """A restart just across the surface (g = 3e-19 > 0, watched downward) while moving away
+    (rate > 0): rounding flips g's sign right after the restart (found in a full test: a
+    separation and re-impact 1.5e-14 s apart).  Without the rate the flip is a crossing; with
+    it, a sign change while moving away with no turn is noise (None), and when the motion does
+    turn back, the crossing found is the one after the turn."""
+    settings = EventSettings(interior_points=0)
+    y0, y1 = np.array([0.0]), np.array([1.0])
+    noisy = lambda t, y: 3e-19 if y[0] == 0.0 else (-1e-19 if y[0] < 1e-12 else 1e-3 * y[0])  # noqa: E731
+    away = lambda t, y: 1.0  # noqa: E731
+    ends = lambda t, y: 3e-19 if y[0] == 0.0 else -1e-19  # noqa: E731  (noise at both samples)
+    assert first_crossing((Event("gap", ends, -1),), _clock, 0.0, 1.0, y0, y1, settings) is not None
+    assert first_crossing((Event("gap", ends, -1, away),), _clock, 0.0, 1.0, y0, y1, settings) is None
+    assert first_crossing((Event("gap", noisy, -1, away),), _clock, 0.0, 1.0, y0, y1, settings) is None
+    # a hop: up from the surface, turning at t = 0.5, back down through it at t = 1 - 1e-9
+    hop = lambda t, y: 3e-19 if y[0] == 0.0 else (-1e-19 if y[0] < 1e-12 else y[0] * (1 - 1e-9 - y[0]))  # noqa: E731
+    rate = lambda t, y: 1 - 1e-9 - 2 * y[0]  # noqa: E731
+    hit = first_crossing((Event("gap", hop, -1, rate),), _clock, 0.0, 1.0, y0, y1, settings)
+    assert hit is not None and hit.t == pytest.approx(1 - 1e-9, abs=1e-13)

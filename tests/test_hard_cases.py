@@ -10,7 +10,7 @@ import pytest
 import camdyn
 from camdyn import analysis
 from camdyn.events import EventSettings
-from registry import RIG
+from registry import BACKENDS, RIG
 
 D_COULOMB = camdyn.Scene(damping="D", friction="coulomb")
 D_FREE = camdyn.Scene(damping="D", friction="none")
@@ -37,14 +37,15 @@ def grazing_reference(loss):
                            rtol=1e-12, atol=1e-15).after(2 * 60 / (1.001 * loss))
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("rtol, time_error", [(1e-8, 1e-5), (1e-10, 1e-7)])
-def test_grazing_hops_are_neither_missed_nor_duplicated(loss, grazing_reference, rtol, time_error):
+def test_grazing_hops_are_neither_missed_nor_duplicated(loss, grazing_reference, rtol, time_error, backend):
     """At rtol 1e-8 a 7e-11 m hop lies inside one step between its samples; the gap rate
     finds it.  Every hop is found exactly once and matches one reference hop: the times
     agree within ``time_error`` (measured 3.3e-6 s at rtol 1e-8: grazing crossings are slow,
     so state errors move them a lot), far below the ~0.5 ms between successive hops."""
     r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=1.001 * loss, revolutions=4, sample_rate_Hz=5000,
-                        rtol=rtol).after(2 * 60 / (1.001 * loss))
+                        rtol=rtol, backend=backend).after(2 * 60 / (1.001 * loss))
     assert r.ok
     ref = grazing_reference.separations()
     assert ref.size >= 10 and np.diff(ref).min() > 40 * time_error
@@ -53,28 +54,32 @@ def test_grazing_hops_are_neither_missed_nor_duplicated(loss, grazing_reference,
     assert np.all(np.diff([s.t for s in r.switches if s.surface == "contact"]) > 0)
 
 
-def test_without_interior_checks_hops_are_missed(loss, grazing_reference):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_without_interior_checks_hops_are_missed(loss, grazing_reference, backend):
     """The same run without interior samples and (for the non-contact surfaces) no rate: the
     rate still catches the hop for the gap, so the counts match; this documents that the
     rate check, not the sampling, carries the detection."""
     r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=1.001 * loss, revolutions=4, sample_rate_Hz=5000,
-                        rtol=1e-8, events=EventSettings(interior_points=0)).after(2 * 60 / (1.001 * loss))
+                        rtol=1e-8, events=EventSettings(interior_points=0), backend=backend
+                        ).after(2 * 60 / (1.001 * loss))
     assert r.separations().size == grazing_reference.separations().size
 
 
-def test_just_below_the_contact_loss_speed_never_separates(loss):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_just_below_the_contact_loss_speed_never_separates(loss, backend):
     r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=0.999 * loss, revolutions=4, sample_rate_Hz=5000,
-                        rtol=1e-10)
+                        rtol=1e-10, backend=backend)
     assert r.ok and r.after(2 * r.period).separations().size == 0
 
 
 # --- chattering near permanent contact ------------------------------------------------------
 
-def test_bouncing_cascade_ends_in_permanent_contact(eq):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_bouncing_cascade_ends_in_permanent_contact(eq, backend):
     """Dropped 2 um above the cam at rest (damping D): impacts of decreasing height end in
     sliding contact in finite time.  Measured: 41 impacts, the last at 25.6 ms; bound 200."""
     r = camdyn.simulate(RIG, D_FREE, speed_rpm=0, t_end=0.2, y0=(eq.alpha + 2e-5, 0.0),
-                        sample_rate_Hz=20_000)
+                        sample_rate_Hz=20_000, backend=backend)
     assert r.ok
     impacts = r.impacts()
     assert 5 < impacts.size < 200
@@ -87,8 +92,9 @@ def test_bouncing_cascade_ends_in_permanent_contact(eq):
 
 # --- damping D/E switch in permanent contact ---------------------------------------------------
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("damping", ["D", "E"])
-def test_D_E_switch_fires_at_the_contact_frequency_and_converges(damping):
+def test_D_E_switch_fires_at_the_contact_frequency_and_converges(damping, backend):
     """Sliding at 300 rev/min, start-up ring-down: maximum compression recurs once per period
     of the contact mode (the linearized natural frequency in sliding contact, within 3 %: the
     ring-down of E is slowed by its impact law beta_E |psi_i|^0.25, which the linearization,
@@ -98,7 +104,8 @@ def test_D_E_switch_fires_at_the_contact_frequency_and_converges(damping):
     nf = analysis.natural_frequency(RIG, scene, camdyn.ConstantSpeed(300)).Hz
     ends = []
     for rtol in (1e-6, 1e-8, 1e-10, 1e-12):
-        r = camdyn.simulate(RIG, scene, speed_rpm=300, t_end=0.02, sample_rate_Hz=20_000, rtol=rtol, atol=1e-15)
+        r = camdyn.simulate(RIG, scene, speed_rpm=300, t_end=0.02, sample_rate_Hz=20_000, rtol=rtol, atol=1e-15,
+                            backend=backend)
         assert r.ok
         ends.append(r.alpha[-1])
         peaks = [s.t for s in r.switches if s.surface == "loading" and "_unloading" in s.after]
@@ -114,13 +121,13 @@ def test_D_E_switch_fires_at_the_contact_frequency_and_converges(damping):
 PRELOADED = RIG.replace(e=0.7 * RIG.r_c, L_us=0.2)  # keeps contact over the oscillating cam's stroke
 
 
-@pytest.fixture(scope="module")
-def reversal():
+@pytest.fixture(scope="module", params=BACKENDS)
+def reversal(request):
     """Section 7.2's oscillating cam (Theta_p = pi, 40 rev/min), e = 0.7 r_c; the first
-    reversal of the cam, at t = 0.375 s."""
+    reversal of the cam, at t = 0.375 s; on each backend."""
     scene = camdyn.Scene(damping="D", friction="coulomb", motion="oscillating")
     return camdyn.simulate(PRELOADED, scene, camdyn.Oscillating(math.pi, 40), t_end=0.45,
-                           sample_rate_Hz=100_000)
+                           sample_rate_Hz=100_000, backend=request.param)
 
 
 def test_coulomb_reversal_sticks_then_slips_without_chatter(reversal):
@@ -149,7 +156,7 @@ def test_tanh_friction_approaches_coulomb_as_s_grows(reversal):
     errors = []
     for s in (10.0, 100.0, 1000.0):
         r = camdyn.simulate(PRELOADED.replace(s=s), scene, camdyn.Oscillating(math.pi, 40), t_end=0.45,
-                            sample_rate_Hz=100_000)
+                            sample_rate_Hz=100_000, backend=reversal.stats["backend"])  # the fixture's backend
         assert r.ok
         errors.append(np.abs(r.alpha[window] - reversal.alpha[window]).max())
     assert errors[0] > errors[1] > errors[2]
@@ -157,16 +164,18 @@ def test_tanh_friction_approaches_coulomb_as_s_grows(reversal):
 
 # --- very stiff contact, point contact ---------------------------------------------------------
 
-def test_stiffest_line_contact_impacts_stay_finite():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_stiffest_line_contact_impacts_stay_finite(backend):
     """The paper's Section 4 line contact, l = 16 mm (k = 1.38 GN/m), impacting."""
     rig = RIG.replace(l_lambda=0.016)
-    r = camdyn.simulate(rig, D_COULOMB, speed_rpm=1200, revolutions=2, sample_rate_Hz=50_000)
+    r = camdyn.simulate(rig, D_COULOMB, speed_rpm=1200, revolutions=2, sample_rate_Hz=50_000, backend=backend)
     assert r.ok and r.impacts().size > 3
     for name in ("alpha", "F_n", "N_x", "energy"):
         assert np.all(np.isfinite(getattr(r, name)))
 
 
-def test_point_contact_law_is_finite_past_the_surface():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_point_contact_law_is_finite_past_the_surface(backend):
     """A stage that overshoots into psi_i > 0 in the contact regime gets a finite force and
     Jacobian from the odd extension of (-psi_i)^1.5, never NaN (also at psi_i = 0 exactly)."""
     scene = camdyn.Scene(contact="point", damping="D", friction="coulomb")
@@ -176,18 +185,19 @@ def test_point_contact_law_is_finite_past_the_surface():
         for name in ("contact_loading_fwd", "contact_unloading_bwd"):
             assert math.isfinite(getattr(K, f"rhs_{name}")(0.0, alpha, 0.3, m.p))
             assert all(math.isfinite(v) for v in getattr(K, f"jac_{name}")(0.0, alpha, 0.3, m.p))
-    r = camdyn.simulate(RIG, scene, speed_rpm=1500, revolutions=2, sample_rate_Hz=20_000)
+    r = camdyn.simulate(RIG, scene, speed_rpm=1500, revolutions=2, sample_rate_Hz=20_000, backend=backend)
     assert r.ok and r.impacts().size > 0
     assert all(np.all(np.isfinite(v)) for v in r.outputs.values())
 
 
 # --- singular geometry -----------------------------------------------------------------------
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("speed", [2e4, 1e5])
-def test_extreme_speed_ends_cleanly(speed):
+def test_extreme_speed_ends_cleanly(speed, backend):
     """A cam far above the loss speed flings the follower: the run ends, either completing in
     free flight or stopping with ANGLE_LIMIT before tan/sec overflow; never NaN."""
-    r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=speed, revolutions=20, sample_rate_Hz=20_000)
+    r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=speed, revolutions=20, sample_rate_Hz=20_000, backend=backend)
     assert r.outcome in (camdyn.Outcome.SUCCESS, camdyn.Outcome.ANGLE_LIMIT)
     assert np.all(np.isfinite(r.alpha)) and np.all(np.abs(r.alpha) < math.pi / 2)
 
@@ -196,7 +206,8 @@ def test_extreme_speed_ends_cleanly(speed):
 
 @pytest.mark.parametrize("method, order, steps", [("DOP853", 8, [1.6e-4, 1.2e-4, 8e-5, 5e-5]),
                                                   ("RK45", 5, [8e-5, 5e-5, 3e-5, 2e-5])])
-def test_observed_order_on_a_smooth_sliding_case(eq, method, order, steps):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_observed_order_on_a_smooth_sliding_case(eq, method, order, steps, backend):
     """Smooth sliding (undamped, frictionless, cam at rest, 1e-7 rad off equilibrium: the
     contact never opens).  With the step size fixed (max_step = h; tolerances too loose to
     cut it) the largest error over the run against a tight reference falls as h^p.
@@ -204,7 +215,7 @@ def test_observed_order_on_a_smooth_sliding_case(eq, method, order, steps):
     scene = camdyn.Scene(damping="none", friction="none")
     kw = dict(speed_rpm=0, t_end=0.01, sample_rate_Hz=3000, y0=(eq.alpha + 1e-7, 0.0))
     ref = camdyn.simulate(RIG, scene, rtol=1e-13, atol=1e-20, **kw).alpha
-    errors = [np.abs(camdyn.simulate(RIG, scene, method=method, rtol=1e-2, atol=1e-2, max_step=h,
+    errors = [np.abs(camdyn.simulate(RIG, scene, method=method, rtol=1e-2, atol=1e-2, max_step=h, backend=backend,
                                      **kw).alpha - ref).max() for h in steps]
     slope = np.polyfit(np.log(steps), np.log(errors), 1)[0]
     assert slope == pytest.approx(order, abs=0.5)
@@ -212,13 +223,14 @@ def test_observed_order_on_a_smooth_sliding_case(eq, method, order, steps):
 
 # --- energy ledger ------------------------------------------------------------------------
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("speed, scene", [(300, D_COULOMB), (1200, D_COULOMB),
                                           (1200, camdyn.Scene(damping="D", friction="tanh"))])
-def test_energy_ledger_balances(speed, scene):
+def test_energy_ledger_balances(speed, scene, backend):
     """energy(t) - energy(0) = work of the drive - contact damping - friction, with the works
     integrated with the state.  Bound: 1e-6 of the largest flow (rtol 1e-10 over the run)."""
     r = camdyn.simulate(RIG, scene, speed_rpm=speed, revolutions=2, sample_rate_Hz=5000, rtol=1e-10,
-                        atol=1e-14, energy_ledger=True)
+                        atol=1e-14, energy_ledger=True, backend=backend)
     assert r.ok
     balance = r.energy - r.energy[0] - (r.work_in - r.dissipated_contact - r.dissipated_friction)
     scale = max(np.abs(r.work_in).max(), r.dissipated_contact.max(), r.dissipated_friction.max())
@@ -228,13 +240,14 @@ def test_energy_ledger_balances(speed, scene):
 
 
 @pytest.mark.slow
-def test_ten_thousand_revolutions_keep_the_energy_ledger():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_ten_thousand_revolutions_keep_the_energy_ledger(backend):
     """10,000 revolutions of impacting motion (1100 rev/min, damping D, Coulomb): the energy
     stays equal to the work of the drive minus what damping and friction dissipated.
     Bound 1e-7 of the largest flow: rtol 1e-9 error accumulated over ~45,000 impacts
     (measured over 100 revolutions: 7.6e-11)."""
     r = camdyn.simulate(RIG, D_COULOMB, speed_rpm=1100, revolutions=10_000, sample_rate_Hz=50,
-                        rtol=1e-9, atol=1e-13, energy_ledger=True)
+                        rtol=1e-9, atol=1e-13, energy_ledger=True, backend=backend)
     assert r.ok
     balance = r.energy - r.energy[0] - (r.work_in - r.dissipated_contact - r.dissipated_friction)
     scale = max(np.abs(r.work_in).max(), r.dissipated_contact[-1], r.dissipated_friction[-1])

@@ -36,13 +36,14 @@ def _duffing_py(t, y, p=(4.0, 1.0, 0.1)):
 @numba.njit
 def _adaptive(rhs, method, p, t0, t_end, y0, y1, rtol, atol, times):
     """Drive stepper.step like SciPy's solver loop; records the accepted times."""
+    fns = (rhs, rhs, rhs, rhs)  # one generated regime (nr = 1): accel calls rhs(0, ...)
     K = np.empty((method[0].shape[0], 2))
     K[0, 0], K[0, 1] = y1, rhs(0, t0, y0, y1, p)
     error_order = -1.0 / method[9] - 1.0
-    h = stepper.initial_step(rhs, 0, t0, y0, y1, K[0, 1], t_end, math.inf, error_order, rtol, atol, p)
+    h = stepper.initial_step(fns, 1, 0, t0, y0, y1, K[0, 1], t_end, math.inf, error_order, rtol, atol, p)
     t, n, nfev = t0, 0, 2
     while t < t_end:
-        status, t, y0, y1, h, f, _ = stepper.step(rhs, 0, t, y0, y1, h, t_end, method, p, K, rtol, atol, math.inf)
+        status, t, y0, y1, h, f, _ = stepper.step(fns, 1, 0, t, y0, y1, h, t_end, method, p, K, rtol, atol, math.inf)
         nfev += f
         times[n] = t
         n += 1
@@ -53,14 +54,15 @@ def _adaptive(rhs, method, p, t0, t_end, y0, y1, rtol, atol, times):
 @numba.njit
 def _fixed(rhs, method, p, h, n_steps, y0, y1, theta):
     """n_steps fixed steps of size h; returns the end state and the interpolant at theta of the last step."""
+    fns = (rhs, rhs, rhs, rhs)
     K = np.empty((method[0].shape[0], 2))
     Q = np.empty((2, method[5].shape[1]))
     t = 0.0
     d0 = d1 = 0.0
     for _ in range(n_steps):
         K[0, 0], K[0, 1] = y1, rhs(0, t, y0, y1, p)
-        n0, n1 = stepper.step_impl(rhs, 0, t, y0, y1, h, method, p, K)
-        stepper.dense_coefficients(rhs, 0, t, y0, y1, h, method, p, K, Q)
+        n0, n1 = stepper.step_impl(fns, 1, 0, t, y0, y1, h, method, p, K)
+        stepper.dense_coefficients(fns, 1, 0, t, y0, y1, h, method, p, K, Q)
         d0, d1 = stepper.dense_eval(t + theta * h, t, h, y0, y1, Q)
         t, y0, y1 = t + h, n0, n1
     return y0, y1, d0, d1

@@ -12,11 +12,13 @@ import dataclasses
 import numpy as np
 
 from ..errors import ParameterError
+from ..hybrid import STICK
 from ..integrate import SolverOptions, Switch, Trajectory
 from ..model import ANGLE_LIMIT, Model
 from ..outcome import Outcome
 from . import engine
-from .kernels import scene_functions
+from .kernels import scene_kernels
+from .regimes import STICK as STICK_FLAG
 from .tableau import TABLEAUS, arrays
 
 #: same chatter rule as the SciPy backend: this many switches within 1e-9 (relative) of time
@@ -32,12 +34,21 @@ def method_arrays(name: str):
     return arrays(TABLEAUS[name])
 
 
+def has_stick(kernels) -> bool:
+    """Coulomb friction (a 'forward' flag): slip reversals may stick (Filippov mode)."""
+    return "forward" in kernels.FLAGS
+
+
 def tables(kernels):
-    """(flags_of, signs, lookup) of a scene, from FLAGS, FLAG_SURFACES, REGIMES, REGIME_NAMES."""
+    """(flags_of, signs, lookup, partner) of a scene, from FLAGS, FLAG_SURFACES, REGIMES and
+    REGIME_NAMES (see camdyn.compiled.regimes).  With Coulomb friction flags_of has a second
+    block of rows, the stick modes nr + r of the forward regimes r (forward flag STICK)."""
     names = list(kernels.REGIME_NAMES)
+    nr = len(names)
     flags = kernels.FLAGS
     nf = max(1, len(flags))
-    flags_of = np.full((len(names), nf), -1, dtype=np.int64)
+    stick = has_stick(kernels)
+    flags_of = np.full(((2 if stick else 1) * nr, nf), -1, dtype=np.int64)
     lookup = np.full(3 ** nf, -1, dtype=np.int64)
     for key, name in kernels.REGIMES.items():
         r = names.index(name)
@@ -46,8 +57,35 @@ def tables(kernels):
             flags_of[r, k] = -1 if v is None else int(v)
             code += (flags_of[r, k] + 1) * 3 ** k
         lookup[code] = r
+    partner = np.full(nr, -1, dtype=np.int64)
+    if stick:
+        for key, name in kernels.REGIMES.items():
+            if key[-1] is not None:
+                partner[names.index(name)] = names.index(kernels.REGIMES[key[:-1] + (not key[-1],)])
+                if key[-1]:
+                    flags_of[nr + names.index(name)] = flags_of[names.index(name)]
+                    flags_of[nr + names.index(name), -1] = STICK_FLAG
     signs = np.array([kernels.FLAG_SURFACES[f][1] for f in flags], dtype=np.int64)
-    return flags_of, signs, lookup
+    return flags_of, signs, lookup, partner
+
+
+def regime_names(kernels) -> tuple[list[str], dict[str, tuple]]:
+    """Names of the engine's regime indices (stick modes after the generated regimes, named
+    as camdyn.hybrid names them) and each name's discrete-state key."""
+    names = list(kernels.REGIME_NAMES)
+    keys = {name: key for key, name in kernels.REGIMES.items()}
+    if has_stick(kernels):
+        for name in list(names):
+            key = keys[name]
+            stuck = name.replace("_fwd", "_stick") if key[-1] else ""
+            names.append(stuck)
+            if stuck:
+                keys[stuck] = key[:-1] + (STICK,)
+    return names, keys
+
+
+#: names of the switches past the flags' surfaces (camdyn.hybrid's event names)
+EXTRA_SWITCHES = ("unstick_fwd", "unstick_bwd")
 
 
 def _fixed_regime(model: Model, t: float, y) -> int:
@@ -65,20 +103,24 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
               options: SolverOptions = SolverOptions()) -> Trajectory:
     """Integrate the hybrid model compiled; same arguments and result as camdyn.integrate.integrate."""
     K = model.kernels
-    rhs, surface = scene_functions(K)
+    fns = scene_kernels(K)
     method = method_arrays(options.method)
-    flags_of, signs, lookup = tables(K)
+    tab = tables(K)
     t0, t_end = map(float, t_span)
     y = np.ascontiguousarray(y0, dtype=float)
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     r0 = _fixed_regime(model, t0, y) if not K.FLAGS else -1
     ev = options.events
-    fset = np.array([options.rtol, options.atol, options.max_step, ev.xtol, ANGLE_LIMIT, CHATTER_WINDOW])
-    iset = np.array([ev.interior_points, ev.max_events, CHATTER_SWITCHES], dtype=np.int64)
-    out_y = np.empty((2, t_eval.size))
+    contact_step = 0.1 / model.equilibrium.vartheta  # s: as the SciPy backend (camdyn.integrate)
+    fset = np.array([options.rtol, options.atol, options.max_step, ev.xtol, ANGLE_LIMIT, CHATTER_WINDOW,
+                     contact_step])
+    rate_flag = next((k for k, f in enumerate(K.FLAGS) if K.FLAG_SURFACES[f][0] == "gap_rate"), -1)
+    iset = np.array([ev.interior_points, ev.max_events, CHATTER_SWITCHES, hasattr(K, "aux_index"),
+                     has_stick(K), rate_flag], dtype=np.int64)
+    out_y = np.empty((5 if options.ledger else 2, t_eval.size))
     out_r = np.empty(t_eval.size, dtype=np.int64)
     p = np.ascontiguousarray(model.p, dtype=float)
-    code, n, sw, stats = engine.run(rhs, surface, method, p, flags_of, signs, lookup, r0, t0, t_end, y,
+    code, n, sw, stats = engine.run(fns, method, p, tab, len(K.REGIME_NAMES), r0, t0, t_end, y,
                                     t_eval, fset, iset, out_y, out_r)
     return trajectory(model, t_eval[:n], out_y[:, :n], out_r[:n], sw, code, stats)
 
@@ -86,16 +128,17 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
 def trajectory(model: Model, t, y, r, sw, code: int, stats) -> Trajectory:
     """The engine's arrays as a camdyn.integrate.Trajectory."""
     K = model.kernels
-    names = np.array(K.REGIME_NAMES, dtype=object)
-    flags = K.FLAGS
-    switches = [Switch(float(s[0]), flags[int(s[1])], names[int(s[2])], names[int(s[3])], float(s[4]),
+    names, keys = regime_names(K)
+    names = np.array(names, dtype=object)
+    surfaces = K.FLAGS + EXTRA_SWITCHES
+    switches = [Switch(float(s[0]), surfaces[int(s[1])], names[int(s[2])], names[int(s[3])], float(s[4]),
                        float(s[5])) for s in sw]
     info = {name: int(v) for name, v in zip(engine.STATS, stats)}
     info.update(njev=0, switches=len(switches), backend="compiled")
     fields = {"t": t, "y": y, "regime": names[r] if r.size else np.empty(0, dtype=object),
               "switches": switches, "outcome": Outcome[engine.OUTCOMES[code]], "stats": info}
     if "keys" in {f.name for f in dataclasses.fields(Trajectory)}:
-        fields["keys"] = {name: key for key, name in K.REGIMES.items()}
+        fields["keys"] = keys
     return Trajectory(**fields)
 
 

@@ -6,9 +6,11 @@ where ``g`` is exactly 0 never starts a crossing; a located time is the *far-sid
 a bracket no wider than ``xtol * max(1, |t|)``, so the restart state is already across the
 surface and a restart cannot trigger the same event again.
 
-``surf(k, t, alpha, alpha_dot, p)`` is a compiled surface function of the flag index k
-(a generated ``surface_index``); ``dirs[k]`` is the direction in which flag k's surface is
-watched in the current regime, 0 for not watched.
+Values are read through :func:`camdyn.compiled.regimes.value` (index k: a flag's surface,
+a stick mode's exit, or the gap rate); ``dirs[k]`` is the direction in which value k is
+watched in the current regime, 0 for not watched.  Like the SciPy backend, the contact
+surface (k = 0) is also checked for an excursion hidden between two samples: when the gap
+rate turns from approaching to leaving, the extremum is located and the gap there read.
 """
 from __future__ import annotations
 
@@ -16,6 +18,7 @@ import math
 
 from numba import njit
 
+from .regimes import GAP_RATE, value
 from .stepper import dense_eval
 
 #: first_crossing's index when a surface value is not finite
@@ -34,20 +37,21 @@ def crossed(g0, g1, direction):
     return up or down
 
 
-@njit(cache=True)
-def surface_on_step(surf, k, tt, t, h, y0, y1, Q, p):
-    """Surface k at time tt on the step's interpolant."""
+@njit(cache=True, inline="always")
+def value_on_step(fns, tab, nr, r, k, tt, t, h, y0, y1, Q, p):
+    """Value k at time tt on the step's interpolant."""
     a, ad = dense_eval(tt, t, h, y0, y1, Q)
-    return surf(k, tt, a, ad, p)
+    return value(fns, tab, nr, r, k, tt, a, ad, p)
 
 
 @njit(cache=True)
-def locate(surf, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
-    """Root of surface k on the interpolant in (ta, tb], returned on the far side.
+def locate(fns, tab, nr, r, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
+    """Root of value k on the interpolant in (ta, tb], returned on the far side.
 
     ga = g(ta) != 0 and gb = g(tb) of the other sign or 0.  Illinois false position keeps
     a bracket [lo, hi] with g(lo) on ga's side and g(hi) not; a bisection replaces any
-    iteration that fails to halve the bracket.  Returns hi once hi - lo <= xtol max(1, |hi|).
+    iteration that fails to shrink the bracket by 5 %.  Returns hi once
+    hi - lo <= xtol max(1, |hi|).
     """
     if gb == 0.0:
         return tb
@@ -63,7 +67,7 @@ def locate(surf, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
             tm = 0.5 * (lo + hi)
             if not (lo < tm < hi):
                 break
-        g = surface_on_step(surf, k, tm, t, h, y0, y1, Q, p)
+        g = value_on_step(fns, tab, nr, r, k, tm, t, h, y0, y1, Q, p)
         if g == 0.0:
             return tm
         if g * near > 0.0:
@@ -80,41 +84,118 @@ def locate(surf, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
 
 
 @njit(cache=True)
-def first_crossing(surf, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, g_prev, g_next):
-    """Earliest crossing of any watched surface over the step [t0, t1].
+def hidden_excursion(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, rb):
+    """(t_ext, g_ext) when the gap crosses its surface and comes back inside (ta, tb), else
+    (-1, 0).  Both ends are on the watched side; if the rate turns from approaching the
+    surface to leaving it, the extremum is located (root of the rate) and the gap read there.
+    Rates exactly 0 at an end do not count as a turn (camdyn.events._hidden_excursion)."""
+    up = direction >= 0 and ga < 0.0 and ra > 0.0 > rb
+    down = direction <= 0 and ga > 0.0 and ra < 0.0 < rb
+    if not (up or down):
+        return -1.0, 0.0
+    k_rate = tab[1].shape[0] + GAP_RATE
+    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
+    g_ext = value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+    if (up and g_ext >= 0.0) or (down and g_ext <= 0.0):
+        return t_ext, g_ext
+    return -1.0, 0.0
+
+
+@njit(cache=True)
+def turned_back(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, rb):
+    """Start (t, g) of the bracket of a gap sign change over (ta, tb], and whether it is one.
+
+    If the gap moves away from the watched direction at ta (rate * direction < 0), it can
+    reach the surface only after turning: the bracket starts at the turn (the rate's root)
+    when the gap is still on the near side there.  If the rate never turns, the sign change
+    is rounding noise (a restart just across the surface, where the gap is ~1e-19 m and the
+    time's rounding alone moves it by more): not a crossing.  camdyn.events._turned_back.
+    """
+    if ra * direction >= 0.0:
+        return ta, ga, True
+    if rb * direction < 0.0:
+        return ta, ga, False
+    k_rate = tab[1].shape[0] + GAP_RATE
+    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
+    g_ext = value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+    if g_ext * direction < 0.0:
+        return t_ext, g_ext, True
+    return ta, ga, True
+
+
+@njit(cache=True)
+def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, rate_check,
+                   rate_flag, have_start, g_prev, r_prev, g_next):
+    """Earliest crossing of any watched value over the step [t0, t1].
 
     Each watched g is sampled at t0 (state y), at n_interior equally spaced interior times
     (interpolant) and at t1 (state n): a micro-hop (out and back inside one step) is seen
-    when a sample falls inside it.  Per surface the earliest crossing sub-interval is
-    refined with :func:`locate`; the earliest time wins, ties to the lowest flag index.
+    when a sample falls inside it, and, with ``rate_check``, also between two samples from
+    the turn of the gap rate (which also tells a gap sign change that is rounding noise from
+    a crossing, :func:`turned_back`).  Per value the earliest crossing sub-interval is refined with
+    :func:`locate`; the earliest time wins, ties to the lowest index.
     Returns (k, t): k = -1 when nothing crosses, NONFINITE when a g is not finite.
-    g_prev, g_next: work arrays of length len(dirs).
+
+    ``rate_flag``: the flag whose surface is the gap rate itself (damping D/E), or -1: its
+    value is the rate already computed for the excursion check.
+    ``have_start``: g_prev (and r_prev, the gap rate) already hold the values at t0 (the
+    previous step's end).  With no crossing, they hold the values at t1 on return.
+    g_next is a work array.  All three have one entry per value index.
     """
     h = t1 - t0
-    nf = dirs.shape[0]
-    for k in range(nf):
-        if dirs[k] != 0:
-            g_prev[k] = surf(k, t0, y0, y1, p)
+    nv = dirs.shape[0]
+    rate = rate_check and dirs[0] != 0
+    if not have_start:
+        for k in range(nv):
+            if dirs[k] != 0:
+                g_prev[k] = value(fns, tab, nr, r, k, t0, y0, y1, p)
+        if rate:
+            r_prev[0] = value(fns, tab, nr, r, nv - 1, t0, y0, y1, p)
     best_k = -1
     best_t = math.inf
     found = 0
     for i in range(1, n_interior + 2):
         ta = t0 + h * (i - 1) / (n_interior + 1)
-        tb = t1 if i == n_interior + 1 else t0 + h * i / (n_interior + 1)
+        last = i == n_interior + 1
+        tb = t1 if last else t0 + h * i / (n_interior + 1)
         if tb >= best_t:
             break  # a root in (ta, tb] cannot beat one already located before tb
-        for k in range(nf):
+        if last:
+            a, ad = n0, n1
+        else:
+            a, ad = dense_eval(tb, t0, h, y0, y1, Q)
+        rb_known = False
+        rb = 0.0
+        for k in range(nv):
             if dirs[k] == 0 or (found >> k) & 1:
                 continue
-            if i == n_interior + 1:
-                g_next[k] = surf(k, t1, n0, n1, p)
+            if k == rate_flag and rb_known:
+                g_next[k] = rb
             else:
-                g_next[k] = surface_on_step(surf, k, tb, t0, h, y0, y1, Q, p)
+                g_next[k] = value(fns, tab, nr, r, k, tb, a, ad, p)
             if not (math.isfinite(g_prev[k]) and math.isfinite(g_next[k])):
                 return NONFINITE, tb
+            tk = -1.0
             if crossed(g_prev[k], g_next[k], dirs[k]):
+                lo, glo, genuine = ta, g_prev[k], True
+                if k == 0 and rate:
+                    rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
+                    rb_known = True
+                    lo, glo, genuine = turned_back(fns, tab, nr, r, dirs[0], t0, h, y0, y1, Q, p, ta, tb,
+                                                   g_prev[0], r_prev[0], rb)
+                    r_prev[0] = rb
+                if genuine:
+                    tk = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, lo, tb, glo, g_next[k], xtol)
+            elif k == 0 and rate:
+                rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
+                rb_known = True
+                t_ext, g_ext = hidden_excursion(fns, tab, nr, r, dirs[0], t0, h, y0, y1, Q, p, ta, tb,
+                                                g_prev[0], r_prev[0], rb)
+                if t_ext >= 0.0:
+                    tk = locate(fns, tab, nr, r, 0, t0, h, y0, y1, Q, p, ta, t_ext, g_prev[0], g_ext, xtol)
+                r_prev[0] = rb
+            if tk >= 0.0:
                 found |= 1 << k
-                tk = locate(surf, k, t0, h, y0, y1, Q, p, ta, tb, g_prev[k], g_next[k], xtol)
                 if tk < best_t:
                     best_k, best_t = k, tk
             g_prev[k] = g_next[k]
@@ -122,11 +203,12 @@ def first_crossing(surf, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, g
 
 
 @njit(cache=True)
-def left_at_start(surf, dirs, t0, t1, y0, y1, n0, n1, p):
+def left_at_start(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, p):
     """A step that starts exactly on a watched surface (g = 0) and ends strictly on its
     leaving side has left the regime at its start (the rule of camdyn.integrate).
-    Returns the flag index, or -1."""
+    Returns the value index, or -1."""
     for k in range(dirs.shape[0]):
-        if dirs[k] != 0 and surf(k, t0, y0, y1, p) == 0.0 and dirs[k] * surf(k, t1, n0, n1, p) > 0.0:
+        if dirs[k] != 0 and value(fns, tab, nr, r, k, t0, y0, y1, p) == 0.0 \
+                and dirs[k] * value(fns, tab, nr, r, k, t1, n0, n1, p) > 0.0:
             return k
     return -1

@@ -1,8 +1,9 @@
 """A scene's generated kernels compiled for the engine: numba ``cfunc``s, cached on disk.
 
 The generated modules carry ``rhs_index(r, t, alpha, alpha_dot, p)`` (the regime's
-alpha_ddot by index) and ``surface_index(k, t, alpha, alpha_dot, p)`` (flag k's switching
-surface).  Compiled as ``cfunc``s of one fixed signature, they reach the engine as
+alpha_ddot by index), ``surface_index(k, ...)`` (flag k's switching surface),
+``aux_index(j, ...)`` (the gap rate; the partials of v_r with Coulomb friction) and
+``power_index(c, ...)`` (the energy ledger's flows).  Compiled as ``cfunc``s of one fixed signature, they reach the engine as
 first-class function values whose numba type is that signature alone: the engine is
 compiled once for every scene (and cached), and each scene's kernels once (and cached,
 in the generated package's ``__pycache__`` or numba's user cache).
@@ -22,25 +23,34 @@ from ..errors import SceneError
 SIGNATURE = types.float64(types.int64, types.float64, types.float64, types.float64, types.float64[::1])
 
 
-def _no_surface(k, t, alpha, alpha_dot, p):
-    """Linear models switch nothing: no surface exists."""
+def _absent(k, t, alpha, alpha_dot, p):
+    """A kernel family the scene does not have (linear models switch nothing: no surface,
+    no gap rate)."""
     return math.nan
 
 
-no_surface = numba.cfunc(SIGNATURE, cache=True)(_no_surface)
+absent = numba.cfunc(SIGNATURE, cache=True)(_absent)
 
 
 @lru_cache(maxsize=None)
 def _compiled(module_name: str):
     import importlib
     K = importlib.import_module(module_name)
-    rhs = numba.cfunc(SIGNATURE, cache=True)(K.rhs_index)
-    surface = numba.cfunc(SIGNATURE, cache=True)(K.surface_index) if K.FLAGS else no_surface
-    return rhs, surface
+
+    def compiled(name):
+        fn = getattr(K, name, None)
+        return absent if fn is None else numba.cfunc(SIGNATURE, cache=True)(fn)
+    return tuple(compiled(name) for name in ("rhs_index", "surface_index", "aux_index", "power_index"))
 
 
 def scene_functions(kernels: ModuleType):
-    """(rhs, surface) cfuncs of a generated scene module.
+    """(rhs, surface) cfuncs of a generated scene module (see :func:`scene_kernels` for all four)."""
+    return scene_kernels(kernels)[:2]
+
+
+def scene_kernels(kernels: ModuleType):
+    """(rhs, surface, aux, power) cfuncs of a generated scene module, ``absent`` for a family
+    the scene does not have.
 
     Raises SceneError for a scene without index kernels: the user cam motion, whose
     kernels take the user's Python callables, cannot run compiled.
@@ -50,7 +60,7 @@ def scene_functions(kernels: ModuleType):
             f"scene {kernels.SLUG!r} has a user cam motion: its Theta(t) is a Python callable, which "
             "the compiled backend cannot call. Use backend='scipy' (or a built-in motion: "
             "ConstantSpeed, Oscillating).")
-    if not hasattr(kernels, "rhs_index"):
-        raise SceneError(f"scene {kernels.SLUG!r} was generated without rhs_index; "
-                         "regenerate with 'python -m camdyn.derive'")
+    if not hasattr(kernels, "rhs_index") or not hasattr(kernels, "power_index"):
+        raise SceneError(f"scene {kernels.SLUG!r} was generated without the index kernels (rhs_index, "
+                         "power_index); regenerate with 'python -m camdyn.derive'")
     return _compiled(kernels.__name__)

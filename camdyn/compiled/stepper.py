@@ -1,9 +1,9 @@
 """The compiled explicit Runge-Kutta stepper with dense output (numba), SciPy's algorithm.
 
 The state is the follower's ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot,
-rhs(r, t, alpha, alpha_dot, p))``, with ``rhs`` a compiled function of the regime index
-``r`` (a generated ``rhs_index`` compiled as a numba ``cfunc``) and ``p`` the parameter
-vector.  Everything is a small ``njit`` function, in the same split as SciPy's
+accel(fns, nr, r, t, alpha, alpha_dot, p))``: regime r's field (:func:`.regimes.accel`,
+the generated ``rhs_index`` compiled as a numba ``cfunc``, or a stick mode's), ``p`` the
+parameter vector.  Everything is a small ``njit`` function, in the same split as SciPy's
 ``RungeKutta``: :func:`step_impl` computes one attempt (stages, solution), :func:`error_norm`
 its error, and :func:`step` does the bookkeeping (accept or reject, the next step size)
 exactly as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's.
@@ -23,6 +23,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .regimes import accel
+
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
@@ -31,14 +33,14 @@ MAX_FACTOR = 10.0
 ACCEPTED, TOO_SMALL = 0, 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _norm(x0, x1):
     """SciPy's RMS norm of a 2-vector."""
     return math.sqrt(0.5 * (x0 * x0 + x1 * x1))
 
 
-@njit(cache=True)
-def stages(rhs, r, t, y0, y1, h, A, C, p, K, first, last):
+@njit(cache=True, inline="always")
+def stages(fns, nr, r, t, y0, y1, h, A, C, p, K, first, last):
     """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y))."""
     for s in range(first, last):
         d0 = 0.0
@@ -49,14 +51,14 @@ def stages(rhs, r, t, y0, y1, h, A, C, p, K, first, last):
             d1 += K[j, 1] * a
         z1 = y1 + d1 * h
         K[s, 0] = z1
-        K[s, 1] = rhs(r, t + C[s] * h, y0 + d0 * h, z1, p)
+        K[s, 1] = accel(fns, nr, r, t + C[s] * h, y0 + d0 * h, z1, p)
 
 
-@njit(cache=True)
-def step_impl(rhs, r, t, y0, y1, h, method, p, K):
+@njit(cache=True, inline="always")
+def step_impl(fns, nr, r, t, y0, y1, h, method, p, K):
     """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
     A, C, B, n = method[0], method[1], method[2], method[6]
-    stages(rhs, r, t, y0, y1, h, A, C, p, K, 1, n)
+    stages(fns, nr, r, t, y0, y1, h, A, C, p, K, 1, n)
     d0 = 0.0
     d1 = 0.0
     for j in range(n):
@@ -65,11 +67,11 @@ def step_impl(rhs, r, t, y0, y1, h, method, p, K):
     n0 = y0 + h * d0
     n1 = y1 + h * d1
     K[n, 0] = n1
-    K[n, 1] = rhs(r, t + h, n0, n1, p)
+    K[n, 1] = accel(fns, nr, r, t + h, n0, n1, p)
     return n0, n1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     """SciPy's error norm of the attempt (RK45: embedded difference; DOP853: 5th/3rd blend)."""
     E, E3, n, kind = method[3], method[4], method[6], method[8]
@@ -94,8 +96,8 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 2.0)
 
 
-@njit(cache=True)
-def step(rhs, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
+@njit(cache=True, inline="always")
+def step(fns, nr, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
 
     Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections);
@@ -117,7 +119,7 @@ def step(rhs, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
             t_new = t_bound
         h = t_new - t
         h_abs = abs(h)
-        n0, n1 = step_impl(rhs, r, t, y0, y1, h, method, p, K)
+        n0, n1 = step_impl(fns, nr, r, t, y0, y1, h, method, p, K)
         nfev += n
         err = error_norm(K, h, y0, y1, n0, n1, rtol, atol, method)
         if err < 1.0:
@@ -133,7 +135,7 @@ def step(rhs, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
 
 
 @njit(cache=True)
-def initial_step(rhs, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, atol, p):
+def initial_step(fns, nr, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, atol, p):
     """SciPy's ``select_initial_step`` (Hairer, Norsett & Wanner II.4), one RHS evaluation."""
     length = abs(t_bound - t)
     if length == 0.0:
@@ -149,7 +151,7 @@ def initial_step(rhs, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, at
     h0 = min(h0, length)
     z0 = y0 + h0 * y1
     z1 = y1 + h0 * f1
-    g1 = rhs(r, t + h0, z0, z1, p)
+    g1 = accel(fns, nr, r, t + h0, z0, z1, p)
     d2 = _norm((z1 - y1) / s0, (g1 - f1) / s1) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -158,14 +160,14 @@ def initial_step(rhs, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, at
     return min(100.0 * h0, h1, length, max_step)
 
 
-@njit(cache=True)
-def dense_coefficients(rhs, r, t, y0, y1, h, method, p, K, Q):
+@njit(cache=True, inline="always")
+def dense_coefficients(fns, nr, r, t, y0, y1, h, method, p, K, Q):
     """Q = K^T P after computing the extra stages (DOP853): y(t + theta h) = y + h theta (Q0 + Q1 theta + ...).
 
     Returns the number of RHS evaluations spent (the extra stages)."""
     A, C, P, n, n_extra = method[0], method[1], method[5], method[6], method[7]
     if n_extra:
-        stages(rhs, r, t, y0, y1, h, A, C, p, K, n + 1, n + 1 + n_extra)
+        stages(fns, nr, r, t, y0, y1, h, A, C, p, K, n + 1, n + 1 + n_extra)
     rows, deg = P.shape
     for k in range(deg):
         q0 = 0.0
@@ -178,7 +180,7 @@ def dense_coefficients(rhs, r, t, y0, y1, h, method, p, K, Q):
     return n_extra
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def dense_eval(tt, t, h, y0, y1, Q):
     """The interpolant at time tt of the step [t, t + h] (Horner in theta)."""
     theta = (tt - t) / h

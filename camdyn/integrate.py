@@ -119,14 +119,17 @@ def _solver(options: SolverOptions, regime, t, y, t_end, h):
 
 
 def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
-              options: SolverOptions = SolverOptions()) -> Trajectory:
-    """Integrate the hybrid model from y0 = (alpha, alpha_dot) over t_span, sampling at t_eval."""
+              options: SolverOptions = SolverOptions(), key: tuple | None = None) -> Trajectory:
+    """Integrate the hybrid model from y0 = (alpha, alpha_dot) over t_span, sampling at t_eval.
+
+    ``key``: the regime to start in (a Trajectory's ``keys`` value, to continue a run);
+    by default it is read off the state's side of each switching surface."""
     t, t_end = map(float, t_span)
     y = np.asarray(y0, dtype=float)
     if options.ledger:
         y = np.concatenate([y, np.zeros(3)])
     hybrid = Hybrid(model)
-    key = hybrid.initial(t, y)
+    key = hybrid.initial(t, y) if key is None else key
     sampler = _Sampler(np.asarray(t_eval, dtype=float), y.size)
     switches: list[Switch] = []
     keys: dict[str, tuple] = {}

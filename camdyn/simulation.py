@@ -11,6 +11,7 @@ from .events import EventSettings
 from .hybrid import Hybrid
 from .integrate import SolverOptions, integrate
 from .model import Model
+from .pieces import integrate_in_pieces
 from .result import Result
 from .rig import Rig
 from .scene import Scene
@@ -88,7 +89,8 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
         raise ParameterError("y0", y0, "two finite numbers (alpha rad, alpha_dot rad/s)")
     options = SolverOptions(method, rtol, atol, max_step, events or EventSettings(), bool(energy_ledger))
     t_eval = t_start + np.arange(n) / fs
-    traj = _integrator(backend, options)(model, (t_start, t_start + duration), y0, t_eval, options)
+    traj = integrate_in_pieces(_integrator(backend, options), model, (t_start, t_start + duration), y0, t_eval,
+                               options)
     return _result(model, traj)
 
 

@@ -44,10 +44,10 @@ either way: the estimate from >= 20 blocks is good to ~16 %): a much larger one 
 comparison toothless, a much smaller one means the motion is no longer chaotic.
 
 Long runs are restarted every CHUNK revolutions at t = 0 from the end state (the cam is
-periodic, so it is the same motion): on one long run the cost at rtol 1e-11 grows with t
-(measured: the same 300 revolutions take 8.2e3 steps from t = 0, 4.6e4 from t = 1000 T,
-1.2e6 from 5000 T, 7.0e6 from 20000 T; at rtol 1e-9 5.4e3 throughout), consistent with the
-rounding of t (Theta = Omega t) dominating the error estimate at large t.
+periodic, so it is the same motion), which bounds the memory of the samples.  (It also
+worked around a cost that grew with t at rtol 1e-11 -- the same 300 revolutions took 8.2e3
+steps from t = 0, 4.6e4 from t = 1000 T, 1.2e6 from 5000 T, 7.0e6 from 20000 T -- which
+simulate() now avoids itself by integrating in phase-wrapped pieces, camdyn.pieces.)
 """
 from __future__ import annotations
 
@@ -67,7 +67,7 @@ SPEED = 196.0                    # rev/min
 T = 60.0 / SPEED                 # s, one cam revolution
 PER_REV = 200                    # samples per revolution (the sample at t = kT is the section)
 TRANSIENT = 100                  # revolutions dropped (the start-up motion ends after ~25)
-CHUNK = 500                      # revolutions per restart (see the module docstring)
+CHUNK = 500                      # revolutions per restart: bounds the samples kept in memory
 ATOL_PER_RTOL = 1e-3             # atol = 1e-3 rtol: alpha ~ 0.3 rad, alpha_dot ~ 1 rad/s
 BLOCK = 20                       # revolutions per batch
 Z = 4.0                          # standard errors allowed between two runs' scalar statistics

@@ -100,7 +100,7 @@ def _fixed_regime(model: Model, t: float, y) -> int:
 
 
 def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
-              options: SolverOptions = SolverOptions()) -> Trajectory:
+              options: SolverOptions = SolverOptions(), key: tuple | None = None) -> Trajectory:
     """Integrate the hybrid model compiled; same arguments and result as camdyn.integrate.integrate."""
     K = model.kernels
     fns = scene_kernels(K)
@@ -109,7 +109,11 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     t0, t_end = map(float, t_span)
     y = np.ascontiguousarray(y0, dtype=float)
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
-    r0 = _fixed_regime(model, t0, y) if not K.FLAGS else -1
+    if key is not None:
+        names, keys = regime_names(K)
+        r0 = names.index(next(name for name, k in keys.items() if k == key))
+    else:
+        r0 = _fixed_regime(model, t0, y) if not K.FLAGS else -1
     ev = options.events
     contact_step = 0.1 / model.equilibrium.vartheta  # s: as the SciPy backend (camdyn.integrate)
     fset = np.array([options.rtol, options.atol, options.max_step, ev.xtol, ANGLE_LIMIT, CHATTER_WINDOW,

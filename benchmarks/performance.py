@@ -374,9 +374,9 @@ def plot_case(result: dict, path: Path):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for label, pts in result["curves"].items():
-        pts = [(s, e) for _, s, e in pts if math.isfinite(e) and e > 0]
-        if pts:
-            s, e = zip(*sorted(pts))
+        pts = [(s, e) for _, s, e in sorted(pts, reverse=True) if math.isfinite(e) and e > 0]
+        if pts:  # joined in tolerance order, loosest first: the solver's curve as rtol tightens
+            s, e = zip(*pts)
             style = "-o" if label.startswith("camdyn compiled") else "--s" if label.startswith("SciPy") else ":^"
             ax.loglog(e, s, style, label=label, ms=4)
     ax.set_xlabel("error (rad; impact cases: max of alpha error and 10 x impact-time error in s)")

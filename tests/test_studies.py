@@ -144,3 +144,57 @@ def test_command_line(tmp_path):
 def test_unknown_study_name_suggests():
     with pytest.raises(KeyError, match="did you mean 'fig10'"):
         studies.run("fig_10", fast=True)
+
+
+# ---------------------------------------------------------------- periodicity runs and the geometry scan
+
+def test_continuation_start_keeps_the_cam_angle():
+    """The up-sweep's second start: the state at the end of a run at one speed, at the same cam angle
+    at the next speed (Theta = Theta0 + Omega_c t)."""
+    end = [0.3, -1.2, 25.71425]
+    y0, t_start = common.continuation_start(end, 140.0, 143.0)
+    assert y0 == [0.3, -1.2]
+    w = lambda rpm: rpm * 2 * math.pi / 60
+    d = (w(143.0) * t_start - w(140.0) * end[2]) % (2 * math.pi)
+    assert min(d, 2 * math.pi - d) == pytest.approx(0.0, abs=1e-9)
+    assert 0.0 <= t_start < 60 / 143.0
+
+
+def test_impact_run_continues_from_its_end_state():
+    """A run continued from its end state ends where the uninterrupted run ends; a periodic run is not
+    extended by max_revolutions."""
+    fs = 4400.0  # 2400 samples per revolution at 110 rev/min: the last sample is at the end of the run
+    one = common.impact_run(EXP, "D", 110.0, 30, 10, sample_rate_Hz=fs, max_revolutions=60)
+    assert one["class"] == "P1" and one["revolutions"] == 30
+    y0, t = one["end_state"][:2], one["end_state"][2]
+    assert t == pytest.approx(30 * 60 / 110.0, abs=1e-9)
+    two = common.impact_run(EXP, "D", 110.0, 30, 0, sample_rate_Hz=fs, y0=y0, t_start=t)
+    whole = common.impact_run(EXP, "D", 110.0, 60, 10, sample_rate_Hz=fs)
+    assert two["end_state"][2] == pytest.approx(whole["end_state"][2], abs=1e-9)
+    assert two["end_state"][0] == pytest.approx(whole["end_state"][0], abs=1e-7)
+
+
+def test_reference_rig_geometry_override_refits_every_printed_number():
+    """identify(geometry=...) keeps every printed number within rounding for another assumed geometry."""
+    res = reference_rig.identify(geometry=dict(d_x=0.05, theta0_offset=math.pi))
+    assert res.all_within
+    assert res.rig.d_x == 0.05
+    assert res.rig.theta0 == pytest.approx(reference_rig.theta0_for(res.rig.alpha0) + math.pi)
+    with pytest.raises(KeyError, match="not one of"):
+        reference_rig.identify(geometry=dict(e=0.1))
+
+
+def test_chaos_scan_writes_its_section_to_both_documents(tmp_path):
+    """chaos-scan (fast) writes its section to reproduction.md and to reference-rig.md, and the
+    reference-rig study keeps that section when it rewrites its page."""
+    quiet = dict(fast=True, out=tmp_path, data_dir=tmp_path / "data", log=lambda *a: None)
+    studies.run("reference-rig", **quiet)
+    assert "Not run yet" in (tmp_path / "reference-rig.md").read_text()
+    out = studies.run("chaos-scan", **quiet)
+    assert len(out.numbers["stage1"]) == 2 and out.numbers["stage2"][-1]["shipped"]
+    doc = (tmp_path / "reference-rig.md").read_text()
+    assert doc.count("## Chaos onsets: geometry scan") == 1 and "Not run yet" not in doc
+    assert "python -m camdyn.studies chaos-scan --fast" in (tmp_path / "reproduction.md").read_text()
+    studies.run("reference-rig", **quiet)
+    again = (tmp_path / "reference-rig.md").read_text()
+    assert again.count("## Chaos onsets: geometry scan") == 1 and "Not run yet" not in again

@@ -13,7 +13,7 @@ From Python::
     out.numbers, out.figures, out.markdown
 
 Studies: reference-rig (identify the reference rig; writes camdyn/data/reference*.toml and
-docs/reference-rig.md), fig4-5, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
+docs/reference-rig.md), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
 """
 from __future__ import annotations
 
@@ -29,6 +29,7 @@ __all__ = ["STUDIES", "run", "Context", "StudyOutput", "FAST_ENV", "report_path"
 STUDIES = {
     "reference-rig": ("reference_rig", "identify the reference rig (presets + docs/reference-rig.md)"),
     "fig4-5": ("fig04_05", "alpha_r rms and peak-to-peak vs speed, damping A-E; time histories at 155 rev/min"),
+    "chaos-scan": ("chaos_scan", "the chaos onsets of Sec. 4 against the assumed geometry (also in reference-rig.md)"),
     "fig6": ("fig06", "alpha_r in time and frequency at 155 rev/min, damping D"),
     "fig7-8": ("fig07_08", "alpha_rp vs speed: contact model and energy balance, low and broad range"),
     "fig9": ("fig09", "the k_s - Omega_c map of sliding and impacting regimes"),

@@ -22,6 +22,8 @@ from camdyn.errors import CamdynError
 
 #: environment variable that switches every study to its fast mode ("1") for tests
 FAST_ENV = "CAMDYN_FAST"
+#: environment variable that caps the number of worker processes of the studies (default 2)
+WORKERS_ENV = "CAMDYN_WORKERS"
 
 #: the reported numbers of the paper (Sundar, Dreyer & Singh 2013), with where they are stated
 PAPER = {
@@ -210,7 +212,7 @@ The paper compares several results with measurements of Alzate et al. (2007); th
 measurements are not available here, so no section plots them and none is invented.
 """
 
-ORDER = ["reference-rig", "fig4-5", "fig6", "fig7-8", "fig9", "fig10", "fig11", "fig12-15", "fig16", "numbers"]
+ORDER = ["reference-rig", "fig4-5", "chaos-scan", "fig6", "fig7-8", "fig9", "fig10", "fig11", "fig12-15", "fig16", "numbers"]
 
 
 def _markers(name):
@@ -269,8 +271,12 @@ def to_json(obj) -> str:
 def parallel_map(fn, jobs, fast: bool, workers: int | None = None):
     """Map ``fn`` over ``jobs`` (in order); on 2 processes unless fast or a single job.
 
-    ``fn`` must be a module-level function (picklable)."""
+    The environment variable ``CAMDYN_WORKERS`` (e.g. ``1`` on a shared machine) overrides the
+    number of processes. ``fn`` must be a module-level function (picklable)."""
     jobs = list(jobs)
+    env = os.environ.get(WORKERS_ENV, "").strip()
+    if workers is None and env:
+        workers = max(1, int(env))
     workers = workers if workers is not None else (1 if fast else min(2, os.cpu_count() or 1))
     if workers <= 1 or len(jobs) <= 1:
         return [fn(j) for j in jobs]
@@ -280,15 +286,61 @@ def parallel_map(fn, jobs, fast: bool, workers: int | None = None):
 
 
 def impact_run(rig, damping: str, speed_rpm: float, revolutions: float, transient: float,
-               sample_rate_Hz: float = 4000.0, keep_history: float = 0.0) -> dict:
+               sample_rate_Hz: float = 4000.0, keep_history: float = 0.0, y0=None, t_start: float = 0.0,
+               max_revolutions: float | None = None) -> dict:
     """One run of the experiment's impacting rig: residual statistics and the Poincare section.
 
     Returns a JSON-able dict; ``keep_history`` revolutions of (t, alpha_r) at the end are kept.
+    The run starts from the static equilibrium, or from ``y0 = (alpha, alpha_dot)`` at time
+    ``t_start`` (e.g. the end state of a run at a neighbouring speed: ``out["end_state"]``).
+
+    Statistics and the class are taken over the last ``revolutions - transient`` revolutions
+    (the *window*). With ``max_revolutions``, a run whose window is aperiodic is continued, one
+    window at a time, from its end state, up to ``max_revolutions`` in all, and classed on its
+    last window: a motion that wanders between coexisting attractors for a few hundred
+    revolutions before it settles is then classed by where it settles, not as aperiodic.
+    ``out["revolutions"]`` is the number of revolutions run in all.
     """
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
-    r = simulate(rig, scene, speed_rpm=speed_rpm, revolutions=revolutions, sample_rate_Hz=sample_rate_Hz)
-    out = {"damping": damping, "speed_rpm": speed_rpm, "outcome": r.outcome.name, "backend": r.meta.get("backend"),
-           "revolutions": revolutions, "transient": transient}
+    window = revolutions - transient
+    out = {"damping": damping, "speed_rpm": speed_rpm, "revolutions": revolutions, "transient": transient}
+    r = simulate(rig, scene, speed_rpm=speed_rpm, revolutions=revolutions, sample_rate_Hz=sample_rate_Hz,
+                 y0=y0, t_start=t_start)
+    skip, total = transient, revolutions
+    while True:
+        out.update(_window_stats(r, skip))
+        if (out["class"] != "aperiodic" or not max_revolutions or window <= 0
+                or total + window > max_revolutions + 1e-9):
+            break
+        r = simulate(rig, scene, speed_rpm=speed_rpm, revolutions=window, sample_rate_Hz=sample_rate_Hz,
+                     y0=(float(r.alpha[-1]), float(r.alpha_dot[-1])), t_start=float(r.t[-1]))
+        skip, total = 0.0, total + window
+    out.update(outcome=r.outcome.name, backend=r.meta.get("backend"), revolutions=total)
+    if r.t.size:
+        out["end_state"] = [float(r.alpha[-1]), float(r.alpha_dot[-1]), float(r.t[-1])]
+    if keep_history and r.t.size:
+        T = r.period
+        keep = r.t >= r.t[-1] - keep_history * T
+        out["t"] = ((r.t[keep] - r.t[keep][0]) / T).tolist()
+        out["alpha_r"] = r.alpha_r[keep].tolist()
+    return out
+
+
+def continuation_start(end_state, from_rpm: float, to_rpm: float) -> tuple[list[float], float]:
+    """(y0, t_start) that continue a run ended in ``end_state`` (alpha, alpha_dot, t) at
+    ``from_rpm`` at the speed ``to_rpm``, at the same cam angle (Theta = Theta0 + Omega_c t):
+    the second initial condition of a slow speed sweep."""
+    alpha, alpha_dot, t = end_state
+    w_from, w_to = from_rpm * 2 * math.pi / 60.0, to_rpm * 2 * math.pi / 60.0
+    phase = math.fmod(w_from * t, 2 * math.pi)
+    return [alpha, alpha_dot], phase / w_to
+
+
+def _window_stats(r, transient: float) -> dict:
+    """rms, peak-to-peak, max, impacts per revolution, Poincare section and class of a run
+    after ``transient`` revolutions (the class's tolerance is relative to the window's own
+    peak-to-peak of alpha_r)."""
+    out = {}
     T = r.period
     t_end = r.t[-1] if r.t.size else 0.0
     steady = r.after(r.t[0] + transient * T) if r.t.size else r
@@ -303,8 +355,4 @@ def impact_run(rig, damping: str, speed_rpm: float, revolutions: float, transien
     else:
         out.update(rms=None, p2p=None, max=None, impacts_per_rev=None, section=[])
         out["class"] = f"stopped ({r.outcome.name})"
-    if keep_history and r.t.size:
-        keep = r.t >= r.t[-1] - keep_history * T
-        out["t"] = ((r.t[keep] - r.t[keep][0]) / T).tolist()
-        out["alpha_r"] = r.alpha_r[keep].tolist()
     return out

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (EXPERIMENT_SPEEDS, Context, StudyOutput, experiment_rig, figure, fmt, impact_run,
-                     md_table, parallel_map, save)
+from .common import (EXPERIMENT_SPEEDS, Context, StudyOutput, continuation_start, experiment_rig, figure, fmt,
+                     impact_run, md_table, parallel_map, save)
 
 NAME, TITLE = "fig4-5", "Figs. 4–5: residual response against speed, damping models A–E"
 MODELS = "ABCDE"
@@ -16,23 +16,51 @@ COLORS = dict(A="tab:blue", B="tab:orange", C="tab:green", D="tab:red", E="tab:p
 
 def settings(fast: bool) -> dict:
     if fast:
-        return dict(speeds=[135.0, 155.0], revolutions=6, transient=3, history=2)
+        return dict(speeds=[135.0, 155.0], revolutions=6, transient=3, max_revolutions=9, history=2)
     speeds = sorted(set(EXPERIMENT_SPEEDS) | {125.0, 130.0, 165.0})
-    return dict(speeds=speeds, revolutions=80, transient=40, history=6)
+    return dict(speeds=speeds, revolutions=200, transient=100, max_revolutions=500, history=6)
 
 
 def _job(args):
-    rig, d, sp, s = args
-    return impact_run(rig, d, sp, s["revolutions"], s["transient"],
-                      keep_history=s["history"] if sp == 155.0 else 0.0)
+    """One damping model over the speeds, in increasing order, from two starts: the static
+    equilibrium (Sec. 4) and, from the second speed on, the end state of the previous speed's
+    up-sweep run (a slow up-sweep): different classes or amplitudes from the two starts reveal
+    coexisting motions."""
+    rig, d, s = args
+    out, prev = [], None
+    for sp in s["speeds"]:
+        r = impact_run(rig, d, sp, s["revolutions"], s["transient"], max_revolutions=s["max_revolutions"],
+                       keep_history=s["history"] if sp == 155.0 else 0.0)
+        if prev is not None:
+            y0, t_start = continuation_start(prev["end_state"], prev["speed_rpm"], sp)
+            u = impact_run(rig, d, sp, s["revolutions"], s["transient"], max_revolutions=s["max_revolutions"],
+                           y0=y0, t_start=t_start)
+        else:
+            u = r
+        r["up"] = {k: u.get(k) for k in ("class", "rms", "p2p", "revolutions", "outcome")}
+        out.append(r)
+        # the sweep goes on from where this speed ended; after a stop (the follower thrown to 90
+        # degrees) from the static-equilibrium run's end state instead
+        prev = next((x for x in (u, r) if x.get("outcome") == "SUCCESS" and "end_state" in x), None)
+    return out
+
+
+def coexist(r) -> bool:
+    """The two starts end on different motions (class, or peak-to-peak by more than 10 %)."""
+    up = r.get("up") or {}
+    if up.get("class") != r["class"]:
+        return True
+    a, b = r.get("p2p"), up.get("p2p")
+    return a is not None and b is not None and abs(a - b) > 0.1 * max(abs(a), abs(b), 1e-12)
 
 
 def run(ctx: Context) -> StudyOutput:
     rig = experiment_rig()
     s = settings(ctx.fast)
-    jobs = [(rig, d, sp, s) for d in MODELS for sp in s["speeds"]]
-    ctx.log(f"{NAME}: {len(jobs)} runs of {s['revolutions']} revolutions")
-    runs = parallel_map(_job, jobs, ctx.fast)
+    jobs = [(rig, d, s) for d in MODELS]
+    ctx.log(f"{NAME}: {len(MODELS)} models x {len(s['speeds'])} speeds x 2 starts, {s['revolutions']} revolutions "
+            f"(up to {s['max_revolutions']} while aperiodic)")
+    runs = [r for rs in parallel_map(_job, jobs, ctx.fast) for r in rs]
     by = {(r["damping"], r["speed_rpm"]): r for r in runs}
     speeds = s["speeds"]
 
@@ -74,22 +102,32 @@ def run(ctx: Context) -> StudyOutput:
     ax[1, 1].legend(fontsize=8, loc="upper right")
     png = save(fig, ctx.png("fig4-5"))
 
-    rows = []
-    for sp in speeds:
-        rows.append([f"{sp:g}"] + [f"{by[d, sp]['class']}, rms {fmt(by[d, sp]['rms'], 3)}, p-p {fmt(by[d, sp]['p2p'], 3)}"
-                                   for d in MODELS])
-    first_aperiodic = {}
+    def cell(r):
+        text = f"{r['class']}, rms {fmt(r['rms'], 3)}, p-p {fmt(r['p2p'], 3)}"
+        if r.get("revolutions", s["revolutions"]) > s["revolutions"]:
+            text += f" ({r['revolutions']:g} rev)"
+        if r.get("up") and r["up"] is not r and coexist(r):
+            text += f"; up-sweep: {r['up']['class']}, p-p {fmt(r['up']['p2p'], 3)}"
+        return text
+
+    rows = [[f"{sp:g}"] + [cell(by[d, sp]) for d in MODELS] for sp in speeds]
+    first_aperiodic, first_aperiodic_up = {}, {}
     for d in MODELS:
         ap = [sp for sp in speeds if by[d, sp]["class"] == "aperiodic"]
         first_aperiodic[d] = min(ap) if ap else None
+        ap = [sp for sp in speeds if (by[d, sp].get("up") or {}).get("class") == "aperiodic"]
+        first_aperiodic_up[d] = min(ap) if ap else None
     at155 = {d: by[d, 155.0]["class"] for d in MODELS if (d, 155.0) in by}
+    coexisting = {d: [sp for sp in speeds[1:] if coexist(by[d, sp])] for d in MODELS}
+    extended = {d: [sp for sp in speeds if by[d, sp].get("revolutions", 0) > s["revolutions"]] for d in MODELS}
+
     def yes(ok):
         return "yes" if ok else "**no**"
 
-    above = [sp for sp in speeds if sp > 155.0]
-    bd_ok = all(first_aperiodic[d] is not None and first_aperiodic[d] > 155.0 for d in "BD")
+    above = [sp for sp in speeds if sp >= 155.0]
+    bd_ok = all(first_aperiodic[d] is not None and first_aperiodic[d] >= 155.0 for d in "BD")
     checks = [
-        ["B and D chaotic only above about 155 rev/min", ", ".join(
+        ["B and D chaotic above about 155 rev/min (periodic below 155, aperiodic from 155 on)", ", ".join(
             f"{d}: first aperiodic at {fmt(first_aperiodic[d])} rev/min" if first_aperiodic[d] else f"{d}: none aperiodic"
             for d in "BD"), yes(bd_ok and bool(above))],
         ["E chaotic before 155 rev/min", f"E: first aperiodic at {fmt(first_aperiodic['E'])} rev/min"
@@ -98,29 +136,40 @@ def run(ctx: Context) -> StudyOutput:
         ["A and C still periodic at 155 rev/min", f"A: {at155.get('A')}, C: {at155.get('C')}",
          yes(str(at155.get("A", "")).startswith("P") and str(at155.get("C", "")).startswith("P"))],
     ]
+    n_co = sum(len(v) for v in coexisting.values())
+    co_text = "; ".join(f"{d}: {', '.join(f'{v:g}' for v in coexisting[d])}" for d in MODELS if coexisting[d])
     md = "\n\n".join([
         f"![Figs. 4-5](img/{png.name})",
         f"Experiment's settings (`reference-experiment`: line contact 16 mm, k_s = {rig.k_s:.3g} N/m, "
         f"Coulomb friction μ_m = 0.3, the damping constants of Section 4), constant cam speed, started from "
-        f"the static equilibrium; {s['revolutions']} revolutions per run, statistics over the last "
+        f"the static equilibrium (as in Sec. 4); {s['revolutions']} revolutions per run, statistics over the last "
         f"{s['revolutions'] - s['transient']} (the first {s['transient']} are dropped as transient). "
         "A run is *periodic (Pn)* when its Poincaré section (α_r once per cam revolution) repeats with period "
         "n ≤ 8 to 0.2 % of its peak-to-peak, else *aperiodic* (chaotic or a long transient; not proven chaotic "
-        "by a Lyapunov exponent).",
+        f"by a Lyapunov exponent). A run whose last {s['revolutions'] - s['transient']} revolutions are aperiodic "
+        f"is continued, {s['revolutions'] - s['transient']} revolutions at a time, up to {s['max_revolutions']} "
+        "in all, and classed by its last window, so that a motion wandering between coexisting attractors "
+        "before it settles is classed by where it settles (the run length is then given in the table). Each "
+        "speed is also run from a second start, the end state of the next slower speed's run (a slow "
+        "up-sweep; after a run that stopped, the sweep goes on from the static-equilibrium run's end state); where the two starts end on different motions (class, or peak-to-peak differing by more "
+        "than 10 %) the table gives both: the rig is multistable there. The first-aperiodic speeds below are "
+        "those of the static-equilibrium start, the paper's protocol.",
         "**Not compared with measurements:** the paper's Figs. 4–5 plot the measured α_r of Alzate et al. "
         "(2007) and their analytical results; those data are not available here, so only the paper's "
         "statements are compared.",
         md_table(["the paper states (Sec. 4)", "camdyn", "reproduced"], checks),
-        "What camdyn shows on this rig: below the contact-loss speed (130 rev/min) the follower stays on the "
-        "cam (α_r of order 1e-9 rad, the contact deflection). Above it two motions coexist: a grazing one, "
-        "the follower barely lifting off near maximum lift (α_r of order 1e-3 rad), and a large period-1 "
-        "flight, the follower thrown off once per revolution and caught on the next (α_r of order 0.15 rad). "
-        "Which one a run settles on, and how long it wanders between them first, depends on the damping model "
-        "and the speed; runs classed aperiodic are mostly such wandering. The paper's chaos onsets depend on "
-        "the rig's unknown geometry (the assumed r_c, χ0, d_x, Θ0 of the reference rig), and the reference "
-        "rig was not fitted to them.",
+        "Up-sweep start, first aperiodic speed: " + ", ".join(
+            f"{d} {fmt(first_aperiodic_up[d]) if first_aperiodic_up[d] else 'none'}" for d in MODELS) + ". "
+        + (f"The two starts end on different motions at {n_co} model-speed pairs ({co_text})." if n_co else
+           "The two starts end on the same motion at every speed.")
+        + (" Runs continued beyond " + f"{s['revolutions']} revolutions: "
+           + "; ".join(f"{d}: {', '.join(f'{v:g}' for v in extended[d])}" for d in MODELS if extended[d]) + "."
+           if any(extended.values()) else ""),
+        "Whether another assumed geometry (r_c, χ0, d_x, Θ0) of the reference rig reproduces the paper's onsets "
+        "is scanned by `python -m camdyn.studies chaos-scan` (next section).",
         md_table(["Ω_c (rev/min)"] + [f"model {d}" for d in MODELS], rows),
     ])
-    numbers = {"first_aperiodic_rpm": first_aperiodic, "class_at_155": at155,
-               "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r")} for r in runs]}
+    numbers = {"first_aperiodic_rpm": first_aperiodic, "first_aperiodic_rpm_upsweep": first_aperiodic_up,
+               "class_at_155": at155, "coexisting_rpm": coexisting,
+               "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r", "end_state")} for r in runs]}
     return StudyOutput(NAME, TITLE, md, numbers, [png])

@@ -17,7 +17,7 @@ from camdyn import calibrate as cal
 from camdyn.analysis import contact_loss_speed, static_equilibrium
 from camdyn.cam import ConstantSpeed
 
-from .common import PAPER, Context, StudyOutput, fmt, md_table
+from .common import PAPER, Context, StudyOutput, fmt, md_table, recorded_numbers
 
 NAME = "reference-rig"
 TITLE = "The reference rig"
@@ -115,23 +115,47 @@ def unknowns(start: dict[str, float]) -> list[cal.Unknown]:
     ]
 
 
-def starting_rig(start: dict[str, float]) -> camdyn.Rig:
+#: the names :func:`identify` accepts in ``geometry`` (the assumed values; theta0_offset in rad)
+GEOMETRY = ("r_c", "chi0", "d_x", "d_y", "theta0_offset")
+
+
+def assumed_values(geometry: dict[str, float] | None = None) -> dict[str, float]:
+    """The assumed geometry (r_c, chi0, d_x, d_y, theta0_offset), with ``geometry``'s overrides.
+
+    Theta0 = -pi/2 - alpha0 + theta0_offset; the reference rig has theta0_offset = 0."""
+    values = {k: v for k, (v, _) in ASSUMED.items() if v is not None}
+    values["theta0_offset"] = 0.0
+    for k, v in (geometry or {}).items():
+        if k not in GEOMETRY:
+            raise KeyError(f"geometry: {k!r} is not one of {', '.join(GEOMETRY)}")
+        values[k] = float(v)
+    return values
+
+
+def starting_rig(start: dict[str, float], geometry: dict[str, float] | None = None) -> camdyn.Rig:
     values = {k: v for k, (v, _) in REPORTED.items()}
-    values.update({k: v for k, (v, _) in ASSUMED.items() if v is not None})
+    geo = assumed_values(geometry)
+    offset = geo.pop("theta0_offset")
+    values.update(geo)
     values.update(I_Pb=start["I_Pb"], w_b=start["w_b"], L_us=start["L_us"], alpha0=start["alpha0"],
-                  theta0=theta0_for(start["alpha0"]), e=0.1 * values["r_c"])
+                  theta0=theta0_for(start["alpha0"]) + offset, e=0.1 * values["r_c"])
     return camdyn.Rig(**values)
 
 
-def identify(start: dict[str, float] | None = None) -> cal.Calibration:
-    """Run the calibration; ``start`` overrides the initial values (e.g. the shipped preset's)."""
+def identify(start: dict[str, float] | None = None, geometry: dict[str, float] | None = None) -> cal.Calibration:
+    """Run the calibration; ``start`` overrides the initial values (e.g. the shipped preset's),
+    ``geometry`` the assumed r_c, chi0, d_x, d_y and theta0_offset (e.g. for a geometry scan:
+    the other unknowns are refitted so that every printed number is reproduced again)."""
     start = {**INITIAL, **(start or {})}
-    rig = starting_rig(start)
+    rig = starting_rig(start, geometry)
+    offset = assumed_values(geometry)["theta0_offset"]
     fixed = {k: why.split(";")[0].split(":")[0] for k, (_, why) in ASSUMED.items() if k != "theta0"}
+    if geometry:
+        fixed = {k: (f"{why} (scanned value)" if k in geometry else why) for k, why in fixed.items()}
     return cal.calibrate(
         rig, unknowns(start), targets(), fixed=fixed,
         tied={"e": lambda p: 0.1 * p["r_c"],  # reported ratio, Sec. 6
-              "theta0": lambda p: theta0_for(p["alpha0"])},  # assumed: the 0-state at minimum lift
+              "theta0": lambda p: theta0_for(p["alpha0"]) + offset},  # assumed: the 0-state at minimum lift
         name="reference",
         description=("The reference rig of camdyn, Sections 6-8 settings (k_s = 2000 N/m, line contact "
                      "1.6 mm, e = 0.1 r_c, zeta_D = 0.01): a physically plausible rig identified to reproduce "
@@ -184,7 +208,9 @@ def _provenance(result: cal.Calibration, exp_rig: camdyn.Rig) -> list[list[str]]
     return rows
 
 
-def document(result: cal.Calibration, exp_rig: camdyn.Rig) -> str:
+def document(result: cal.Calibration, exp_rig: camdyn.Rig, chaos_scan: dict | None = None) -> str:
+    """reference-rig.md; ``chaos_scan``: the numbers the chaos-scan study recorded (None: not run yet)."""
+    from .chaos_scan import reference_rig_block, section
     ref = result.rig
     eq_line = static_equilibrium(ref, "line")
     eq_point = static_equilibrium(ref, "point")
@@ -259,7 +285,8 @@ def document(result: cal.Calibration, exp_rig: camdyn.Rig) -> str:
         f"L_us − d_y enters Eq. 11), Θ0 (no static target sees it). Their reasons are in the table above. The "
         f"chaos onsets of Section 4 (B and D aperiodic above about 155 rev/min, E earlier, A and C periodic "
         f"at 155) are not fitted: they are checked by `python -m camdyn.studies fig4-5` and reported in "
-        f"[reproduction.md](reproduction.md).",
+        f"[reproduction.md](reproduction.md); whether another assumed geometry would reproduce them is "
+        f"scanned by `python -m camdyn.studies chaos-scan` (section *Chaos onsets: geometry scan* below).",
         "",
         "```text",
         dof.statement(),
@@ -304,6 +331,8 @@ def document(result: cal.Calibration, exp_rig: camdyn.Rig) -> str:
         "",
         result.report(),
         "",
+        reference_rig_block(section(chaos_scan) if chaos_scan else None),
+        "",
     ]
     return "\n".join(lines)
 
@@ -326,7 +355,8 @@ def run(ctx: Context) -> StudyOutput:
     result.rig.to_toml(data_dir / "reference.toml")
     exp_rig.to_toml(data_dir / "reference-experiment.toml")
     ctx.log(f"wrote {data_dir / 'reference.toml'} and {data_dir / 'reference-experiment.toml'}")
-    doc = document(result, exp_rig)
+    chaos = recorded_numbers(ctx.out / "reproduction.md").get("chaos-scan")
+    doc = document(result, exp_rig, chaos)
     if ctx.write_docs:
         (ctx.out / "reference-rig.md").write_text(doc, encoding="utf-8")
         ctx.log(f"wrote {ctx.out / 'reference-rig.md'}")

@@ -122,14 +122,14 @@ def simulate(rig, scene, cam=None, *, prefer_compiled: bool = True, fallback: bo
     """camdyn.simulate, on the compiled backend when it exists and supports the run, else SciPy.
 
     A compiled run that stops early for a numerical reason (anything but the follower
-    reaching 90 degrees) is rerun on the SciPy reference backend, which models Coulomb
-    stick-slip (``fallback=False`` keeps the compiled result).  The backend used is recorded in ``result.meta["backend"]``.
+    reaching 90 degrees) is rerun on the SciPy reference backend (``fallback=False`` keeps
+    the compiled result).  The backend used is recorded in ``result.meta["backend"]``.
     """
     if prefer_compiled and _has_backend() and getattr(cam, "kind", "constant") != "user":
         try:
             result = camdyn.simulate(rig, scene, cam, backend="compiled", **kw)
             result.meta["backend"] = "compiled"
-            # a stop the SciPy reference may handle (e.g. Coulomb stick-slip): run it there
+            # a stop the SciPy reference may handle: run it there
             if result.ok or result.outcome.name == "ANGLE_LIMIT" or not fallback:
                 return result
         except (ImportError, NotImplementedError, CamdynError):  # not supported there: the reference

@@ -20,7 +20,7 @@ VR = [("printed", "printed v_r (as the paper)"), ("kinematic", "kinematic v_r (d
 
 
 def _runs(rig, fast):
-    periods = 1.0 if fast else 2.0  # fast: no SciPy rerun of a Coulomb run stopped at a v_r reversal
+    periods = 1.0 if fast else 2.0
     out = {}
     for motion, cam in (("constant", camdyn.ConstantSpeed(50.0)), ("oscillating", camdyn.Oscillating(math.pi, 40.0))):
         for vr, _ in VR:
@@ -79,9 +79,9 @@ def run(ctx: Context) -> StudyOutput:
         "50 rev/min is in sliding contact, as the paper verified), line contact 1.6 mm, damping D, "
         "μ_m = 0.3. Left: the paper's printed sliding velocity v_r = ψ̇_j − (r_c + e sin(α+Θ))(α̇ + Θ̇); "
         "right: the relative velocity of the two material points at the contact (misprint 8). Coulomb "
-        "friction switches sign with v_r; where v_r reaches zero the SciPy backend follows the Filippov "
-        "sticking motion (`stick` regimes); runs the compiled backend could not finish there were rerun on "
-        "SciPy.",
+        "friction switches sign with v_r; where v_r reaches zero and both sides' fields point at it, "
+        "both backends follow the Filippov sticking motion (`stick` regimes); the backend of each run "
+        "is recorded with its numbers.",
         "The paper (Sec. 7.2): at e = 0.7 r_c and 50 rev/min 'a change in direction in v_r(t) is introduced "
         "(twice per revolution of the cam)'; F_f and N_x with model I are 'discontinuous during the change in "
         "direction of v_r(t) followed by some high frequency oscillations', smoothed by model II; for the "

@@ -173,6 +173,13 @@ def locate(
     return float(hi)
 
 
+def _extremum(event: Event, dense, ta: float, tb: float) -> tuple[float, float]:
+    """(t, g) where the rate of ``g`` changes sign in (ta, tb), on the interpolant."""
+    t_ext, _ = brentq(lambda s: event.rate(s, dense(s)), ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
+                      maxiter=100, full_output=True, disp=False)
+    return t_ext, float(event.fn(t_ext, dense(t_ext)))
+
+
 def _hidden_excursion(event: Event, dense, ta: float, tb: float, ga: float, ra: float, rb: float):
     """(t_ext, ga, g_ext) if g crosses the surface and comes back inside (ta, tb), else None.
 
@@ -185,9 +192,7 @@ def _hidden_excursion(event: Event, dense, ta: float, tb: float, ga: float, ra: 
     down = event.direction <= 0 and ga > 0 and ra < 0 < rb
     if not (up or down):
         return None
-    t_ext, _ = brentq(lambda s: event.rate(s, dense(s)), ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
-                      maxiter=100, full_output=True, disp=False)
-    g_ext = float(event.fn(t_ext, dense(t_ext)))
+    t_ext, g_ext = _extremum(event, dense, ta, tb)
     if (up and g_ext >= 0) or (down and g_ext <= 0):
         return t_ext, ga, g_ext
     return None
@@ -206,9 +211,7 @@ def _turned_back(event: Event, dense, ta: float, tb: float, ga: float, gb: float
         return ta, tb, ga, gb
     if rb * event.direction < 0:
         return None
-    t_ext, _ = brentq(lambda s: event.rate(s, dense(s)), ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
-                      maxiter=100, full_output=True, disp=False)
-    g_ext = float(event.fn(t_ext, dense(t_ext)))
+    t_ext, g_ext = _extremum(event, dense, ta, tb)
     if g_ext * event.direction < 0:  # still on the near side at the turn: the crossing follows it
         return t_ext, tb, g_ext, gb
     return ta, tb, ga, gb

@@ -84,8 +84,6 @@ def chattering(sw, n, window, count):
     return t - sw[n - 1 - count, 0] < window * max(1.0, abs(t))
 
 
-
-
 @njit(cache=True)
 def first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_free, K):
     """K[0] = f(t, y) and the size of the first step in regime r: SciPy's initial step at

@@ -84,6 +84,14 @@ def locate(fns, tab, nr, r, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
 
 
 @njit(cache=True)
+def extremum(fns, tab, nr, r, t, h, y0, y1, Q, p, ta, tb, ra, rb):
+    """(t, gap) where the gap rate (ra at ta, rb at tb, of opposite signs) changes sign."""
+    k_rate = tab[1].shape[0] + GAP_RATE
+    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
+    return t_ext, value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+
+
+@njit(cache=True)
 def hidden_excursion(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, rb):
     """(t_ext, g_ext) when the gap crosses its surface and comes back inside (ta, tb), else
     (-1, 0).  Both ends are on the watched side; if the rate turns from approaching the
@@ -93,9 +101,7 @@ def hidden_excursion(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga,
     down = direction <= 0 and ga > 0.0 and ra < 0.0 < rb
     if not (up or down):
         return -1.0, 0.0
-    k_rate = tab[1].shape[0] + GAP_RATE
-    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
-    g_ext = value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+    t_ext, g_ext = extremum(fns, tab, nr, r, t, h, y0, y1, Q, p, ta, tb, ra, rb)
     if (up and g_ext >= 0.0) or (down and g_ext <= 0.0):
         return t_ext, g_ext
     return -1.0, 0.0
@@ -115,9 +121,7 @@ def turned_back(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, 
         return ta, ga, True
     if rb * direction < 0.0:
         return ta, ga, False
-    k_rate = tab[1].shape[0] + GAP_RATE
-    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
-    g_ext = value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
+    t_ext, g_ext = extremum(fns, tab, nr, r, t, h, y0, y1, Q, p, ta, tb, ra, rb)
     if g_ext * direction < 0.0:
         return t_ext, g_ext, True
     return ta, ga, True

@@ -178,10 +178,17 @@ def _short(c: str) -> str:
 def section(numbers: dict) -> str:
     """The markdown of the scan (for reproduction.md and reference-rig.md) from its recorded numbers."""
     s = numbers["settings"]
-    st1 = numbers["stage1"]
+    st1, st2 = numbers["stage1"], numbers["stage2"]
     runs = [f"{d}{sp:g}" for d, sp in s["stage1"]]
+    lines = _intro(s, st1) + _stage1_lines(st1, runs) + _stage2_lines(st2, s["dense"])
+    lines += _conclusion(st2, s["dense"])
+    return "\n".join(lines)
+
+
+def _intro(s: dict, st1: list[dict]) -> list[str]:
+    """The grid, the refit and the classifier."""
     g = s["grid"]
-    lines = [
+    return [
         f"Does any assumed geometry reproduce the chaos onsets of Section 4 (B and D chaotic above about "
         f"155 rev/min, E earlier, A and C still periodic at 155)? Grid: r_c ∈ {{{', '.join(f'{1000 * v:g}' for v in g['r_c'])}}} mm "
         f"(the bound of Sec. 7.2 allows up to about 25 mm), χ0 ∈ {{{', '.join(f'{1000 * v:g}' for v in g['chi0'])}}} mm, "
@@ -205,6 +212,11 @@ def section(numbers: dict) -> str:
         + "; ".join(f"({i + 1}) {CHECKS[k][0]}" for i, k in enumerate(CHECKS)) + ".",
         "",
     ]
+
+
+def _stage1_lines(st1: list[dict], runs: list[str]) -> list[str]:
+    """Every geometry at the deciding speeds, with the checks it meets."""
+    lines = []
     rows = []
     for r in sorted(st1, key=lambda r: -r["met"]):
         ok = "".join("✓" if r["checks"].get(k) else "✗" for k in CHECKS) if r["checks"] else "–"
@@ -222,8 +234,12 @@ def section(numbers: dict) -> str:
                                                                   for i, k in enumerate(CHECKS)) + "; all "
                      f"{len(CHECKS)}: {sum(1 for r in st1 if r['met'] == len(CHECKS))}.")
         lines.append("")
-    st2 = numbers["stage2"]
-    speeds = s["dense"]
+    return lines
+
+
+def _stage2_lines(st2: list[dict], speeds) -> list[str]:
+    """The best geometries and the shipped one on the dense speed grid."""
+    lines = []
     lines.append(f"**Stage 2**: the {len(st2) - 1} geometries meeting most checks, and the shipped geometry "
                  f"(last), for all five models at {', '.join(f'{v:g}' for v in speeds)} rev/min.")
     lines.append("")
@@ -238,6 +254,12 @@ def section(numbers: dict) -> str:
         lines.append("Paper's statements on this grid: " + "; ".join(
             f"{k}: {'yes' if v else '**no**'}" for k, v in verdict(r["classes"], speeds).items()) + ".")
         lines.append("")
+    return lines
+
+
+def _conclusion(st2: list[dict], speeds) -> list[str]:
+    """Whether any geometry reproduces the onsets; otherwise the closest one and why not."""
+    lines = []
     found = [r for r in st2 if all(verdict(r["classes"], speeds).values())]
     # a periodic range ending in a chaotic one, or periodic again above an aperiodic speed?
     rows_ap = [(r, d) for r in st2 for d in MODELS if r["onsets"][d] is not None]
@@ -276,7 +298,7 @@ def section(numbers: dict) -> str:
             "numbers fix; and the paper does not say how it classed a motion as chaotic (its Figs. 4–6 show time "
             "histories and spectra of a few revolutions), so which of camdyn's periodic windows, long transients "
             "or coexisting motions would count as chaotic there is not known.")
-    return "\n".join(lines)
+    return lines
 
 
 def run(ctx: Context) -> StudyOutput:

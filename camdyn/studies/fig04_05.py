@@ -64,43 +64,7 @@ def run(ctx: Context) -> StudyOutput:
     by = {(r["damping"], r["speed_rpm"]): r for r in runs}
     speeds = s["speeds"]
 
-    fig, ax = figure(2, 2, figsize=(11, 7.5))
-    for d in MODELS:
-        rms = [by[d, sp]["rms"] for sp in speeds]
-        p2p = [by[d, sp]["p2p"] for sp in speeds]
-        ax[0, 0].plot(speeds, [np.nan if v is None else v for v in rms], "o-", ms=3, color=COLORS[d], label=f"model {d}")
-        ax[0, 1].plot(speeds, [np.nan if v is None else v for v in p2p], "o-", ms=3, color=COLORS[d], label=f"model {d}")
-        for k, sp in enumerate(speeds):
-            sec = np.asarray(by[d, sp].get("section", []))
-            off = (MODELS.index(d) - 2) * 0.35
-            ax[1, 0].plot(np.full(sec.size, sp + off), sec, ".", ms=2, color=COLORS[d],
-                          label=f"model {d}" if k == 0 else None)
-    for a, lab in ((ax[0, 0], "α_r rms (rad)"), (ax[0, 1], "α_r peak-to-peak (rad)")):
-        a.set_xlabel("cam speed Ω_c (rev/min)")
-        a.set_ylabel(lab)
-        a.set_yscale("log")
-        a.grid(alpha=0.3)
-        a.legend(fontsize=8)
-    ax[0, 0].set_title("(a) Fig. 4(a): rms of α_r after the transient")
-    ax[0, 1].set_title("(b) Fig. 4(b): peak-to-peak of α_r")
-    ax[1, 0].set_title("(c) α_r once per revolution (Poincaré): one dot = periodic")
-    ax[1, 0].set_xlabel("cam speed Ω_c (rev/min), models offset for legibility")
-    ax[1, 0].set_ylabel("α_r at Θ = Θ0 + 2πk (rad)")
-    ax[1, 0].grid(alpha=0.3)
-    ax[1, 0].legend(fontsize=8, markerscale=4)
-    offset = 0.0
-    for d in MODELS:
-        r = by.get((d, 155.0))
-        if r and "t" in r:
-            ar = np.asarray(r["alpha_r"])
-            mean = float(np.mean(ar)) if np.mean(ar) > 0 else 1.0
-            ax[1, 1].plot(r["t"], ar / mean + offset, color=COLORS[d], lw=0.8, label=f"model {d}")
-            offset += float(np.max(ar / mean)) * 1.1
-    ax[1, 1].set_title("(d) Fig. 5: α_r / mean(α_r) at 155 rev/min (stacked)")
-    ax[1, 1].set_xlabel("t / cam period")
-    ax[1, 1].set_yticks([])
-    ax[1, 1].legend(fontsize=8, loc="upper right")
-    png = save(fig, ctx.png("fig4-5"))
+    png = _figure(ctx, by, speeds)
 
     def cell(r):
         text = f"{r['class']}, rms {fmt(r['rms'], 3)}, p-p {fmt(r['p2p'], 3)}"
@@ -121,21 +85,7 @@ def run(ctx: Context) -> StudyOutput:
     coexisting = {d: [sp for sp in speeds[1:] if coexist(by[d, sp])] for d in MODELS}
     extended = {d: [sp for sp in speeds if by[d, sp].get("revolutions", 0) > s["revolutions"]] for d in MODELS}
 
-    def yes(ok):
-        return "yes" if ok else "**no**"
-
-    above = [sp for sp in speeds if sp >= 155.0]
-    bd_ok = all(first_aperiodic[d] is not None and first_aperiodic[d] >= 155.0 for d in "BD")
-    checks = [
-        ["B and D chaotic above about 155 rev/min (periodic below 155, aperiodic from 155 on)", ", ".join(
-            f"{d}: first aperiodic at {fmt(first_aperiodic[d])} rev/min" if first_aperiodic[d] else f"{d}: none aperiodic"
-            for d in "BD"), yes(bd_ok and bool(above))],
-        ["E chaotic before 155 rev/min", f"E: first aperiodic at {fmt(first_aperiodic['E'])} rev/min"
-         if first_aperiodic["E"] else "E: none aperiodic",
-         yes(first_aperiodic["E"] is not None and first_aperiodic["E"] < 155.0)],
-        ["A and C still periodic at 155 rev/min", f"A: {at155.get('A')}, C: {at155.get('C')}",
-         yes(str(at155.get("A", "")).startswith("P") and str(at155.get("C", "")).startswith("P"))],
-    ]
+    checks = _checks(first_aperiodic, at155, speeds)
     n_co = sum(len(v) for v in coexisting.values())
     co_text = "; ".join(f"{d}: {', '.join(f'{v:g}' for v in coexisting[d])}" for d in MODELS if coexisting[d])
     md = "\n\n".join([
@@ -173,3 +123,65 @@ def run(ctx: Context) -> StudyOutput:
                "class_at_155": at155, "coexisting_rpm": coexisting,
                "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r", "end_state")} for r in runs]}
     return StudyOutput(NAME, TITLE, md, numbers, [png])
+
+
+def _figure(ctx: Context, by: dict, speeds: list):
+    """Figs. 4-5: rms and peak-to-peak against speed, the Poincare sections, and the normalised
+    alpha_r histories at 155 rev/min; returns the PNG path."""
+    fig, ax = figure(2, 2, figsize=(11, 7.5))
+    for d in MODELS:
+        rms = [by[d, sp]["rms"] for sp in speeds]
+        p2p = [by[d, sp]["p2p"] for sp in speeds]
+        ax[0, 0].plot(speeds, [np.nan if v is None else v for v in rms], "o-", ms=3, color=COLORS[d], label=f"model {d}")
+        ax[0, 1].plot(speeds, [np.nan if v is None else v for v in p2p], "o-", ms=3, color=COLORS[d], label=f"model {d}")
+        for k, sp in enumerate(speeds):
+            sec = np.asarray(by[d, sp].get("section", []))
+            off = (MODELS.index(d) - 2) * 0.35
+            ax[1, 0].plot(np.full(sec.size, sp + off), sec, ".", ms=2, color=COLORS[d],
+                          label=f"model {d}" if k == 0 else None)
+    for a, lab in ((ax[0, 0], "α_r rms (rad)"), (ax[0, 1], "α_r peak-to-peak (rad)")):
+        a.set_xlabel("cam speed Ω_c (rev/min)")
+        a.set_ylabel(lab)
+        a.set_yscale("log")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    ax[0, 0].set_title("(a) Fig. 4(a): rms of α_r after the transient")
+    ax[0, 1].set_title("(b) Fig. 4(b): peak-to-peak of α_r")
+    ax[1, 0].set_title("(c) α_r once per revolution (Poincaré): one dot = periodic")
+    ax[1, 0].set_xlabel("cam speed Ω_c (rev/min), models offset for legibility")
+    ax[1, 0].set_ylabel("α_r at Θ = Θ0 + 2πk (rad)")
+    ax[1, 0].grid(alpha=0.3)
+    ax[1, 0].legend(fontsize=8, markerscale=4)
+    offset = 0.0
+    for d in MODELS:
+        r = by.get((d, 155.0))
+        if r and "t" in r:
+            ar = np.asarray(r["alpha_r"])
+            mean = float(np.mean(ar)) if np.mean(ar) > 0 else 1.0
+            ax[1, 1].plot(r["t"], ar / mean + offset, color=COLORS[d], lw=0.8, label=f"model {d}")
+            offset += float(np.max(ar / mean)) * 1.1
+    ax[1, 1].set_title("(d) Fig. 5: α_r / mean(α_r) at 155 rev/min (stacked)")
+    ax[1, 1].set_xlabel("t / cam period")
+    ax[1, 1].set_yticks([])
+    ax[1, 1].legend(fontsize=8, loc="upper right")
+    return save(fig, ctx.png("fig4-5"))
+
+
+def _checks(first_aperiodic: dict, at155: dict, speeds: list) -> list[list[str]]:
+    """The paper's Section 4 statements, camdyn's result and whether it reproduces them."""
+
+    def yes(ok):
+        return "yes" if ok else "**no**"
+
+    above = [sp for sp in speeds if sp >= 155.0]
+    bd_ok = all(first_aperiodic[d] is not None and first_aperiodic[d] >= 155.0 for d in "BD")
+    return [
+        ["B and D chaotic above about 155 rev/min (periodic below 155, aperiodic from 155 on)", ", ".join(
+            f"{d}: first aperiodic at {fmt(first_aperiodic[d])} rev/min" if first_aperiodic[d] else f"{d}: none aperiodic"
+            for d in "BD"), yes(bd_ok and bool(above))],
+        ["E chaotic before 155 rev/min", f"E: first aperiodic at {fmt(first_aperiodic['E'])} rev/min"
+         if first_aperiodic["E"] else "E: none aperiodic",
+         yes(first_aperiodic["E"] is not None and first_aperiodic["E"] < 155.0)],
+        ["A and C still periodic at 155 rev/min", f"A: {at155.get('A')}, C: {at155.get('C')}",
+         yes(str(at155.get("A", "")).startswith("P") and str(at155.get("C", "")).startswith("P"))],
+    ]

@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import textwrap
 from dataclasses import dataclass
+from functools import lru_cache
 
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
@@ -21,6 +22,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from . import laws
 from . import symbols as S
+from . import trig
 from .scenes import FLAG_SURFACES, OUTPUTS, Function, SceneSpec, build, regimes
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
@@ -61,18 +63,35 @@ class _Vector(NumPyPrinter):
 
 
 def _param_names(exprs) -> list[str]:
+    """The parameters the expressions read, in PARAM_ORDER, then the trigonometric
+    constants (derive.trig) by name."""
     names = {s.name for e in exprs for s in sp.sympify(e).free_symbols}
-    return [n for n in PARAM_ORDER if n in names]
+    return [n for n in PARAM_ORDER if n in names] + sorted(n for n in names if _is_constant(n))
+
+
+def _is_constant(name: str) -> bool:
+    return name.startswith(("sin_", "cos_"))
+
+
+@lru_cache(maxsize=None)
+def _economised(exprs: tuple[sp.Expr, ...]) -> tuple[tuple[sp.Expr, ...], tuple[tuple[sp.Symbol, sp.Expr], ...]]:
+    """derive.trig.economise of a function's expressions (as emitted), and its constants."""
+    out, constants = trig.economise(list(exprs))
+    return tuple(out), tuple(sorted(constants.items(), key=lambda kv: kv[0].name))
 
 
 @dataclass
 class _Module:
+    """A scene's functions as derived (hashed) and the index kernels' branches; the
+    parameters and trigonometric constants (derive.trig) of the code emitted for both."""
     spec: SceneSpec
     functions: tuple[Function, ...]
 
-    @property
-    def params(self) -> list[str]:
-        return _param_names([x for f in self.functions for x in f.exprs])
+    def __post_init__(self):
+        self.families = _index_families(self.spec, self.functions)
+        emitted = list(self.functions) + [f for fam in self.families for _, f in fam[2]]
+        self.constants = dict(sorted({kv for f in emitted for kv in _economised(f.exprs)[1]}, key=lambda kv: kv[0].name))
+        self.params = _param_names([x for f in emitted for x in _economised(f.exprs)[0]])
 
     def source_hash(self) -> str:
         h = hashlib.sha256(repr(sorted(self.spec.as_dict().items())).encode())
@@ -93,39 +112,12 @@ def _function_code(f: Function, params: list[str]) -> str:
     return "\n".join(lines + _body_lines(f, params))
 
 
-def _economise_trig(exprs: list[sp.Expr]) -> list[sp.Expr]:
-    """The same expressions with fewer distinct trigonometric calls, for the emitted code only.
-
-    tan(u) and sec(u) become sin(u)/cos(u) and 1/cos(u) (a sin/cos pair of one argument costs
-    about one call: compilers fuse it into sincos), and sin(2v), cos(2v) become
-    2 sin(v) cos(v) and 1 - 2 sin(v)^2 when sin(v) or cos(v) is computed anyway (the
-    half-angle forms of the gap, geometry.psi_i_conditioned, bring v = (alpha - alpha0)/2).
-    Both rewrites are exact identities, accurate to a few ulp.
-    """
-    exprs = [sp.sympify(x).replace(sp.tan, lambda u: sp.sin(u) / sp.cos(u))
-             .replace(sp.sec, lambda u: 1 / sp.cos(u)) for x in exprs]
-    args = sorted({call.args[0] for x in exprs for call in x.atoms(sp.sin, sp.cos)}, key=sp.default_sort_key)
-    double = {}
-    for u in args:
-        for v in args:
-            if v != u and sp.expand(u - 2 * v) == 0:
-                double[u] = v
-                break
-    if not double:
-        return exprs
-    subs = {}
-    for u, v in double.items():
-        subs[sp.sin(u)] = 2 * sp.sin(v) * sp.cos(v)
-        subs[sp.cos(u)] = 1 - 2 * sp.sin(v) ** 2
-    return [x.xreplace(subs) for x in exprs]
-
-
 def _body_lines(f: Function, params: list[str]) -> list[str]:
     """The statements of a function (parameter unpacking, CSE, return), indented once."""
     printer = _Vector() if f.vectorised else _Scalar()
-    replacements, reduced = sp.cse(_economise_trig(list(f.exprs)), symbols=sp.numbered_symbols("x"),
-                                   order="canonical")
-    used = _param_names(list(f.exprs))
+    exprs = list(_economised(f.exprs)[0])
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="canonical")
+    used = _param_names(exprs)
     lines = []
     if "cam" in f.args:
         lines.append("    Theta, Theta_dot, Theta_ddot = cam")
@@ -167,8 +159,9 @@ def _index_function_code(name: str, selector: str, branches: list[tuple[str, Fun
     return "\n".join(lines)
 
 
-def _index_functions(spec: SceneSpec, functions: tuple[Function, ...], params: list[str]) -> list[str]:
-    """The index-dispatched kernels of a compiled engine:
+def _index_families(spec: SceneSpec, functions: tuple[Function, ...]) -> list[tuple]:
+    """The index-dispatched kernels of a compiled engine, as (name, selector, branches, doc,
+    output) for _index_function_code:
 
     - ``rhs_index`` over the regimes;
     - with flags, ``surface_index`` over the flags' surfaces;
@@ -180,23 +173,19 @@ def _index_functions(spec: SceneSpec, functions: tuple[Function, ...], params: l
         return []
     by_name = {f.name: f for f in functions}
     names = [r.name for r in regimes(spec)]
-    out = [_index_function_code("rhs_index", "r", [(n, by_name[f"rhs_{n}"]) for n in names],
-                                "Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> "
-                                "by index.", "alpha_ddot", params)]
+    out = [("rhs_index", "r", [(n, by_name[f"rhs_{n}"]) for n in names],
+            "Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.", "alpha_ddot")]
     if spec.flags:
         surfaces = [(f"{flag}: {FLAG_SURFACES[flag][0]}", by_name[FLAG_SURFACES[flag][0]]) for flag in spec.flags]
-        out.append(_index_function_code("surface_index", "k", surfaces,
-                                        "Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate "
-                                        "or slip by index.", "surface", params))
+        out.append(("surface_index", "k", surfaces,
+                    "Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate or slip by index.", "surface"))
     if "gap_rate" in by_name:
         aux = [("psi_i_dot", by_name["gap_rate"])] + _single_outputs(by_name.get("slip_partials"))
-        out.append(_index_function_code("aux_index", "j", aux,
-                                        "Auxiliary scalars of the hybrid loop by index: the gap rate and, "
-                                        "with Coulomb friction, the partials of v_r.", "auxiliary", params))
+        out.append(("aux_index", "j", aux, "Auxiliary scalars of the hybrid loop by index: the gap rate and, "
+                    "with Coulomb friction, the partials of v_r.", "auxiliary"))
     flows = [pair for n in names for pair in _single_outputs(by_name[f"out_{n}"], OUTPUTS[10:13], f"{n}: ")]
-    out.append(_index_function_code("power_index", "c", flows,
-                                    "Power flows of the energy ledger by index: P_in (cam drive), D_c "
-                                    "(contact damping), D_f (friction) of each regime.", "power", params))
+    out.append(("power_index", "c", flows, "Power flows of the energy ledger by index: P_in (cam drive), D_c "
+                "(contact damping), D_f (friction) of each regime.", "power"))
     return out
 
 
@@ -210,9 +199,10 @@ def _single_outputs(f: Function | None, outputs: tuple[str, ...] | None = None,
             for o in wanted]
 
 
-def _pack_code(params: list[str]) -> tuple[str, list[str]]:
+def _pack_code(params: list[str], constants: dict[sp.Symbol, sp.Expr]) -> tuple[str, list[str]]:
+    derived = {**laws.CONSTANTS, **constants}
     inputs = [n for n in PARAM_ORDER if n in params and n not in {s.name for s in laws.CONSTANTS}]
-    for sym, definition in laws.CONSTANTS.items():
+    for sym, definition in derived.items():
         if sym.name in params:
             inputs += [n for n in _param_names([definition]) if n not in inputs]
     inputs = [n for n in PARAM_ORDER if n in inputs]
@@ -220,10 +210,11 @@ def _pack_code(params: list[str]) -> tuple[str, list[str]]:
     lines = ["def pack(values):",
              '    """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.',
              "",
-             "    Computes the laws' constants (Y_e, Eq. 14) once, here, not in every kernel call.",
+             "    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only",
+             "    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.",
              '    """']
     lines += [f"    {n} = float(values[{n!r}])" for n in inputs]
-    for sym, definition in laws.CONSTANTS.items():
+    for sym, definition in derived.items():
         if sym.name in params:
             lines.append(f"    {sym.name} = {printer.doprint(definition)}")
     lines.append(f"    return numpy.array([{', '.join(params)}], dtype=float)")
@@ -234,7 +225,7 @@ def module_source(spec: SceneSpec) -> str:
     """The complete text of a scene's generated module."""
     mod = _Module(spec, build(spec))
     params = mod.params
-    pack, inputs = _pack_code(params)
+    pack, inputs = _pack_code(params, mod.constants)
     regime_table = {r.key: r.name for r in regimes(spec)}
     flags = spec.flags
     header = [
@@ -263,14 +254,16 @@ def module_source(spec: SceneSpec) -> str:
         f"SLUG = {spec.slug!r}",
         "PARAMS = " + repr(tuple(params)),
         "INPUTS = " + repr(tuple(inputs)),
-        "UNITS = " + repr({n: UNITS[n] for n in params + [i for i in inputs if i not in params]}),
+        "UNITS = " + repr({n: UNITS.get(n, "1" if _is_constant(n) else None)
+                           for n in params + [i for i in inputs if i not in params]}),
         "FLAGS = " + repr(flags),
         "FLAG_SURFACES = " + repr({f: FLAG_SURFACES[f] for f in flags}),
         "REGIMES = " + repr(regime_table),
         "OUTPUTS = " + repr(OUTPUTS),
         "REGIME_NAMES = " + repr(tuple(regime_table.values())),
     ]
-    body = [_function_code(f, params) for f in mod.functions] + _index_functions(spec, mod.functions, params)
+    body = [_function_code(f, params) for f in mod.functions]
+    body += [_index_function_code(*family, params) for family in mod.families]
     imports = ["from math import *  # noqa: F401,F403  (sin, cos, sqrt, ... on floats)", "", "import numpy"]
     parts = ["\n".join(header), "\n".join(doc), "\n".join(imports), "\n".join(data), pack] + body
     return "\n\n\n".join(parts[:3]) + "\n\n" + parts[3] + "\n\n\n" + "\n\n\n".join(parts[4:]) + "\n"

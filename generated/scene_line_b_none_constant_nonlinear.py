@@ -25,9 +25,9 @@ import numpy
 
 SCENE = {'contact': 'line', 'damping': 'B', 'friction': 'none', 'motion': 'constant', 'model': 'nonlinear', 'sliding_velocity': 'kinematic', 'damping_sign': 'dissipative'}
 SLUG = 'line_b_none_constant_nonlinear'
-PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'beta_B', 'Y_e', 'Omega_c')
+PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'beta_B', 'Y_e', 'Omega_c', 'cos_alpha0', 'cos_alpha0_p_theta0', 'cos_theta0', 'sin_alpha0', 'sin_alpha0_p_theta0', 'sin_theta0')
 INPUTS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_c', 'Y_b', 'nu_c', 'nu_b', 'l_lambda', 'beta_B', 'Omega_c')
-UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'beta_B': 's/m', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
+UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'beta_B': 's/m', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'cos_alpha0': '1', 'cos_alpha0_p_theta0': '1', 'cos_theta0': '1', 'sin_alpha0': '1', 'sin_alpha0_p_theta0': '1', 'sin_theta0': '1', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
 FLAGS = ('contact',)
 FLAG_SURFACES = {'contact': ('gap', -1)}
 REGIMES = {(False,): 'free', (True,): 'contact'}
@@ -38,7 +38,8 @@ REGIME_NAMES = ('free', 'contact')
 def pack(values):
     """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.
 
-    Computes the laws' constants (Y_e, Eq. 14) once, here, not in every kernel call.
+    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only
+    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.
     """
     r_c = float(values['r_c'])
     e = float(values['e'])
@@ -59,7 +60,13 @@ def pack(values):
     beta_B = float(values['beta_B'])
     Omega_c = float(values['Omega_c'])
     Y_e = 1/((1 - nu_c**2)/Y_c + (1 - nu_b**2)/Y_b)
-    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, beta_B, Y_e, Omega_c], dtype=float)
+    cos_alpha0 = cos(alpha0)
+    cos_alpha0_p_theta0 = cos(alpha0 + theta0)
+    cos_theta0 = cos(theta0)
+    sin_alpha0 = sin(alpha0)
+    sin_alpha0_p_theta0 = sin(alpha0 + theta0)
+    sin_theta0 = sin(theta0)
+    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, beta_B, Y_e, Omega_c, cos_alpha0, cos_alpha0_p_theta0, cos_theta0, sin_alpha0, sin_alpha0_p_theta0, sin_theta0], dtype=float)
 
 
 def cam(t, p):
@@ -165,39 +172,49 @@ def out_free(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = cos(x6)
-    x8 = sin(x5)
-    x9 = 2*e*x8
-    x10 = cos(x1)
-    x11 = 2*x3
-    x12 = sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = cos(alpha)
-    x18 = 1/x17
-    x19 = x18*sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = 1/x23
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18, chi0*x8 + x15*x20 - x18*x21, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7, k_s*(L_us + d_x*x25 - d_y - x19*x24), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)), 0, asin(x20/sqrt(x28**2 + x29**2)) - atan2(x28, x29), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x23) - x19*log(x24 + x25)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -228,40 +245,50 @@ def out_free_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = numpy.cos(x6)
-    x8 = numpy.sin(x5)
-    x9 = 2*e*x8
-    x10 = numpy.cos(x1)
-    x11 = 2*x3
-    x12 = numpy.sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = numpy.cos(alpha)
-    x18 = x17**(-1.0)
-    x19 = x18*numpy.sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = x23**(-1.0)
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18 + _zero, chi0*x8 + x15*x20 - x18*x21 + _zero, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7 + _zero, k_s*(L_us + d_x*x25 - d_y - x19*x24) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)) + _zero, 0 + _zero, numpy.arcsin(x20/numpy.sqrt(x28**2 + x29**2)) - numpy.arctan2(x28, x29) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x23) - x19*numpy.log(x24 + x25)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact(t, alpha, alpha_dot, p):
@@ -280,7 +307,6 @@ def rhs_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -290,24 +316,36 @@ def rhs_contact(t, alpha, alpha_dot, p):
     beta_B = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = 2*x4
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = alpha + theta0 + x7
-    x10 = sin(x9)
-    x11 = cos(x2)
-    x12 = x11*x3
-    x13 = 2*r_c + w_b
-    x14 = e*cos(x9)
-    x15 = -2*chi0*x11*x3 + x13*x4 + 2*x14*x8
-    x16 = (1/4)*pi*Y_e*l_lambda
-    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (beta_B*x16*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6))*abs(x15) - x15*x16)*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = x3 - 1
+    x5 = -x4
+    x6 = cos(x0)
+    x7 = x1*x6
+    x8 = 2*x7
+    x9 = 1/(cos_alpha0*x5 - sin_alpha0*x8)
+    x10 = (1/2)*w_b
+    x11 = (1/2)*Omega_c
+    x12 = t*x11
+    x13 = sin(x12)
+    x14 = cos(x12)
+    x15 = x14*x8
+    x16 = x13*x5 + x15
+    x17 = 2*x13
+    x18 = x17*x7
+    x19 = x14*x5 - x18
+    x20 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x19
+    x21 = 2*r_c + w_b
+    x22 = x2*x21
+    x23 = e*(cos_alpha0_p_theta0*x19 - sin_alpha0_p_theta0*x16)
+    x24 = (1/4)*pi*Y_e*l_lambda
+    return (-d_x*k_s*(L_us + d_x*x9*(cos_alpha0*x8 + sin_alpha0*x5) - d_y - x10*x9) - (beta_B*x24*(-Omega_c*x14*x23 + alpha_dot*chi0*x5 - alpha_dot*x21*x7 + 2*e*x13*x20*(alpha_dot + x11))*abs(chi0*x8 + e*x17*(cos_alpha0_p_theta0*(x14*x4 + x18) - sin_alpha0_p_theta0*(x13*x4 - x15)) - x22) + x24*(2*chi0*x1*x6 - x17*x23 - x22))*(-chi0*x3 + chi0 + 2*e*x13*x20 - x8*(r_c + x10)))/I_Pb
 
 
 def jac_contact(t, alpha, alpha_dot, p):
@@ -327,7 +365,6 @@ def jac_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
@@ -335,45 +372,54 @@ def jac_contact(t, alpha, alpha_dot, p):
     beta_B = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
     x0 = 1/I_Pb
-    x1 = cos(alpha)**(-2)
-    x2 = sin(alpha)
-    x3 = (1/2)*w_b
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
-    x7 = e*cos(x6)
-    x8 = sin(x5)
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = 2*x3
+    x5 = x4 - 1
+    x6 = -x5
+    x7 = cos(x1)
+    x8 = x2*x7
     x9 = 2*x8
-    x10 = x7*x9
-    x11 = (1/2)*alpha - 1/2*alpha0
-    x12 = cos(x11)
-    x13 = sin(x11)
-    x14 = x12*x13
-    x15 = 2*x14
-    x16 = chi0*x15
-    x17 = r_c + x3
-    x18 = x13**2
-    x19 = 2*x18
-    x20 = 1 - x19
-    x21 = 2*r_c + w_b
-    x22 = x18*x21
-    x23 = x10 - x16 + x22
-    x24 = (1/4)*pi*Y_e*l_lambda
-    x25 = Omega_c*cos(x5)
-    x26 = alpha_dot + x4
-    x27 = sin(x6)
-    x28 = x14*x21
-    x29 = alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7
-    x30 = beta_B*abs(x23)
-    x31 = x24*x30
-    x32 = e*x27
-    x33 = x32*x9
-    x34 = -chi0*x19 + chi0 - x15*x17 + x33
-    x35 = chi0*x20 - x28 + x33
-    x36 = x24*x35
-    x37 = (1/2)*alpha_dot
-    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - x34*(-beta_B*x24*x29*x35*(0.0 if x23 == 0 else copysign(1, x23)) + x31*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x37 + x22*x37 + x25*x32) + x36) - (-x23*x24 + x29*x31)*(x10 - x16 - x17*x20)), -x0*x30*x34*x36)
+    x10 = (cos_alpha0*x6 - sin_alpha0*x9)**(-2)
+    x11 = cos_alpha0*x9 + sin_alpha0*x6
+    x12 = (1/2)*w_b
+    x13 = chi0*x9
+    x14 = r_c + x12
+    x15 = (1/2)*Omega_c
+    x16 = t*x15
+    x17 = cos(x16)
+    x18 = sin(x16)
+    x19 = x18*x9
+    x20 = x17*x6 - x19
+    x21 = x17*x9
+    x22 = x18*x6 + x21
+    x23 = e*(cos_alpha0_p_theta0*x20 - sin_alpha0_p_theta0*x22)
+    x24 = 2*x18
+    x25 = x23*x24
+    x26 = 2*r_c + w_b
+    x27 = x26*x3
+    x28 = -x13 + x25 + x27
+    x29 = (1/4)*pi*Y_e*l_lambda
+    x30 = x26*x8
+    x31 = Omega_c*x17
+    x32 = alpha_dot + x15
+    x33 = cos_alpha0_p_theta0*x22 + sin_alpha0_p_theta0*x20
+    x34 = alpha_dot*chi0*x6 - alpha_dot*x30 + 2*e*x18*x32*x33 - x23*x31
+    x35 = e*x24
+    x36 = beta_B*abs(x13 - x27 + x35*(cos_alpha0_p_theta0*(x17*x5 + x19) - sin_alpha0_p_theta0*(x18*x5 - x21)))
+    x37 = x29*x36
+    x38 = x33*x35
+    x39 = -chi0*x4 + chi0 - x14*x9 + x38
+    x40 = chi0*x6 - x30 + x38
+    x41 = x29*x40
+    x42 = (1/2)*alpha_dot
+    return (x0*(-d_x*k_s*(d_x*(x10*x11**2 + 1) - x10*x11*x12) - x39*(-beta_B*x29*x34*x40*(0.0 if x28 == 0 else copysign(1, x28)) + x37*(-alpha_dot*x13 + e*x31*x33 + x25*x32 - x26*x42*x7**2 + x27*x42) + x41) - (-x28*x29 + x34*x37)*(-x13 - x14*x6 + x25)), -x0*x36*x39*x41)
 
 
 def out_contact(t, alpha, alpha_dot, p):
@@ -404,7 +450,6 @@ def out_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -414,55 +459,67 @@ def out_contact(t, alpha, alpha_dot, p):
     beta_B = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = cos(x8)
-    x10 = 2*x9
-    x11 = cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = cos(alpha)
-    x29 = 1/x28
-    x30 = sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_B*x35*abs(x12)
-    x37 = x13*x35 + x27*x36
-    x38 = Omega_c*t + theta0
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x38) + x18*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x38) + x18*x39
-    x43 = x29 + x31
-    x44 = d_x*k_s
-    x45 = (1/8)*x34
-    x46 = x28**(-2)
-    x47 = x27**2*x36
-    return (x13, x21, x27, x33, -x37, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x38), -x30*x37, asin(x18/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x43)), alpha_dot*(-d_x*x33 - x37*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x46 + alpha_dot*(x30**2*x46 + 1))/x43) + x47, x47, 0)
+    x4 = x0*x3
+    x5 = cos(x1)
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = cos(x7)
+    x9 = 2*x3
+    x10 = x9 - 1
+    x11 = -x10
+    x12 = x11*x8
+    x13 = sin(x7)
+    x14 = 2*x13
+    x15 = x2*x5
+    x16 = x14*x15
+    x17 = x12 - x16
+    x18 = 2*x15
+    x19 = x18*x8
+    x20 = x11*x13 + x19
+    x21 = cos_alpha0_p_theta0*x17 - sin_alpha0_p_theta0*x20
+    x22 = e*x14
+    x23 = -2*chi0*x2*x5 + x21*x22 + x4
+    x24 = -x23
+    x25 = (1/2)*w_b
+    x26 = r_c + x25
+    x27 = cos_alpha0_p_theta0*x20 + sin_alpha0_p_theta0*x17
+    x28 = chi0*x9 + x18*x26 - x22*x27
+    x29 = alpha_dot*x0
+    x30 = Omega_c*e
+    x31 = x21*x30*x8
+    x32 = alpha_dot + x6
+    x33 = alpha_dot*chi0*x11 + 2*e*x13*x27*x32 - x15*x29 - x31
+    x34 = cos_alpha0*x11 - sin_alpha0*x18
+    x35 = 1/x34
+    x36 = cos_alpha0*x18 + sin_alpha0*x11
+    x37 = x35*x36
+    x38 = d_x*x37
+    x39 = k_s*(L_us - d_y - x25*x35 + x38)
+    x40 = pi*Y_e*l_lambda
+    x41 = (1/4)*x40
+    x42 = beta_B*x41*abs(chi0*x18 + x22*(cos_alpha0_p_theta0*(x10*x8 + x16) - sin_alpha0_p_theta0*(x10*x13 - x19)) - x4)
+    x43 = x24*x41 + x33*x42
+    x44 = 1 - 2*x13**2
+    x45 = 4*x13
+    x46 = x14*x8
+    x47 = -chi0*sin_alpha0 + cos_alpha0*x26 + e*sin_theta0 - e*(cos_theta0*x46 + sin_theta0*x44)
+    x48 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x44 - sin_theta0*x46) + sin_alpha0*x26
+    x49 = (1/8)*x40
+    x50 = x35 + x37
+    x51 = d_x*k_s
+    x52 = x34**(-2)
+    x53 = x33**2*x42
+    return (x24, x28, x33, x39, -x43, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x30*(cos_alpha0_p_theta0*(x12*x14 + x18*x44) + sin_alpha0_p_theta0*(x11*x44 - x15*x45*x8)), -x36*x43, asin(x26/sqrt(x47**2 + x48**2)) - atan2(x47, x48), (1/2)*I_Pb*alpha_dot**2 + x23**2*x49 + x51*(L_us*alpha - alpha*d_y - d_x*log(x34) - x25*log(x50)), alpha_dot*(-d_x*x39 - x43*(chi0 - x28)) + x23*x49*(-2*alpha_dot*chi0*x11 - e*x27*x32*x45 + x18*x29 + 2*x31) + x51*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x38 - x25*(alpha_dot*x36*x52 + alpha_dot*(x36**2*x52 + 1))/x50) + x53, x53, 0)
 
 
 def out_contact_v(t, alpha, alpha_dot, p):
@@ -493,7 +550,6 @@ def out_contact_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -503,56 +559,68 @@ def out_contact_v(t, alpha, alpha_dot, p):
     beta_B = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = numpy.sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = numpy.cos(x8)
-    x10 = 2*x9
-    x11 = numpy.cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = numpy.sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*numpy.cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = numpy.cos(alpha)
-    x29 = x28**(-1.0)
-    x30 = numpy.sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = (1/4)*x34
-    x36 = beta_B*x35*abs(x12)
-    x37 = x13*x35 + x27*x36
-    x38 = Omega_c*t + theta0
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x38) + x18*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x38) + x18*x39
-    x43 = x29 + x31
-    x44 = d_x*k_s
-    x45 = (1/8)*x34
-    x46 = x28**(-2.0)
-    x47 = x27**2*x36
+    x4 = x0*x3
+    x5 = numpy.cos(x1)
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = numpy.cos(x7)
+    x9 = 2*x3
+    x10 = x9 - 1
+    x11 = -x10
+    x12 = x11*x8
+    x13 = numpy.sin(x7)
+    x14 = 2*x13
+    x15 = x2*x5
+    x16 = x14*x15
+    x17 = x12 - x16
+    x18 = 2*x15
+    x19 = x18*x8
+    x20 = x11*x13 + x19
+    x21 = cos_alpha0_p_theta0*x17 - sin_alpha0_p_theta0*x20
+    x22 = e*x14
+    x23 = -2*chi0*x2*x5 + x21*x22 + x4
+    x24 = -x23
+    x25 = (1/2)*w_b
+    x26 = r_c + x25
+    x27 = cos_alpha0_p_theta0*x20 + sin_alpha0_p_theta0*x17
+    x28 = chi0*x9 + x18*x26 - x22*x27
+    x29 = alpha_dot*x0
+    x30 = Omega_c*e
+    x31 = x21*x30*x8
+    x32 = alpha_dot + x6
+    x33 = alpha_dot*chi0*x11 + 2*e*x13*x27*x32 - x15*x29 - x31
+    x34 = cos_alpha0*x11 - sin_alpha0*x18
+    x35 = x34**(-1.0)
+    x36 = cos_alpha0*x18 + sin_alpha0*x11
+    x37 = x35*x36
+    x38 = d_x*x37
+    x39 = k_s*(L_us - d_y - x25*x35 + x38)
+    x40 = numpy.pi*Y_e*l_lambda
+    x41 = (1/4)*x40
+    x42 = beta_B*x41*abs(chi0*x18 + x22*(cos_alpha0_p_theta0*(x10*x8 + x16) - sin_alpha0_p_theta0*(x10*x13 - x19)) - x4)
+    x43 = x24*x41 + x33*x42
+    x44 = 1 - 2*x13**2
+    x45 = 4*x13
+    x46 = x14*x8
+    x47 = -chi0*sin_alpha0 + cos_alpha0*x26 + e*sin_theta0 - e*(cos_theta0*x46 + sin_theta0*x44)
+    x48 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x44 - sin_theta0*x46) + sin_alpha0*x26
+    x49 = (1/8)*x40
+    x50 = x35 + x37
+    x51 = d_x*k_s
+    x52 = x34**(-2.0)
+    x53 = x33**2*x42
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, -x37 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x38) + _zero, -x30*x37 + _zero, numpy.arcsin(x18/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x33 - x37*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x46 + alpha_dot*(x30**2*x46 + 1))/x43) + x47 + _zero, x47 + _zero, 0 + _zero)
+    return (x24 + _zero, x28 + _zero, x33 + _zero, x39 + _zero, -x43 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x30*(cos_alpha0_p_theta0*(x12*x14 + x18*x44) + sin_alpha0_p_theta0*(x11*x44 - x15*x45*x8)) + _zero, -x36*x43 + _zero, numpy.arcsin(x26/numpy.sqrt(x47**2 + x48**2)) - numpy.arctan2(x47, x48) + _zero, (1/2)*I_Pb*alpha_dot**2 + x23**2*x49 + x51*(L_us*alpha - alpha*d_y - d_x*numpy.log(x34) - x25*numpy.log(x50)) + _zero, alpha_dot*(-d_x*x39 - x43*(chi0 - x28)) + x23*x49*(-2*alpha_dot*chi0*x11 - e*x27*x32*x45 + x18*x29 + 2*x31) + x51*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x38 - x25*(alpha_dot*x36*x52 + alpha_dot*(x36**2*x52 + 1))/x50) + x53 + _zero, x53 + _zero, 0 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -571,12 +639,20 @@ def gap(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[14]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0_p_theta0 = p[19]
     x0 = (1/2)*alpha - 1/2*alpha0
     x1 = sin(x0)
-    x2 = (1/2)*Omega_c*t
-    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+    x2 = x1**2
+    x3 = cos(x0)
+    x4 = (1/2)*Omega_c*t
+    x5 = cos(x4)
+    x6 = 1 - 2*x2
+    x7 = sin(x4)
+    x8 = 2*x7
+    x9 = x1*x3
+    return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -595,14 +671,20 @@ def gap_rate(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[14]
-    x0 = (1/2)*Omega_c
-    x1 = t*x0
-    x2 = alpha + theta0 + x1
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = 1 - 2*x1**2
+    x3 = x1*cos(x0)
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = cos(x5)
+    x7 = sin(x5)
+    x8 = x2*x6 - 2*x3*x7
+    x9 = x2*x7 + 2*x3*x6
+    return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
 
 
 def static_moment(alpha, p):
@@ -628,27 +710,29 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[13]
-    x0 = cos(alpha)
-    x1 = 1/x0
-    x2 = (1/2)*w_b
-    x3 = sin(alpha)
-    x4 = d_x*k_s
-    x5 = 2*r_c + w_b
-    x6 = (1/2)*alpha - 1/2*alpha0
-    x7 = sin(x6)
-    x8 = x7**2
-    x9 = x7*cos(x6)
-    x10 = 2*x9
-    x11 = chi0*x10
-    x12 = x11 - x5*x8
-    x13 = 2*x8
-    x14 = r_c + x2
-    x15 = chi0*x13 + x10*x14
-    x16 = (1/4)*pi*Y_e*l_lambda
-    x17 = x16*(chi0 - x15)
-    x18 = x0**(-2)
-    x19 = 1 - x13
-    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
+    cos_alpha0 = p[15]
+    sin_alpha0 = p[18]
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = x2*cos(x1)
+    x5 = 2*x4
+    x6 = chi0*x5
+    x7 = -x0*x3 + x6
+    x8 = 2*x3
+    x9 = (1/2)*w_b
+    x10 = r_c + x9
+    x11 = chi0*x8 + x10*x5
+    x12 = (1/4)*pi*Y_e*l_lambda
+    x13 = x12*(chi0 - x11)
+    x14 = 1 - x8
+    x15 = cos_alpha0*x14 - sin_alpha0*x5
+    x16 = 1/x15
+    x17 = cos_alpha0*x5 + sin_alpha0*x14
+    x18 = d_x*k_s
+    x19 = x15**(-2)
+    return (-x13*x7 - x18*(L_us + d_x*x16*x17 - d_y - x16*x9), -x12*x7*(-x10*x14 - x6) - x13*(chi0*x14 - x0*x4) - x18*(d_x*(x17**2*x19 + 1) - x17*x19*x9), x7, x11, x12)
 
 
 def reach(Theta, p):
@@ -664,12 +748,12 @@ def reach(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
-    x0 = cos(alpha0)
-    x1 = sin(alpha0)
-    x2 = r_c + (1/2)*w_b
-    return -x2 + sqrt((chi0*x0 - e*cos(Theta) + e*cos(theta0) + x1*x2)**2 + (-chi0*x1 - e*sin(Theta) + e*sin(theta0) + x0*x2)**2)
+    cos_alpha0 = p[15]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_theta0 = p[20]
+    x0 = r_c + (1/2)*w_b
+    return -x0 + sqrt((chi0*cos_alpha0 + cos_theta0*e - e*cos(Theta) + sin_alpha0*x0)**2 + (-chi0*sin_alpha0 + cos_alpha0*x0 + e*sin_theta0 - e*sin(Theta))**2)
 
 
 def rigid_contact(Theta, p):
@@ -688,39 +772,38 @@ def rigid_contact(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = sin(alpha0)
-    x1 = sin(Theta)
-    x2 = e*x1
-    x3 = cos(alpha0)
-    x4 = (1/2)*w_b
-    x5 = r_c + x4
-    x6 = chi0*x0 - e*sin(theta0) + x2 - x3*x5
-    x7 = -x6
-    x8 = cos(Theta)
-    x9 = e*x8
-    x10 = chi0*x3 + e*cos(theta0) + x0*x5 - x9
-    x11 = x10**2 + x7**2
-    x12 = asin(x5/sqrt(x11)) - atan2(x7, x10)
-    x13 = 1/x11
-    x14 = x10*x9
-    x15 = x13*x6
-    x16 = x7*x9
-    x17 = x10*x2
-    x18 = x16 - x17
-    x19 = -x13*x5**2 + 1
-    x20 = 1/sqrt(x19)
-    x21 = x20*x5/x11**(3/2)
-    x22 = 2*x16 - 2*x17
-    x23 = x22/x11**2
-    x24 = e**2
-    x25 = 1/cos(x12)
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
+    cos_alpha0 = p[15]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_theta0 = p[20]
+    x0 = sin(Theta)
+    x1 = e*x0
+    x2 = (1/2)*w_b
+    x3 = r_c + x2
+    x4 = chi0*sin_alpha0 - cos_alpha0*x3 - e*sin_theta0 + x1
+    x5 = -x4
+    x6 = cos(Theta)
+    x7 = e*x6
+    x8 = chi0*cos_alpha0 + cos_theta0*e + sin_alpha0*x3 - x7
+    x9 = x5**2 + x8**2
+    x10 = asin(x3/sqrt(x9)) - atan2(x5, x8)
+    x11 = 1/x9
+    x12 = x7*x8
+    x13 = x11*x4
+    x14 = x1*x8
+    x15 = e*x5*x6 - x14
+    x16 = -x11*x3**2 + 1
+    x17 = 1/sqrt(x16)
+    x18 = x17*x3/x9**(3/2)
+    x19 = 2*e*x5*x6 - 2*x14
+    x20 = x19/x9**2
+    x21 = e**2
+    x22 = 1/cos(x10)
+    return (x10, -x1*x13 + x11*x12 + x15*x18, -x1*x20*x4 - x11*x14 + x12*x20 - x13*x7 + x15*x17*x3*(3*e*x5*x6 - 3*x14)/x9**(5/2) + (1/2)*x15*x19*x3**3/(x16**(3/2)*x9**(7/2)) + x18*(-x0**2*x21 - x1*x5 - x12 - x21*x6**2), d_x*k_s*(L_us + d_x*x22*sin(x10) - d_y - x2*x22))
 
 
 def spring_potential(alpha, p):
@@ -775,7 +858,6 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -785,24 +867,36 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_B = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = 2*x4
-        x6 = (1/2)*Omega_c
-        x7 = t*x6
-        x8 = sin(x7)
-        x9 = alpha + theta0 + x7
-        x10 = sin(x9)
-        x11 = cos(x2)
-        x12 = x11*x3
-        x13 = 2*r_c + w_b
-        x14 = e*cos(x9)
-        x15 = -2*chi0*x11*x3 + x13*x4 + 2*x14*x8
-        x16 = (1/4)*pi*Y_e*l_lambda
-        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (beta_B*x16*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6))*abs(x15) - x15*x16)*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = x3 - 1
+        x5 = -x4
+        x6 = cos(x0)
+        x7 = x1*x6
+        x8 = 2*x7
+        x9 = 1/(cos_alpha0*x5 - sin_alpha0*x8)
+        x10 = (1/2)*w_b
+        x11 = (1/2)*Omega_c
+        x12 = t*x11
+        x13 = sin(x12)
+        x14 = cos(x12)
+        x15 = x14*x8
+        x16 = x13*x5 + x15
+        x17 = 2*x13
+        x18 = x17*x7
+        x19 = x14*x5 - x18
+        x20 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x19
+        x21 = 2*r_c + w_b
+        x22 = x2*x21
+        x23 = e*(cos_alpha0_p_theta0*x19 - sin_alpha0_p_theta0*x16)
+        x24 = (1/4)*pi*Y_e*l_lambda
+        return (-d_x*k_s*(L_us + d_x*x9*(cos_alpha0*x8 + sin_alpha0*x5) - d_y - x10*x9) - (beta_B*x24*(-Omega_c*x14*x23 + alpha_dot*chi0*x5 - alpha_dot*x21*x7 + 2*e*x13*x20*(alpha_dot + x11))*abs(chi0*x8 + e*x17*(cos_alpha0_p_theta0*(x14*x4 + x18) - sin_alpha0_p_theta0*(x13*x4 - x15)) - x22) + x24*(2*chi0*x1*x6 - x17*x23 - x22))*(-chi0*x3 + chi0 + 2*e*x13*x20 - x8*(r_c + x10)))/I_Pb
     return nan
 
 
@@ -826,12 +920,20 @@ def surface_index(k, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[14]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
         x0 = (1/2)*alpha - 1/2*alpha0
         x1 = sin(x0)
-        x2 = (1/2)*Omega_c*t
-        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+        x2 = x1**2
+        x3 = cos(x0)
+        x4 = (1/2)*Omega_c*t
+        x5 = cos(x4)
+        x6 = 1 - 2*x2
+        x7 = sin(x4)
+        x8 = 2*x7
+        x9 = x1*x3
+        return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
     return nan
 
 
@@ -855,14 +957,20 @@ def aux_index(j, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[14]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
     return nan
 
 
@@ -897,7 +1005,6 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -906,60 +1013,79 @@ def power_index(c, t, alpha, alpha_dot, p):
         beta_B = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = 2*r_c + w_b
-        x9 = (1/2)*alpha - 1/2*alpha0
-        x10 = sin(x9)
-        x11 = x10**2
-        x12 = (1/2)*Omega_c
-        x13 = t*x12
-        x14 = alpha + theta0 + x13
-        x15 = e*cos(x14)
-        x16 = sin(x13)
-        x17 = cos(x9)
-        x18 = -2*chi0*x10*x17 + x11*x8 + 2*x15*x16
-        x19 = Omega_c*x15*cos(x13)
-        x20 = 2*x11
-        x21 = 1 - x20
-        x22 = alpha_dot + x12
-        x23 = sin(x14)
-        x24 = x10*x17
-        x25 = 2*x24
-        x26 = alpha_dot*x8
-        x27 = pi*Y_e*l_lambda
-        x28 = alpha_dot*chi0*x21 + 2*e*x16*x22*x23 - x19 - x24*x26
-        x29 = (1/4)*x27
-        x30 = beta_B*x29*abs(x18)
-        return alpha_dot*(-x7*(L_us - d_y - x2*x6 + x4) - (-x18*x29 + x28*x30)*(-chi0*x20 + chi0 + 2*e*x16*x23 - x25*(r_c + x6))) + (1/8)*x18*x27*(-2*alpha_dot*chi0*x21 - 4*e*x16*x22*x23 + 2*x19 + x25*x26) + x28**2*x30 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = x3 - 1
+        x5 = -x4
+        x6 = cos(x0)
+        x7 = x1*x6
+        x8 = 2*x7
+        x9 = cos_alpha0*x8 + sin_alpha0*x5
+        x10 = cos_alpha0*x5 - sin_alpha0*x8
+        x11 = 1/x10
+        x12 = x11*x9
+        x13 = d_x*x12
+        x14 = x10**(-2)
+        x15 = (1/2)*w_b
+        x16 = d_x*k_s
+        x17 = 2*r_c + w_b
+        x18 = x17*x2
+        x19 = (1/2)*Omega_c
+        x20 = t*x19
+        x21 = sin(x20)
+        x22 = 2*x21
+        x23 = cos(x20)
+        x24 = x22*x7
+        x25 = x23*x5 - x24
+        x26 = x23*x8
+        x27 = x21*x5 + x26
+        x28 = e*(cos_alpha0_p_theta0*x25 - sin_alpha0_p_theta0*x27)
+        x29 = -2*chi0*x1*x6 + x18 + x22*x28
+        x30 = alpha_dot*x17
+        x31 = Omega_c*x23*x28
+        x32 = alpha_dot + x19
+        x33 = cos_alpha0_p_theta0*x27 + sin_alpha0_p_theta0*x25
+        x34 = pi*Y_e*l_lambda
+        x35 = alpha_dot*chi0*x5 + 2*e*x21*x32*x33 - x30*x7 - x31
+        x36 = (1/4)*x34
+        x37 = beta_B*x36*abs(chi0*x8 + e*x22*(cos_alpha0_p_theta0*(x23*x4 + x24) - sin_alpha0_p_theta0*(x21*x4 - x26)) - x18)
+        return alpha_dot*(-x16*(L_us - d_y - x11*x15 + x13) - (-x29*x36 + x35*x37)*(-chi0*x3 + chi0 + 2*e*x21*x33 - x8*(r_c + x15))) + x16*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x13 - x15*(alpha_dot*x14*x9 + alpha_dot*(x14*x9**2 + 1))/(x11 + x12)) + (1/8)*x29*x34*(-2*alpha_dot*chi0*x5 - 4*e*x21*x32*x33 + x30*x8 + 2*x31) + x35**2*x37
     elif c == 4:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         l_lambda = p[11]
         beta_B = p[12]
         Y_e = p[13]
         Omega_c = p[14]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
         x0 = 2*r_c + w_b
         x1 = (1/2)*alpha - 1/2*alpha0
         x2 = sin(x1)
         x3 = x2**2
-        x4 = (1/2)*Omega_c
-        x5 = t*x4
-        x6 = alpha + theta0 + x5
-        x7 = e*cos(x6)
-        x8 = sin(x5)
-        x9 = x2*cos(x1)
-        return (1/4)*pi*Y_e*beta_B*l_lambda*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2*abs(-2*chi0*x9 + x0*x3 + 2*x7*x8)
+        x4 = x2*cos(x1)
+        x5 = 2*x4
+        x6 = (1/2)*Omega_c
+        x7 = t*x6
+        x8 = cos(x7)
+        x9 = 2*x3 - 1
+        x10 = sin(x7)
+        x11 = 2*x10
+        x12 = x11*x4
+        x13 = x5*x8
+        x14 = -x9
+        x15 = -x12 + x14*x8
+        x16 = x10*x14 + x13
+        return (1/4)*pi*Y_e*beta_B*l_lambda*(-Omega_c*e*x8*(cos_alpha0_p_theta0*x15 - sin_alpha0_p_theta0*x16) + alpha_dot*chi0*x14 - alpha_dot*x0*x4 + 2*e*x10*(alpha_dot + x6)*(cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x15))**2*abs(chi0*x5 + e*x11*(cos_alpha0_p_theta0*(x12 + x8*x9) - sin_alpha0_p_theta0*(x10*x9 - x13)) - x0*x3)
     elif c == 5:
         return 0
     return nan

@@ -25,9 +25,9 @@ import numpy
 
 SCENE = {'contact': 'line', 'damping': 'D', 'friction': 'none', 'motion': 'constant', 'model': 'nonlinear', 'sliding_velocity': 'kinematic', 'damping_sign': 'printed'}
 SLUG = 'line_d_none_constant_nonlinear_printedsign'
-PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'zeta_D', 'beta_D', 'Y_e', 'chi_star', 'vartheta', 'Omega_c')
+PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'zeta_D', 'beta_D', 'Y_e', 'chi_star', 'vartheta', 'Omega_c', 'cos_alpha0', 'cos_alpha0_p_theta0', 'cos_theta0', 'sin_alpha0', 'sin_alpha0_p_theta0', 'sin_theta0')
 INPUTS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_c', 'Y_b', 'nu_c', 'nu_b', 'l_lambda', 'zeta_D', 'beta_D', 'chi_star', 'vartheta', 'Omega_c')
-UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'zeta_D': '1', 'beta_D': 's/m', 'Y_e': 'Pa', 'chi_star': 'm', 'vartheta': 'rad/s', 'Omega_c': 'rad/s', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
+UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'zeta_D': '1', 'beta_D': 's/m', 'Y_e': 'Pa', 'chi_star': 'm', 'vartheta': 'rad/s', 'Omega_c': 'rad/s', 'cos_alpha0': '1', 'cos_alpha0_p_theta0': '1', 'cos_theta0': '1', 'sin_alpha0': '1', 'sin_alpha0_p_theta0': '1', 'sin_theta0': '1', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
 FLAGS = ('contact', 'loading')
 FLAG_SURFACES = {'contact': ('gap', -1), 'loading': ('gap_rate', -1)}
 REGIMES = {(False, None): 'free', (True, True): 'contact_loading', (True, False): 'contact_unloading'}
@@ -38,7 +38,8 @@ REGIME_NAMES = ('free', 'contact_loading', 'contact_unloading')
 def pack(values):
     """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.
 
-    Computes the laws' constants (Y_e, Eq. 14) once, here, not in every kernel call.
+    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only
+    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.
     """
     r_c = float(values['r_c'])
     e = float(values['e'])
@@ -62,7 +63,13 @@ def pack(values):
     vartheta = float(values['vartheta'])
     Omega_c = float(values['Omega_c'])
     Y_e = 1/((1 - nu_c**2)/Y_c + (1 - nu_b**2)/Y_b)
-    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, zeta_D, beta_D, Y_e, chi_star, vartheta, Omega_c], dtype=float)
+    cos_alpha0 = cos(alpha0)
+    cos_alpha0_p_theta0 = cos(alpha0 + theta0)
+    cos_theta0 = cos(theta0)
+    sin_alpha0 = sin(alpha0)
+    sin_alpha0_p_theta0 = sin(alpha0 + theta0)
+    sin_theta0 = sin(theta0)
+    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, zeta_D, beta_D, Y_e, chi_star, vartheta, Omega_c, cos_alpha0, cos_alpha0_p_theta0, cos_theta0, sin_alpha0, sin_alpha0_p_theta0, sin_theta0], dtype=float)
 
 
 def cam(t, p):
@@ -168,39 +175,49 @@ def out_free(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = cos(x6)
-    x8 = sin(x5)
-    x9 = 2*e*x8
-    x10 = cos(x1)
-    x11 = 2*x3
-    x12 = sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = cos(alpha)
-    x18 = 1/x17
-    x19 = x18*sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = 1/x23
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18, chi0*x8 + x15*x20 - x18*x21, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7, k_s*(L_us + d_x*x25 - d_y - x19*x24), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)), 0, asin(x20/sqrt(x28**2 + x29**2)) - atan2(x28, x29), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x23) - x19*log(x24 + x25)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -231,40 +248,50 @@ def out_free_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = numpy.cos(x6)
-    x8 = numpy.sin(x5)
-    x9 = 2*e*x8
-    x10 = numpy.cos(x1)
-    x11 = 2*x3
-    x12 = numpy.sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = numpy.cos(alpha)
-    x18 = x17**(-1.0)
-    x19 = x18*numpy.sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = x23**(-1.0)
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18 + _zero, chi0*x8 + x15*x20 - x18*x21 + _zero, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7 + _zero, k_s*(L_us + d_x*x25 - d_y - x19*x24) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)) + _zero, 0 + _zero, numpy.arcsin(x20/numpy.sqrt(x28**2 + x29**2)) - numpy.arctan2(x28, x29) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x23) - x19*numpy.log(x24 + x25)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_loading(t, alpha, alpha_dot, p):
@@ -283,7 +310,6 @@ def rhs_contact_loading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -293,23 +319,32 @@ def rhs_contact_loading(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = 2*x4
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = alpha + theta0 + x7
-    x10 = sin(x9)
-    x11 = cos(x2)
-    x12 = x11*x3
-    x13 = 2*r_c + w_b
-    x14 = e*cos(x9)
-    x15 = (1/4)*pi*Y_e*l_lambda*(2*chi0*x11*x3 - x13*x4 - 2*x14*x8)
-    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (beta_D*x15*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6)) + x15)*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = x1*x5
+    x7 = 2*x6
+    x8 = 1/(cos_alpha0*x4 - sin_alpha0*x7)
+    x9 = (1/2)*w_b
+    x10 = (1/2)*Omega_c
+    x11 = t*x10
+    x12 = sin(x11)
+    x13 = cos(x11)
+    x14 = x12*x4 + x13*x7
+    x15 = 2*x12
+    x16 = x13*x4 - x15*x6
+    x17 = cos_alpha0_p_theta0*x14 + sin_alpha0_p_theta0*x16
+    x18 = 2*r_c + w_b
+    x19 = e*(cos_alpha0_p_theta0*x16 - sin_alpha0_p_theta0*x14)
+    x20 = (1/4)*pi*Y_e*l_lambda*(2*chi0*x1*x5 - x15*x19 - x18*x2)
+    return (-d_x*k_s*(L_us + d_x*x8*(cos_alpha0*x7 + sin_alpha0*x4) - d_y - x8*x9) - (beta_D*x20*(-Omega_c*x13*x19 + alpha_dot*chi0*x4 - alpha_dot*x18*x6 + 2*e*x12*x17*(alpha_dot + x10)) + x20)*(-chi0*x3 + chi0 + 2*e*x12*x17 - x7*(r_c + x9)))/I_Pb
 
 
 def jac_contact_loading(t, alpha, alpha_dot, p):
@@ -329,7 +364,6 @@ def jac_contact_loading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
@@ -337,43 +371,49 @@ def jac_contact_loading(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
     x0 = 1/I_Pb
-    x1 = cos(alpha)**(-2)
-    x2 = sin(alpha)
-    x3 = (1/2)*w_b
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
-    x7 = e*cos(x6)
-    x8 = sin(x5)
-    x9 = 2*x8
-    x10 = x7*x9
-    x11 = (1/2)*alpha - 1/2*alpha0
-    x12 = cos(x11)
-    x13 = sin(x11)
-    x14 = x12*x13
-    x15 = 2*x14
-    x16 = chi0*x15
-    x17 = r_c + x3
-    x18 = x13**2
-    x19 = 2*x18
-    x20 = 1 - x19
-    x21 = 2*r_c + w_b
-    x22 = x18*x21
-    x23 = (1/4)*pi*Y_e*l_lambda
-    x24 = x23*(-x10 + x16 - x22)
-    x25 = Omega_c*cos(x5)
-    x26 = alpha_dot + x4
-    x27 = sin(x6)
-    x28 = x14*x21
-    x29 = beta_D*(alpha_dot*chi0*x20 - alpha_dot*x28 + 2*e*x26*x27*x8 - x25*x7)
-    x30 = -chi0*x19 + chi0 + 2*e*x27*x8 - x15*x17
-    x31 = e*x27
-    x32 = chi0*x20 - x28 + x31*x9
-    x33 = x23*x32
-    x34 = (1/2)*alpha_dot
-    x35 = beta_D*x24
-    return (x0*(-d_x*k_s*(d_x*(x1*x2**2 + 1) - x1*x2*x3) - x30*(x29*x33 + x33 + x35*(-alpha_dot*x16 + x10*x26 - x12**2*x21*x34 + x22*x34 + x25*x31)) - (x24*x29 + x24)*(x10 - x16 - x17*x20)), -x0*x30*x32*x35)
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = 2*x3
+    x5 = 1 - x4
+    x6 = cos(x1)
+    x7 = x2*x6
+    x8 = 2*x7
+    x9 = (cos_alpha0*x5 - sin_alpha0*x8)**(-2)
+    x10 = cos_alpha0*x8 + sin_alpha0*x5
+    x11 = (1/2)*w_b
+    x12 = chi0*x8
+    x13 = r_c + x11
+    x14 = (1/2)*Omega_c
+    x15 = t*x14
+    x16 = cos(x15)
+    x17 = sin(x15)
+    x18 = x16*x5 - x17*x8
+    x19 = x16*x8 + x17*x5
+    x20 = e*(cos_alpha0_p_theta0*x18 - sin_alpha0_p_theta0*x19)
+    x21 = 2*x17
+    x22 = x20*x21
+    x23 = 2*r_c + w_b
+    x24 = x23*x3
+    x25 = (1/4)*pi*Y_e*l_lambda
+    x26 = x25*(x12 - x22 - x24)
+    x27 = x23*x7
+    x28 = Omega_c*x16
+    x29 = alpha_dot + x14
+    x30 = cos_alpha0_p_theta0*x19 + sin_alpha0_p_theta0*x18
+    x31 = beta_D*(alpha_dot*chi0*x5 - alpha_dot*x27 + 2*e*x17*x29*x30 - x20*x28)
+    x32 = -chi0*x4 + chi0 + 2*e*x17*x30 - x13*x8
+    x33 = e*x30
+    x34 = chi0*x5 + x21*x33 - x27
+    x35 = x25*x34
+    x36 = (1/2)*alpha_dot
+    x37 = beta_D*x26
+    return (x0*(-d_x*k_s*(d_x*(x10**2*x9 + 1) - x10*x11*x9) - x32*(x31*x35 + x35 + x37*(-alpha_dot*x12 + x22*x29 - x23*x36*x6**2 + x24*x36 + x28*x33)) - (x26*x31 + x26)*(-x12 - x13*x5 + x22)), -x0*x32*x34*x37)
 
 
 def out_contact_loading(t, alpha, alpha_dot, p):
@@ -404,7 +444,6 @@ def out_contact_loading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -414,55 +453,63 @@ def out_contact_loading(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = cos(x8)
-    x10 = 2*x9
-    x11 = cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = cos(alpha)
-    x29 = 1/x28
-    x30 = sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = (1/4)*x13*x34
-    x36 = beta_D*x35
-    x37 = x27*x36 + x35
-    x38 = Omega_c*t + theta0
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x38) + x18*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x38) + x18*x39
-    x43 = x29 + x31
-    x44 = d_x*k_s
-    x45 = (1/8)*x34
-    x46 = x28**(-2)
-    x47 = x27**2*x36
-    return (x13, x21, x27, x33, -x37, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x38), -x30*x37, asin(x18/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x43)), alpha_dot*(-d_x*x33 - x37*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x46 + alpha_dot*(x30**2*x46 + 1))/x43) + x47, x47, 0)
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27
+    x30 = cos_alpha0*x9 - sin_alpha0*x15
+    x31 = 1/x30
+    x32 = cos_alpha0*x15 + sin_alpha0*x9
+    x33 = x31*x32
+    x34 = d_x*x33
+    x35 = k_s*(L_us - d_y - x21*x31 + x34)
+    x36 = pi*Y_e*l_lambda
+    x37 = (1/4)*x20*x36
+    x38 = beta_D*x37
+    x39 = x29*x38 + x37
+    x40 = 1 - 2*x11**2
+    x41 = 4*x11
+    x42 = x12*x7
+    x43 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x42 + sin_theta0*x40)
+    x44 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x40 - sin_theta0*x42) + sin_alpha0*x22
+    x45 = (1/8)*x36
+    x46 = x31 + x33
+    x47 = d_x*k_s
+    x48 = x30**(-2)
+    x49 = x29**2*x38
+    return (x20, x24, x29, x35, -x39, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x40) + sin_alpha0_p_theta0*(-x13*x41*x7 + x40*x9)), -x32*x39, asin(x22/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x19**2*x45 + x47*(L_us*alpha - alpha*d_y - d_x*log(x30) - x21*log(x46)), alpha_dot*(-d_x*x35 - x39*(chi0 - x24)) + x19*x45*(-2*alpha_dot*chi0*x9 - e*x23*x28*x41 + x15*x25 + 2*x27) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x34 - x21*(alpha_dot*x32*x48 + alpha_dot*(x32**2*x48 + 1))/x46) + x49, x49, 0)
 
 
 def out_contact_loading_v(t, alpha, alpha_dot, p):
@@ -493,7 +540,6 @@ def out_contact_loading_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -503,56 +549,64 @@ def out_contact_loading_v(t, alpha, alpha_dot, p):
     beta_D = p[13]
     Y_e = p[14]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = numpy.sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = numpy.cos(x8)
-    x10 = 2*x9
-    x11 = numpy.cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = numpy.sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*numpy.cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = numpy.cos(alpha)
-    x29 = x28**(-1.0)
-    x30 = numpy.sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = (1/4)*x13*x34
-    x36 = beta_D*x35
-    x37 = x27*x36 + x35
-    x38 = Omega_c*t + theta0
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x38) + x18*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x38) + x18*x39
-    x43 = x29 + x31
-    x44 = d_x*k_s
-    x45 = (1/8)*x34
-    x46 = x28**(-2.0)
-    x47 = x27**2*x36
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = numpy.cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27
+    x30 = cos_alpha0*x9 - sin_alpha0*x15
+    x31 = x30**(-1.0)
+    x32 = cos_alpha0*x15 + sin_alpha0*x9
+    x33 = x31*x32
+    x34 = d_x*x33
+    x35 = k_s*(L_us - d_y - x21*x31 + x34)
+    x36 = numpy.pi*Y_e*l_lambda
+    x37 = (1/4)*x20*x36
+    x38 = beta_D*x37
+    x39 = x29*x38 + x37
+    x40 = 1 - 2*x11**2
+    x41 = 4*x11
+    x42 = x12*x7
+    x43 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x42 + sin_theta0*x40)
+    x44 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x40 - sin_theta0*x42) + sin_alpha0*x22
+    x45 = (1/8)*x36
+    x46 = x31 + x33
+    x47 = d_x*k_s
+    x48 = x30**(-2.0)
+    x49 = x29**2*x38
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, -x37 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x38) + _zero, -x30*x37 + _zero, numpy.arcsin(x18/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x33 - x37*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x46 + alpha_dot*(x30**2*x46 + 1))/x43) + x47 + _zero, x47 + _zero, 0 + _zero)
+    return (x20 + _zero, x24 + _zero, x29 + _zero, x35 + _zero, -x39 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x40) + sin_alpha0_p_theta0*(-x13*x41*x7 + x40*x9)) + _zero, -x32*x39 + _zero, numpy.arcsin(x22/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x19**2*x45 + x47*(L_us*alpha - alpha*d_y - d_x*numpy.log(x30) - x21*numpy.log(x46)) + _zero, alpha_dot*(-d_x*x35 - x39*(chi0 - x24)) + x19*x45*(-2*alpha_dot*chi0*x9 - e*x23*x28*x41 + x15*x25 + 2*x27) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x34 - x21*(alpha_dot*x32*x48 + alpha_dot*(x32**2*x48 + 1))/x46) + x49 + _zero, x49 + _zero, 0 + _zero)
 
 
 def rhs_contact_unloading(t, alpha, alpha_dot, p):
@@ -571,7 +625,6 @@ def rhs_contact_unloading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -583,22 +636,31 @@ def rhs_contact_unloading(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = 2*x4
-    x6 = (1/2)*Omega_c
-    x7 = t*x6
-    x8 = sin(x7)
-    x9 = alpha + theta0 + x7
-    x10 = sin(x9)
-    x11 = cos(x2)
-    x12 = x11*x3
-    x13 = 2*r_c + w_b
-    x14 = e*cos(x9)
-    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (2*I_Pb*vartheta*zeta_D*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x11*x3 - x13*x4 - 2*x14*x8))*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = x1*x5
+    x7 = 2*x6
+    x8 = 1/(cos_alpha0*x4 - sin_alpha0*x7)
+    x9 = (1/2)*w_b
+    x10 = (1/2)*Omega_c
+    x11 = t*x10
+    x12 = sin(x11)
+    x13 = cos(x11)
+    x14 = x12*x4 + x13*x7
+    x15 = 2*x12
+    x16 = x13*x4 - x15*x6
+    x17 = cos_alpha0_p_theta0*x14 + sin_alpha0_p_theta0*x16
+    x18 = 2*r_c + w_b
+    x19 = e*(cos_alpha0_p_theta0*x16 - sin_alpha0_p_theta0*x14)
+    return (-d_x*k_s*(L_us + d_x*x8*(cos_alpha0*x7 + sin_alpha0*x4) - d_y - x8*x9) - (2*I_Pb*vartheta*zeta_D*(-Omega_c*x13*x19 + alpha_dot*chi0*x4 - alpha_dot*x18*x6 + 2*e*x12*x17*(alpha_dot + x10))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x1*x5 - x15*x19 - x18*x2))*(-chi0*x3 + chi0 + 2*e*x12*x17 - x7*(r_c + x9)))/I_Pb
 
 
 def jac_contact_unloading(t, alpha, alpha_dot, p):
@@ -618,7 +680,6 @@ def jac_contact_unloading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
@@ -628,40 +689,46 @@ def jac_contact_unloading(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
-    x0 = cos(alpha)**(-2)
-    x1 = sin(alpha)
-    x2 = (1/2)*w_b
-    x3 = (1/2)*Omega_c
-    x4 = t*x3
-    x5 = sin(x4)
-    x6 = 2*x5
-    x7 = alpha + theta0 + x4
-    x8 = e*cos(x7)
-    x9 = x6*x8
-    x10 = (1/2)*alpha - 1/2*alpha0
-    x11 = cos(x10)
-    x12 = sin(x10)
-    x13 = x11*x12
-    x14 = 2*x13
-    x15 = chi0*x14
-    x16 = r_c + x2
-    x17 = x12**2
-    x18 = 2*x17
-    x19 = 1 - x18
-    x20 = 2*r_c + w_b
-    x21 = x17*x20
-    x22 = (1/4)*pi*Y_e*l_lambda
-    x23 = Omega_c*cos(x4)
-    x24 = alpha_dot + x3
-    x25 = sin(x7)
-    x26 = x13*x20
-    x27 = 2*vartheta*zeta_D/chi_star**2
-    x28 = I_Pb*x27
-    x29 = -chi0*x18 + chi0 + 2*e*x25*x5 - x14*x16
-    x30 = e*x25
-    x31 = chi0*x19 - x26 + x30*x6
-    x32 = (1/2)*alpha_dot
-    return ((-d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - x29*(x22*x31 + x28*(-alpha_dot*x15 - x11**2*x20*x32 + x21*x32 + x23*x30 + x24*x9)) - (x22*(x15 - x21 - x9) + x28*(alpha_dot*chi0*x19 - alpha_dot*x26 + 2*e*x24*x25*x5 - x23*x8))*(-x15 - x16*x19 + x9))/I_Pb, -x27*x29*x31)
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = x1*x5
+    x7 = 2*x6
+    x8 = (cos_alpha0*x4 - sin_alpha0*x7)**(-2)
+    x9 = cos_alpha0*x7 + sin_alpha0*x4
+    x10 = (1/2)*w_b
+    x11 = chi0*x7
+    x12 = r_c + x10
+    x13 = (1/2)*Omega_c
+    x14 = t*x13
+    x15 = sin(x14)
+    x16 = 2*x15
+    x17 = cos(x14)
+    x18 = -x15*x7 + x17*x4
+    x19 = x15*x4 + x17*x7
+    x20 = e*(cos_alpha0_p_theta0*x18 - sin_alpha0_p_theta0*x19)
+    x21 = x16*x20
+    x22 = 2*r_c + w_b
+    x23 = x2*x22
+    x24 = (1/4)*pi*Y_e*l_lambda
+    x25 = x22*x6
+    x26 = Omega_c*x17
+    x27 = alpha_dot + x13
+    x28 = cos_alpha0_p_theta0*x19 + sin_alpha0_p_theta0*x18
+    x29 = 2*vartheta*zeta_D/chi_star**2
+    x30 = I_Pb*x29
+    x31 = -chi0*x3 + chi0 + 2*e*x15*x28 - x12*x7
+    x32 = e*x28
+    x33 = chi0*x4 + x16*x32 - x25
+    x34 = (1/2)*alpha_dot
+    return ((-d_x*k_s*(d_x*(x8*x9**2 + 1) - x10*x8*x9) - x31*(x24*x33 + x30*(-alpha_dot*x11 + x21*x27 - x22*x34*x5**2 + x23*x34 + x26*x32)) - (x24*(x11 - x21 - x23) + x30*(alpha_dot*chi0*x4 - alpha_dot*x25 + 2*e*x15*x27*x28 - x20*x26))*(-x11 - x12*x4 + x21))/I_Pb, -x29*x31*x33)
 
 
 def out_contact_unloading(t, alpha, alpha_dot, p):
@@ -692,7 +759,6 @@ def out_contact_unloading(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -704,54 +770,62 @@ def out_contact_unloading(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = cos(x8)
-    x10 = 2*x9
-    x11 = cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = cos(alpha)
-    x29 = 1/x28
-    x30 = sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x13*x34 + x27*x35
-    x37 = Omega_c*t + theta0
-    x38 = sin(alpha0)
-    x39 = cos(alpha0)
-    x40 = -chi0*x38 + e*sin(theta0) - e*sin(x37) + x18*x39
-    x41 = chi0*x39 + e*cos(theta0) - e*cos(x37) + x18*x38
-    x42 = x29 + x31
-    x43 = d_x*k_s
-    x44 = (1/8)*x34
-    x45 = x28**(-2)
-    x46 = x27**2*x35
-    return (x13, x21, x27, x33, -x36, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x37), -x30*x36, asin(x18/sqrt(x40**2 + x41**2)) - atan2(x40, x41), (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*log(x28) - x17*log(x42)), alpha_dot*(-d_x*x33 - x36*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x45 + alpha_dot*(x30**2*x45 + 1))/x42) + x46, x46, 0)
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27
+    x30 = cos_alpha0*x9 - sin_alpha0*x15
+    x31 = 1/x30
+    x32 = cos_alpha0*x15 + sin_alpha0*x9
+    x33 = x31*x32
+    x34 = d_x*x33
+    x35 = k_s*(L_us - d_y - x21*x31 + x34)
+    x36 = pi*Y_e*l_lambda
+    x37 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x38 = (1/4)*x20*x36 + x29*x37
+    x39 = 1 - 2*x11**2
+    x40 = 4*x11
+    x41 = x12*x7
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x39)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x39 - sin_theta0*x41) + sin_alpha0*x22
+    x44 = (1/8)*x36
+    x45 = x31 + x33
+    x46 = d_x*k_s
+    x47 = x29**2*x37
+    x48 = x30**(-2)
+    return (x20, x24, x29, x35, -x38, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x39) + sin_alpha0_p_theta0*(-x13*x40*x7 + x39*x9)), -x32*x38, asin(x22/sqrt(x42**2 + x43**2)) - atan2(x42, x43), (1/2)*I_Pb*alpha_dot**2 + x19**2*x44 + x46*(L_us*alpha - alpha*d_y - d_x*log(x30) - x21*log(x45)), alpha_dot*(-d_x*x35 - x38*(chi0 - x24)) + x19*x44*(-2*alpha_dot*chi0*x9 - e*x23*x28*x40 + x15*x25 + 2*x27) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x34 - x21*(alpha_dot*x32*x48 + alpha_dot*(x32**2*x48 + 1))/x45) + x47, x47, 0)
 
 
 def out_contact_unloading_v(t, alpha, alpha_dot, p):
@@ -782,7 +856,6 @@ def out_contact_unloading_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -794,55 +867,63 @@ def out_contact_unloading_v(t, alpha, alpha_dot, p):
     chi_star = p[15]
     vartheta = p[16]
     Omega_c = p[17]
+    cos_alpha0 = p[18]
+    cos_alpha0_p_theta0 = p[19]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_alpha0_p_theta0 = p[22]
+    sin_theta0 = p[23]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = numpy.sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = numpy.cos(x8)
-    x10 = 2*x9
-    x11 = numpy.cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = numpy.sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*numpy.cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9
-    x28 = numpy.cos(alpha)
-    x29 = x28**(-1.0)
-    x30 = numpy.sin(alpha)
-    x31 = x29*x30
-    x32 = d_x*x31
-    x33 = k_s*(L_us - d_y - x17*x29 + x32)
-    x34 = numpy.pi*Y_e*l_lambda
-    x35 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-    x36 = (1/4)*x13*x34 + x27*x35
-    x37 = Omega_c*t + theta0
-    x38 = numpy.sin(alpha0)
-    x39 = numpy.cos(alpha0)
-    x40 = -chi0*x38 + e*numpy.sin(theta0) - e*numpy.sin(x37) + x18*x39
-    x41 = chi0*x39 + e*numpy.cos(theta0) - e*numpy.cos(x37) + x18*x38
-    x42 = x29 + x31
-    x43 = d_x*k_s
-    x44 = (1/8)*x34
-    x45 = x28**(-2.0)
-    x46 = x27**2*x35
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = numpy.cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27
+    x30 = cos_alpha0*x9 - sin_alpha0*x15
+    x31 = x30**(-1.0)
+    x32 = cos_alpha0*x15 + sin_alpha0*x9
+    x33 = x31*x32
+    x34 = d_x*x33
+    x35 = k_s*(L_us - d_y - x21*x31 + x34)
+    x36 = numpy.pi*Y_e*l_lambda
+    x37 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+    x38 = (1/4)*x20*x36 + x29*x37
+    x39 = 1 - 2*x11**2
+    x40 = 4*x11
+    x41 = x12*x7
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x39)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x39 - sin_theta0*x41) + sin_alpha0*x22
+    x44 = (1/8)*x36
+    x45 = x31 + x33
+    x46 = d_x*k_s
+    x47 = x29**2*x37
+    x48 = x30**(-2.0)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x21 + _zero, x27 + _zero, x33 + _zero, -x36 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x37) + _zero, -x30*x36 + _zero, numpy.arcsin(x18/numpy.sqrt(x40**2 + x41**2)) - numpy.arctan2(x40, x41) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*numpy.log(x28) - x17*numpy.log(x42)) + _zero, alpha_dot*(-d_x*x33 - x36*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x32 - x17*(alpha_dot*x30*x45 + alpha_dot*(x30**2*x45 + 1))/x42) + x46 + _zero, x46 + _zero, 0 + _zero)
+    return (x20 + _zero, x24 + _zero, x29 + _zero, x35 + _zero, -x38 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x39) + sin_alpha0_p_theta0*(-x13*x40*x7 + x39*x9)) + _zero, -x32*x38 + _zero, numpy.arcsin(x22/numpy.sqrt(x42**2 + x43**2)) - numpy.arctan2(x42, x43) + _zero, (1/2)*I_Pb*alpha_dot**2 + x19**2*x44 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x30) - x21*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x35 - x38*(chi0 - x24)) + x19*x44*(-2*alpha_dot*chi0*x9 - e*x23*x28*x40 + x15*x25 + 2*x27) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x34 - x21*(alpha_dot*x32*x48 + alpha_dot*(x32**2*x48 + 1))/x45) + x47 + _zero, x47 + _zero, 0 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -861,12 +942,20 @@ def gap(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[17]
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0_p_theta0 = p[22]
     x0 = (1/2)*alpha - 1/2*alpha0
     x1 = sin(x0)
-    x2 = (1/2)*Omega_c*t
-    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+    x2 = x1**2
+    x3 = cos(x0)
+    x4 = (1/2)*Omega_c*t
+    x5 = cos(x4)
+    x6 = 1 - 2*x2
+    x7 = sin(x4)
+    x8 = 2*x7
+    x9 = x1*x3
+    return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -885,14 +974,20 @@ def gap_rate(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[17]
-    x0 = (1/2)*Omega_c
-    x1 = t*x0
-    x2 = alpha + theta0 + x1
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    cos_alpha0_p_theta0 = p[19]
+    sin_alpha0_p_theta0 = p[22]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = 1 - 2*x1**2
+    x3 = x1*cos(x0)
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = cos(x5)
+    x7 = sin(x5)
+    x8 = x2*x6 - 2*x3*x7
+    x9 = x2*x7 + 2*x3*x6
+    return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
 
 
 def static_moment(alpha, p):
@@ -918,27 +1013,29 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[14]
-    x0 = cos(alpha)
-    x1 = 1/x0
-    x2 = (1/2)*w_b
-    x3 = sin(alpha)
-    x4 = d_x*k_s
-    x5 = 2*r_c + w_b
-    x6 = (1/2)*alpha - 1/2*alpha0
-    x7 = sin(x6)
-    x8 = x7**2
-    x9 = x7*cos(x6)
-    x10 = 2*x9
-    x11 = chi0*x10
-    x12 = x11 - x5*x8
-    x13 = 2*x8
-    x14 = r_c + x2
-    x15 = chi0*x13 + x10*x14
-    x16 = (1/4)*pi*Y_e*l_lambda
-    x17 = x16*(chi0 - x15)
-    x18 = x0**(-2)
-    x19 = 1 - x13
-    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
+    cos_alpha0 = p[18]
+    sin_alpha0 = p[21]
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = x2*cos(x1)
+    x5 = 2*x4
+    x6 = chi0*x5
+    x7 = -x0*x3 + x6
+    x8 = 2*x3
+    x9 = (1/2)*w_b
+    x10 = r_c + x9
+    x11 = chi0*x8 + x10*x5
+    x12 = (1/4)*pi*Y_e*l_lambda
+    x13 = x12*(chi0 - x11)
+    x14 = 1 - x8
+    x15 = cos_alpha0*x14 - sin_alpha0*x5
+    x16 = 1/x15
+    x17 = cos_alpha0*x5 + sin_alpha0*x14
+    x18 = d_x*k_s
+    x19 = x15**(-2)
+    return (-x13*x7 - x18*(L_us + d_x*x16*x17 - d_y - x16*x9), -x12*x7*(-x10*x14 - x6) - x13*(chi0*x14 - x0*x4) - x18*(d_x*(x17**2*x19 + 1) - x17*x19*x9), x7, x11, x12)
 
 
 def reach(Theta, p):
@@ -954,12 +1051,12 @@ def reach(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
-    x0 = cos(alpha0)
-    x1 = sin(alpha0)
-    x2 = r_c + (1/2)*w_b
-    return -x2 + sqrt((chi0*x0 - e*cos(Theta) + e*cos(theta0) + x1*x2)**2 + (-chi0*x1 - e*sin(Theta) + e*sin(theta0) + x0*x2)**2)
+    cos_alpha0 = p[18]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_theta0 = p[23]
+    x0 = r_c + (1/2)*w_b
+    return -x0 + sqrt((chi0*cos_alpha0 + cos_theta0*e - e*cos(Theta) + sin_alpha0*x0)**2 + (-chi0*sin_alpha0 + cos_alpha0*x0 + e*sin_theta0 - e*sin(Theta))**2)
 
 
 def rigid_contact(Theta, p):
@@ -978,39 +1075,38 @@ def rigid_contact(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = sin(alpha0)
-    x1 = sin(Theta)
-    x2 = e*x1
-    x3 = cos(alpha0)
-    x4 = (1/2)*w_b
-    x5 = r_c + x4
-    x6 = chi0*x0 - e*sin(theta0) + x2 - x3*x5
-    x7 = -x6
-    x8 = cos(Theta)
-    x9 = e*x8
-    x10 = chi0*x3 + e*cos(theta0) + x0*x5 - x9
-    x11 = x10**2 + x7**2
-    x12 = asin(x5/sqrt(x11)) - atan2(x7, x10)
-    x13 = 1/x11
-    x14 = x10*x9
-    x15 = x13*x6
-    x16 = x7*x9
-    x17 = x10*x2
-    x18 = x16 - x17
-    x19 = -x13*x5**2 + 1
-    x20 = 1/sqrt(x19)
-    x21 = x20*x5/x11**(3/2)
-    x22 = 2*x16 - 2*x17
-    x23 = x22/x11**2
-    x24 = e**2
-    x25 = 1/cos(x12)
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
+    cos_alpha0 = p[18]
+    cos_theta0 = p[20]
+    sin_alpha0 = p[21]
+    sin_theta0 = p[23]
+    x0 = sin(Theta)
+    x1 = e*x0
+    x2 = (1/2)*w_b
+    x3 = r_c + x2
+    x4 = chi0*sin_alpha0 - cos_alpha0*x3 - e*sin_theta0 + x1
+    x5 = -x4
+    x6 = cos(Theta)
+    x7 = e*x6
+    x8 = chi0*cos_alpha0 + cos_theta0*e + sin_alpha0*x3 - x7
+    x9 = x5**2 + x8**2
+    x10 = asin(x3/sqrt(x9)) - atan2(x5, x8)
+    x11 = 1/x9
+    x12 = x7*x8
+    x13 = x11*x4
+    x14 = x1*x8
+    x15 = e*x5*x6 - x14
+    x16 = -x11*x3**2 + 1
+    x17 = 1/sqrt(x16)
+    x18 = x17*x3/x9**(3/2)
+    x19 = 2*e*x5*x6 - 2*x14
+    x20 = x19/x9**2
+    x21 = e**2
+    x22 = 1/cos(x10)
+    return (x10, -x1*x13 + x11*x12 + x15*x18, -x1*x20*x4 - x11*x14 + x12*x20 - x13*x7 + x15*x17*x3*(3*e*x5*x6 - 3*x14)/x9**(5/2) + (1/2)*x15*x19*x3**3/(x16**(3/2)*x9**(7/2)) + x18*(-x0**2*x21 - x1*x5 - x12 - x21*x6**2), d_x*k_s*(L_us + d_x*x22*sin(x10) - d_y - x2*x22))
 
 
 def spring_potential(alpha, p):
@@ -1066,7 +1162,6 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1076,30 +1171,38 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         beta_D = p[13]
         Y_e = p[14]
         Omega_c = p[17]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = 2*x4
-        x6 = (1/2)*Omega_c
-        x7 = t*x6
-        x8 = sin(x7)
-        x9 = alpha + theta0 + x7
-        x10 = sin(x9)
-        x11 = cos(x2)
-        x12 = x11*x3
-        x13 = 2*r_c + w_b
-        x14 = e*cos(x9)
-        x15 = (1/4)*pi*Y_e*l_lambda*(2*chi0*x11*x3 - x13*x4 - 2*x14*x8)
-        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (beta_D*x15*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6)) + x15)*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+        cos_alpha0 = p[18]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0 = p[21]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = x1*x5
+        x7 = 2*x6
+        x8 = 1/(cos_alpha0*x4 - sin_alpha0*x7)
+        x9 = (1/2)*w_b
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = sin(x11)
+        x13 = cos(x11)
+        x14 = x12*x4 + x13*x7
+        x15 = 2*x12
+        x16 = x13*x4 - x15*x6
+        x17 = cos_alpha0_p_theta0*x14 + sin_alpha0_p_theta0*x16
+        x18 = 2*r_c + w_b
+        x19 = e*(cos_alpha0_p_theta0*x16 - sin_alpha0_p_theta0*x14)
+        x20 = (1/4)*pi*Y_e*l_lambda*(2*chi0*x1*x5 - x15*x19 - x18*x2)
+        return (-d_x*k_s*(L_us + d_x*x8*(cos_alpha0*x7 + sin_alpha0*x4) - d_y - x8*x9) - (beta_D*x20*(-Omega_c*x13*x19 + alpha_dot*chi0*x4 - alpha_dot*x18*x6 + 2*e*x12*x17*(alpha_dot + x10)) + x20)*(-chi0*x3 + chi0 + 2*e*x12*x17 - x7*(r_c + x9)))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1111,22 +1214,31 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         chi_star = p[15]
         vartheta = p[16]
         Omega_c = p[17]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = 2*x4
-        x6 = (1/2)*Omega_c
-        x7 = t*x6
-        x8 = sin(x7)
-        x9 = alpha + theta0 + x7
-        x10 = sin(x9)
-        x11 = cos(x2)
-        x12 = x11*x3
-        x13 = 2*r_c + w_b
-        x14 = e*cos(x9)
-        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - (2*I_Pb*vartheta*zeta_D*(-Omega_c*x14*cos(x7) + alpha_dot*chi0*(1 - x5) - alpha_dot*x12*x13 + 2*e*x10*x8*(alpha_dot + x6))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x11*x3 - x13*x4 - 2*x14*x8))*(-chi0*x5 + chi0 + 2*e*x10*x8 - 2*x12*(r_c + x1)))/I_Pb
+        cos_alpha0 = p[18]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0 = p[21]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = x1*x5
+        x7 = 2*x6
+        x8 = 1/(cos_alpha0*x4 - sin_alpha0*x7)
+        x9 = (1/2)*w_b
+        x10 = (1/2)*Omega_c
+        x11 = t*x10
+        x12 = sin(x11)
+        x13 = cos(x11)
+        x14 = x12*x4 + x13*x7
+        x15 = 2*x12
+        x16 = x13*x4 - x15*x6
+        x17 = cos_alpha0_p_theta0*x14 + sin_alpha0_p_theta0*x16
+        x18 = 2*r_c + w_b
+        x19 = e*(cos_alpha0_p_theta0*x16 - sin_alpha0_p_theta0*x14)
+        return (-d_x*k_s*(L_us + d_x*x8*(cos_alpha0*x7 + sin_alpha0*x4) - d_y - x8*x9) - (2*I_Pb*vartheta*zeta_D*(-Omega_c*x13*x19 + alpha_dot*chi0*x4 - alpha_dot*x18*x6 + 2*e*x12*x17*(alpha_dot + x10))/chi_star**2 + (1/4)*pi*Y_e*l_lambda*(2*chi0*x1*x5 - x15*x19 - x18*x2))*(-chi0*x3 + chi0 + 2*e*x12*x17 - x7*(r_c + x9)))/I_Pb
     return nan
 
 
@@ -1151,26 +1263,40 @@ def surface_index(k, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[17]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0_p_theta0 = p[22]
         x0 = (1/2)*alpha - 1/2*alpha0
         x1 = sin(x0)
-        x2 = (1/2)*Omega_c*t
-        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+        x2 = x1**2
+        x3 = cos(x0)
+        x4 = (1/2)*Omega_c*t
+        x5 = cos(x4)
+        x6 = 1 - 2*x2
+        x7 = sin(x4)
+        x8 = 2*x7
+        x9 = x1*x3
+        return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[17]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
     return nan
 
 
@@ -1194,14 +1320,20 @@ def aux_index(j, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[17]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
     return nan
 
 
@@ -1239,7 +1371,6 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1248,60 +1379,73 @@ def power_index(c, t, alpha, alpha_dot, p):
         beta_D = p[13]
         Y_e = p[14]
         Omega_c = p[17]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = 2*r_c + w_b
-        x9 = (1/2)*alpha - 1/2*alpha0
-        x10 = sin(x9)
-        x11 = x10**2
-        x12 = (1/2)*Omega_c
-        x13 = t*x12
-        x14 = alpha + theta0 + x13
-        x15 = e*cos(x14)
-        x16 = sin(x13)
-        x17 = cos(x9)
-        x18 = -2*chi0*x10*x17 + x11*x8 + 2*x15*x16
-        x19 = Omega_c*x15*cos(x13)
-        x20 = 2*x11
-        x21 = 1 - x20
-        x22 = alpha_dot + x12
-        x23 = sin(x14)
-        x24 = x10*x17
-        x25 = 2*x24
-        x26 = alpha_dot*x8
-        x27 = pi*Y_e*l_lambda
-        x28 = alpha_dot*chi0*x21 + 2*e*x16*x22*x23 - x19 - x24*x26
-        x29 = -1/4*x18*x27
-        x30 = beta_D*x29
-        return alpha_dot*(-x7*(L_us - d_y - x2*x6 + x4) - (x28*x30 + x29)*(-chi0*x20 + chi0 + 2*e*x16*x23 - x25*(r_c + x6))) + (1/8)*x18*x27*(-2*alpha_dot*chi0*x21 - 4*e*x16*x22*x23 + 2*x19 + x25*x26) + x28**2*x30 + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        cos_alpha0 = p[18]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0 = p[21]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = x1*x5
+        x7 = 2*x6
+        x8 = cos_alpha0*x7 + sin_alpha0*x4
+        x9 = cos_alpha0*x4 - sin_alpha0*x7
+        x10 = 1/x9
+        x11 = x10*x8
+        x12 = d_x*x11
+        x13 = x9**(-2)
+        x14 = (1/2)*w_b
+        x15 = d_x*k_s
+        x16 = 2*r_c + w_b
+        x17 = (1/2)*Omega_c
+        x18 = t*x17
+        x19 = sin(x18)
+        x20 = 2*x19
+        x21 = cos(x18)
+        x22 = -x20*x6 + x21*x4
+        x23 = x19*x4 + x21*x7
+        x24 = e*(cos_alpha0_p_theta0*x22 - sin_alpha0_p_theta0*x23)
+        x25 = -2*chi0*x1*x5 + x16*x2 + x20*x24
+        x26 = alpha_dot*x16
+        x27 = Omega_c*x21*x24
+        x28 = alpha_dot + x17
+        x29 = cos_alpha0_p_theta0*x23 + sin_alpha0_p_theta0*x22
+        x30 = pi*Y_e*l_lambda
+        x31 = alpha_dot*chi0*x4 + 2*e*x19*x28*x29 - x26*x6 - x27
+        x32 = -1/4*x25*x30
+        x33 = beta_D*x32
+        return alpha_dot*(-x15*(L_us - d_y - x10*x14 + x12) - (x31*x33 + x32)*(-chi0*x3 + chi0 + 2*e*x19*x29 - x7*(r_c + x14))) + x15*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x12 - x14*(alpha_dot*x13*x8 + alpha_dot*(x13*x8**2 + 1))/(x10 + x11)) + (1/8)*x25*x30*(-2*alpha_dot*chi0*x4 - 4*e*x19*x28*x29 + x26*x7 + 2*x27) + x31**2*x33
     elif c == 4:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         l_lambda = p[11]
         beta_D = p[13]
         Y_e = p[14]
         Omega_c = p[17]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0_p_theta0 = p[22]
         x0 = 2*r_c + w_b
         x1 = (1/2)*alpha - 1/2*alpha0
         x2 = sin(x1)
         x3 = x2**2
-        x4 = (1/2)*Omega_c
-        x5 = t*x4
-        x6 = alpha + theta0 + x5
-        x7 = e*cos(x6)
-        x8 = sin(x5)
-        x9 = cos(x1)
-        return (1/4)*pi*Y_e*beta_D*l_lambda*(2*chi0*x2*x9 - x0*x3 - 2*x7*x8)*(-Omega_c*x7*cos(x5) + alpha_dot*chi0*(1 - 2*x3) - alpha_dot*x0*x2*x9 + 2*e*x8*(alpha_dot + x4)*sin(x6))**2
+        x4 = cos(x1)
+        x5 = (1/2)*Omega_c
+        x6 = t*x5
+        x7 = sin(x6)
+        x8 = 2*x7
+        x9 = cos(x6)
+        x10 = 1 - 2*x3
+        x11 = x2*x4
+        x12 = x10*x9 - x11*x8
+        x13 = x10*x7 + 2*x11*x9
+        x14 = e*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x13)
+        return (1/4)*pi*Y_e*beta_D*l_lambda*(2*chi0*x2*x4 - x0*x3 - x14*x8)*(-Omega_c*x14*x9 + alpha_dot*chi0*x10 - alpha_dot*x0*x11 + 2*e*x7*(alpha_dot + x5)*(cos_alpha0_p_theta0*x13 + sin_alpha0_p_theta0*x12))**2
     elif c == 5:
         return 0
     elif c == 6:
@@ -1310,7 +1454,6 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1322,55 +1465,68 @@ def power_index(c, t, alpha, alpha_dot, p):
         chi_star = p[15]
         vartheta = p[16]
         Omega_c = p[17]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = (1/2)*Omega_c
-        x9 = t*x8
-        x10 = alpha + theta0 + x9
-        x11 = e*cos(x10)
-        x12 = Omega_c*x11*cos(x9)
-        x13 = (1/2)*alpha - 1/2*alpha0
-        x14 = sin(x13)
-        x15 = x14**2
-        x16 = 2*x15
-        x17 = 1 - x16
-        x18 = alpha_dot + x8
-        x19 = sin(x9)
-        x20 = sin(x10)
-        x21 = cos(x13)
-        x22 = x14*x21
-        x23 = 2*r_c + w_b
-        x24 = alpha_dot*x23
-        x25 = alpha_dot*chi0*x17 + 2*e*x18*x19*x20 - x12 - x22*x24
-        x26 = 2*I_Pb*vartheta*zeta_D/chi_star**2
-        x27 = -2*chi0*x14*x21 + 2*x11*x19 + x15*x23
-        x28 = 2*x22
-        x29 = pi*Y_e*l_lambda
-        return alpha_dot*(-x7*(L_us - d_y - x2*x6 + x4) - (x25*x26 - 1/4*x27*x29)*(-chi0*x16 + chi0 + 2*e*x19*x20 - x28*(r_c + x6))) + x25**2*x26 + (1/8)*x27*x29*(-2*alpha_dot*chi0*x17 - 4*e*x18*x19*x20 + 2*x12 + x24*x28) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        cos_alpha0 = p[18]
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0 = p[21]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = x1*x5
+        x7 = 2*r_c + w_b
+        x8 = alpha_dot*x7
+        x9 = (1/2)*Omega_c
+        x10 = t*x9
+        x11 = cos(x10)
+        x12 = sin(x10)
+        x13 = 2*x12
+        x14 = x11*x4 - x13*x6
+        x15 = 2*x6
+        x16 = x11*x15 + x12*x4
+        x17 = e*(cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16)
+        x18 = Omega_c*x11*x17
+        x19 = alpha_dot + x9
+        x20 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+        x21 = alpha_dot*chi0*x4 + 2*e*x12*x19*x20 - x18 - x6*x8
+        x22 = 2*I_Pb*vartheta*zeta_D/chi_star**2
+        x23 = cos_alpha0*x15 + sin_alpha0*x4
+        x24 = cos_alpha0*x4 - sin_alpha0*x15
+        x25 = 1/x24
+        x26 = x23*x25
+        x27 = d_x*x26
+        x28 = x24**(-2)
+        x29 = (1/2)*w_b
+        x30 = d_x*k_s
+        x31 = -2*chi0*x1*x5 + x13*x17 + x2*x7
+        x32 = pi*Y_e*l_lambda
+        return alpha_dot*(-x30*(L_us - d_y - x25*x29 + x27) - (x21*x22 - 1/4*x31*x32)*(-chi0*x3 + chi0 + 2*e*x12*x20 - x15*(r_c + x29))) + x21**2*x22 + x30*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x27 - x29*(alpha_dot*x23*x28 + alpha_dot*(x23**2*x28 + 1))/(x25 + x26)) + (1/8)*x31*x32*(-2*alpha_dot*chi0*x4 - 4*e*x12*x19*x20 + x15*x8 + 2*x18)
     elif c == 7:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         I_Pb = p[10]
         zeta_D = p[12]
         chi_star = p[15]
         vartheta = p[16]
         Omega_c = p[17]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2))**2/chi_star**2
+        cos_alpha0_p_theta0 = p[19]
+        sin_alpha0_p_theta0 = p[22]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return 2*I_Pb*vartheta*zeta_D*(-Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8))**2/chi_star**2
     elif c == 8:
         return 0
     return nan

@@ -25,9 +25,9 @@ import numpy
 
 SCENE = {'contact': 'line', 'damping': 'none', 'friction': 'coulomb', 'motion': 'constant', 'model': 'nonlinear', 'sliding_velocity': 'kinematic', 'damping_sign': 'dissipative'}
 SLUG = 'line_none_coulomb_constant_nonlinear'
-PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'mu_m', 'Y_e', 'Omega_c')
+PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'mu_m', 'Y_e', 'Omega_c', 'cos_alpha0', 'cos_alpha0_p_theta0', 'cos_theta0', 'sin_alpha0', 'sin_alpha0_p_theta0', 'sin_theta0')
 INPUTS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_c', 'Y_b', 'nu_c', 'nu_b', 'l_lambda', 'mu_m', 'Omega_c')
-UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'mu_m': '1', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
+UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'mu_m': '1', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'cos_alpha0': '1', 'cos_alpha0_p_theta0': '1', 'cos_theta0': '1', 'sin_alpha0': '1', 'sin_alpha0_p_theta0': '1', 'sin_theta0': '1', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
 FLAGS = ('contact', 'forward')
 FLAG_SURFACES = {'contact': ('gap', -1), 'forward': ('slip', 1)}
 REGIMES = {(False, None): 'free', (True, True): 'contact_fwd', (True, False): 'contact_bwd'}
@@ -38,7 +38,8 @@ REGIME_NAMES = ('free', 'contact_fwd', 'contact_bwd')
 def pack(values):
     """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.
 
-    Computes the laws' constants (Y_e, Eq. 14) once, here, not in every kernel call.
+    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only
+    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.
     """
     r_c = float(values['r_c'])
     e = float(values['e'])
@@ -59,7 +60,13 @@ def pack(values):
     mu_m = float(values['mu_m'])
     Omega_c = float(values['Omega_c'])
     Y_e = 1/((1 - nu_c**2)/Y_c + (1 - nu_b**2)/Y_b)
-    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, mu_m, Y_e, Omega_c], dtype=float)
+    cos_alpha0 = cos(alpha0)
+    cos_alpha0_p_theta0 = cos(alpha0 + theta0)
+    cos_theta0 = cos(theta0)
+    sin_alpha0 = sin(alpha0)
+    sin_alpha0_p_theta0 = sin(alpha0 + theta0)
+    sin_theta0 = sin(theta0)
+    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, l_lambda, mu_m, Y_e, Omega_c, cos_alpha0, cos_alpha0_p_theta0, cos_theta0, sin_alpha0, sin_alpha0_p_theta0, sin_theta0], dtype=float)
 
 
 def cam(t, p):
@@ -165,39 +172,49 @@ def out_free(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = cos(x6)
-    x8 = sin(x5)
-    x9 = 2*e*x8
-    x10 = cos(x1)
-    x11 = 2*x3
-    x12 = sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = cos(alpha)
-    x18 = 1/x17
-    x19 = x18*sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = 1/x23
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18, chi0*x8 + x15*x20 - x18*x21, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7, k_s*(L_us + d_x*x25 - d_y - x19*x24), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)), 0, asin(x20/sqrt(x28**2 + x29**2)) - atan2(x28, x29), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x23) - x19*log(x24 + x25)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -228,40 +245,50 @@ def out_free_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = numpy.cos(x6)
-    x8 = numpy.sin(x5)
-    x9 = 2*e*x8
-    x10 = numpy.cos(x1)
-    x11 = 2*x3
-    x12 = numpy.sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = numpy.cos(alpha)
-    x18 = x17**(-1.0)
-    x19 = x18*numpy.sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = x23**(-1.0)
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18 + _zero, chi0*x8 + x15*x20 - x18*x21 + _zero, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7 + _zero, k_s*(L_us + d_x*x25 - d_y - x19*x24) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)) + _zero, 0 + _zero, numpy.arcsin(x20/numpy.sqrt(x28**2 + x29**2)) - numpy.arctan2(x28, x29) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x23) - x19*numpy.log(x24 + x25)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact_fwd(t, alpha, alpha_dot, p):
@@ -280,7 +307,6 @@ def rhs_contact_fwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -290,17 +316,26 @@ def rhs_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = (1/2)*Omega_c*t
-    x6 = alpha + theta0 + x5
-    x7 = sin(x5)
-    x8 = cos(x2)
-    x9 = 2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b)
-    return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x9 - 1/4*pi*Y_e*l_lambda*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = 2*x1*x5
+    x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+    x8 = (1/2)*w_b
+    x9 = (1/2)*Omega_c*t
+    x10 = cos(x9)
+    x11 = sin(x9)
+    x12 = x10*x4 - x11*x6
+    x13 = x10*x6 + x11*x4
+    x14 = 2*chi0*x1*x5 - 2*e*x11*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x13) - x2*(2*r_c + w_b)
+    return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x14 - 1/4*pi*Y_e*l_lambda*x14*(-chi0*x3 + chi0 + 2*e*x11*(cos_alpha0_p_theta0*x13 + sin_alpha0_p_theta0*x12) - x6*(r_c + x8)) - d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8))/I_Pb
 
 
 def jac_contact_fwd(t, alpha, alpha_dot, p):
@@ -320,7 +355,6 @@ def jac_contact_fwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
@@ -328,28 +362,34 @@ def jac_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = cos(alpha)**(-2)
-    x1 = sin(alpha)
-    x2 = (1/2)*w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = 2*x5
-    x7 = 1 - x6
-    x8 = (1/2)*Omega_c*t
-    x9 = alpha + theta0 + x8
-    x10 = sin(x9)
-    x11 = sin(x8)
-    x12 = 2*e*x11
-    x13 = 2*r_c + w_b
-    x14 = x4*cos(x3)
-    x15 = chi0*x7 + x10*x12 - x13*x14
-    x16 = r_c + x2
-    x17 = 2*x14
-    x18 = (1/4)*pi*Y_e*l_lambda
-    x19 = x12*cos(x9)
-    x20 = chi0*x17
-    return (((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - x15*x18*(-chi0*x6 + chi0 + 2*e*x10*x11 - x16*x17) - x18*(-x13*x5 - x19 + x20)*(-x16*x7 + x19 - x20))/I_Pb, 0)
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = 2*r_c + w_b
+    x6 = x1*cos(x0)
+    x7 = (1/2)*Omega_c*t
+    x8 = sin(x7)
+    x9 = cos(x7)
+    x10 = 2*x6
+    x11 = x10*x9 + x4*x8
+    x12 = -x10*x8 + x4*x9
+    x13 = cos_alpha0_p_theta0*x11 + sin_alpha0_p_theta0*x12
+    x14 = 2*e*x8
+    x15 = chi0*x4 + x13*x14 - x5*x6
+    x16 = (cos_alpha0*x4 - sin_alpha0*x10)**(-2)
+    x17 = cos_alpha0*x10 + sin_alpha0*x4
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = (1/4)*pi*Y_e*l_lambda
+    x21 = chi0*x10
+    x22 = x14*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x11)
+    return (((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x16*x17**2 + 1) - x16*x17*x18) - x15*x20*(-chi0*x3 + chi0 + 2*e*x13*x8 - x10*x19) - x20*(-x19*x4 - x21 + x22)*(-x2*x5 + x21 - x22))/I_Pb, 0)
 
 
 def out_contact_fwd(t, alpha, alpha_dot, p):
@@ -380,7 +420,6 @@ def out_contact_fwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -390,54 +429,62 @@ def out_contact_fwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = cos(x8)
-    x10 = 2*x9
-    x11 = cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = cos(alpha)
-    x28 = 1/x27
-    x29 = sin(alpha)
-    x30 = x28*x29
-    x31 = d_x*x30
-    x32 = k_s*(L_us - d_y - x17*x28 + x31)
-    x33 = pi*Y_e*l_lambda
-    x34 = (1/4)*x13*x33
-    x35 = mu_m*x34
-    x36 = Omega_c*t + theta0
-    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x36)
-    x38 = sin(alpha0)
-    x39 = cos(alpha0)
-    x40 = -chi0*x38 + e*sin(theta0) - e*sin(x36) + x18*x39
-    x41 = chi0*x39 + e*cos(theta0) - e*cos(x36) + x18*x38
-    x42 = x28 + x30
-    x43 = d_x*k_s
-    x44 = (1/8)*x33
-    x45 = x27**(-2)
-    x46 = -x35*x37
-    return (x13, x21, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9, x32, -x34, -x35, x37, -x27*x35 - x29*x34, asin(x18/sqrt(x40**2 + x41**2)) - atan2(x40, x41), (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*log(x27) - x17*log(x42)), alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*x32 - x34*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x45 + alpha_dot*(x29**2*x45 + 1))/x42) + x46, 0, x46)
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = cos_alpha0*x9 - sin_alpha0*x15
+    x30 = 1/x29
+    x31 = cos_alpha0*x15 + sin_alpha0*x9
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x21*x30 + x33)
+    x35 = pi*Y_e*l_lambda
+    x36 = (1/4)*x20*x35
+    x37 = mu_m*x36
+    x38 = 1 - 2*x11**2
+    x39 = 4*x11
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x38) + sin_alpha0_p_theta0*(-x13*x39*x7 + x38*x9))
+    x41 = x12*x7
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x38)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x38 - sin_theta0*x41) + sin_alpha0*x22
+    x44 = (1/8)*x35
+    x45 = x30 + x32
+    x46 = d_x*k_s
+    x47 = -x37*x40
+    x48 = x29**(-2)
+    return (x20, x24, alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27, x34, -x36, -x37, x40, -x29*x37 - x31*x36, asin(x22/sqrt(x42**2 + x43**2)) - atan2(x42, x43), (1/2)*I_Pb*alpha_dot**2 + x19**2*x44 + x46*(L_us*alpha - alpha*d_y - d_x*log(x29) - x21*log(x45)), alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x20 - d_x*x34 - x36*(chi0 - x24)) + x19*x44*(-2*alpha_dot*chi0*x9 - e*x23*x28*x39 + x15*x25 + 2*x27) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x21*(alpha_dot*x31*x48 + alpha_dot*(x31**2*x48 + 1))/x45) + x47, 0, x47)
 
 
 def out_contact_fwd_v(t, alpha, alpha_dot, p):
@@ -468,7 +515,6 @@ def out_contact_fwd_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -478,55 +524,63 @@ def out_contact_fwd_v(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = numpy.sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = numpy.cos(x8)
-    x10 = 2*x9
-    x11 = numpy.cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = numpy.sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*numpy.cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = numpy.cos(alpha)
-    x28 = x27**(-1.0)
-    x29 = numpy.sin(alpha)
-    x30 = x28*x29
-    x31 = d_x*x30
-    x32 = k_s*(L_us - d_y - x17*x28 + x31)
-    x33 = numpy.pi*Y_e*l_lambda
-    x34 = (1/4)*x13*x33
-    x35 = mu_m*x34
-    x36 = Omega_c*t + theta0
-    x37 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x36)
-    x38 = numpy.sin(alpha0)
-    x39 = numpy.cos(alpha0)
-    x40 = -chi0*x38 + e*numpy.sin(theta0) - e*numpy.sin(x36) + x18*x39
-    x41 = chi0*x39 + e*numpy.cos(theta0) - e*numpy.cos(x36) + x18*x38
-    x42 = x28 + x30
-    x43 = d_x*k_s
-    x44 = (1/8)*x33
-    x45 = x27**(-2.0)
-    x46 = -x35*x37
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = numpy.cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = cos_alpha0*x9 - sin_alpha0*x15
+    x30 = x29**(-1.0)
+    x31 = cos_alpha0*x15 + sin_alpha0*x9
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x21*x30 + x33)
+    x35 = numpy.pi*Y_e*l_lambda
+    x36 = (1/4)*x20*x35
+    x37 = mu_m*x36
+    x38 = 1 - 2*x11**2
+    x39 = 4*x11
+    x40 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x38) + sin_alpha0_p_theta0*(-x13*x39*x7 + x38*x9))
+    x41 = x12*x7
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x38)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x38 - sin_theta0*x41) + sin_alpha0*x22
+    x44 = (1/8)*x35
+    x45 = x30 + x32
+    x46 = d_x*k_s
+    x47 = -x37*x40
+    x48 = x29**(-2.0)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x21 + _zero, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9 + _zero, x32 + _zero, -x34 + _zero, -x35 + _zero, x37 + _zero, -x27*x35 - x29*x34 + _zero, numpy.arcsin(x18/numpy.sqrt(x40**2 + x41**2)) - numpy.arctan2(x40, x41) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x44 + x43*(L_us*alpha - alpha*d_y - d_x*numpy.log(x27) - x17*numpy.log(x42)) + _zero, alpha_dot*((1/8)*numpy.pi*Y_e*l_lambda*mu_m*w_b*x13 - d_x*x32 - x34*(chi0 - x21)) + x12*x44*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x43*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x45 + alpha_dot*(x29**2*x45 + 1))/x42) + x46 + _zero, 0 + _zero, x46 + _zero)
+    return (x20 + _zero, x24 + _zero, alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27 + _zero, x34 + _zero, -x36 + _zero, -x37 + _zero, x40 + _zero, -x29*x37 - x31*x36 + _zero, numpy.arcsin(x22/numpy.sqrt(x42**2 + x43**2)) - numpy.arctan2(x42, x43) + _zero, (1/2)*I_Pb*alpha_dot**2 + x19**2*x44 + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x29) - x21*numpy.log(x45)) + _zero, alpha_dot*((1/8)*numpy.pi*Y_e*l_lambda*mu_m*w_b*x20 - d_x*x34 - x36*(chi0 - x24)) + x19*x44*(-2*alpha_dot*chi0*x9 - e*x23*x28*x39 + x15*x25 + 2*x27) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x21*(alpha_dot*x31*x48 + alpha_dot*(x31**2*x48 + 1))/x45) + x47 + _zero, 0 + _zero, x47 + _zero)
 
 
 def rhs_contact_bwd(t, alpha, alpha_dot, p):
@@ -545,7 +599,6 @@ def rhs_contact_bwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -555,17 +608,26 @@ def rhs_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = (1/2)*Omega_c*t
-    x6 = alpha + theta0 + x5
-    x7 = sin(x5)
-    x8 = cos(x2)
-    x9 = pi*Y_e*l_lambda*(2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b))
-    return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/8*mu_m*w_b*x9 - 1/4*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)))/I_Pb
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = 2*x1*x5
+    x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+    x8 = (1/2)*w_b
+    x9 = (1/2)*Omega_c*t
+    x10 = cos(x9)
+    x11 = sin(x9)
+    x12 = x10*x4 - x11*x6
+    x13 = x10*x6 + x11*x4
+    x14 = pi*Y_e*l_lambda*(2*chi0*x1*x5 - 2*e*x11*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x13) - x2*(2*r_c + w_b))
+    return (-d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8) - 1/8*mu_m*w_b*x14 - 1/4*x14*(-chi0*x3 + chi0 + 2*e*x11*(cos_alpha0_p_theta0*x13 + sin_alpha0_p_theta0*x12) - x6*(r_c + x8)))/I_Pb
 
 
 def jac_contact_bwd(t, alpha, alpha_dot, p):
@@ -585,7 +647,6 @@ def jac_contact_bwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
@@ -593,28 +654,34 @@ def jac_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
-    x0 = cos(alpha)**(-2)
-    x1 = sin(alpha)
-    x2 = (1/2)*w_b
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    x5 = x4**2
-    x6 = 2*x5
-    x7 = 1 - x6
-    x8 = (1/2)*Omega_c*t
-    x9 = alpha + theta0 + x8
-    x10 = sin(x9)
-    x11 = sin(x8)
-    x12 = 2*e*x11
-    x13 = 2*r_c + w_b
-    x14 = x4*cos(x3)
-    x15 = chi0*x7 + x10*x12 - x13*x14
-    x16 = r_c + x2
-    x17 = 2*x14
-    x18 = (1/4)*pi*Y_e*l_lambda
-    x19 = x12*cos(x9)
-    x20 = chi0*x17
-    return ((-1/8*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - x15*x18*(-chi0*x6 + chi0 + 2*e*x10*x11 - x16*x17) - x18*(-x13*x5 - x19 + x20)*(-x16*x7 + x19 - x20))/I_Pb, 0)
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = 2*r_c + w_b
+    x6 = x1*cos(x0)
+    x7 = (1/2)*Omega_c*t
+    x8 = sin(x7)
+    x9 = cos(x7)
+    x10 = 2*x6
+    x11 = x10*x9 + x4*x8
+    x12 = -x10*x8 + x4*x9
+    x13 = cos_alpha0_p_theta0*x11 + sin_alpha0_p_theta0*x12
+    x14 = 2*e*x8
+    x15 = chi0*x4 + x13*x14 - x5*x6
+    x16 = (cos_alpha0*x4 - sin_alpha0*x10)**(-2)
+    x17 = cos_alpha0*x10 + sin_alpha0*x4
+    x18 = (1/2)*w_b
+    x19 = r_c + x18
+    x20 = (1/4)*pi*Y_e*l_lambda
+    x21 = chi0*x10
+    x22 = x14*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x11)
+    return ((-1/8*pi*Y_e*l_lambda*mu_m*w_b*x15 - d_x*k_s*(d_x*(x16*x17**2 + 1) - x16*x17*x18) - x15*x20*(-chi0*x3 + chi0 + 2*e*x13*x8 - x10*x19) - x20*(-x19*x4 - x21 + x22)*(-x2*x5 + x21 - x22))/I_Pb, 0)
 
 
 def out_contact_bwd(t, alpha, alpha_dot, p):
@@ -645,7 +712,6 @@ def out_contact_bwd(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -655,55 +721,63 @@ def out_contact_bwd(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = cos(x8)
-    x10 = 2*x9
-    x11 = cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = cos(alpha)
-    x28 = 1/x27
-    x29 = sin(alpha)
-    x30 = x28*x29
-    x31 = d_x*x30
-    x32 = k_s*(L_us - d_y - x17*x28 + x31)
-    x33 = pi*Y_e*l_lambda
-    x34 = x13*x33
-    x35 = (1/4)*x34
-    x36 = mu_m*x35
-    x37 = Omega_c*t + theta0
-    x38 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*sin(alpha + x37)
-    x39 = sin(alpha0)
-    x40 = cos(alpha0)
-    x41 = -chi0*x39 + e*sin(theta0) - e*sin(x37) + x18*x40
-    x42 = chi0*x40 + e*cos(theta0) - e*cos(x37) + x18*x39
-    x43 = x28 + x30
-    x44 = d_x*k_s
-    x45 = (1/8)*x33
-    x46 = x27**(-2)
-    x47 = x36*x38
-    return (x13, x21, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9, x32, -x35, x36, x38, x27*x36 - x29*x35, asin(x18/sqrt(x41**2 + x42**2)) - atan2(x41, x42), (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*log(x27) - x17*log(x43)), alpha_dot*(-d_x*x32 - 1/8*mu_m*w_b*x34 - x35*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x46 + alpha_dot*(x29**2*x46 + 1))/x43) + x47, 0, x47)
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = cos_alpha0*x9 - sin_alpha0*x15
+    x30 = 1/x29
+    x31 = cos_alpha0*x15 + sin_alpha0*x9
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x21*x30 + x33)
+    x35 = pi*Y_e*l_lambda
+    x36 = x20*x35
+    x37 = (1/4)*x36
+    x38 = mu_m*x37
+    x39 = 1 - 2*x11**2
+    x40 = 4*x11
+    x41 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x39) + sin_alpha0_p_theta0*(-x13*x40*x7 + x39*x9))
+    x42 = x12*x7
+    x43 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x42 + sin_theta0*x39)
+    x44 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x39 - sin_theta0*x42) + sin_alpha0*x22
+    x45 = (1/8)*x35
+    x46 = x30 + x32
+    x47 = d_x*k_s
+    x48 = x38*x41
+    x49 = x29**(-2)
+    return (x20, x24, alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27, x34, -x37, x38, x41, x29*x38 - x31*x37, asin(x22/sqrt(x43**2 + x44**2)) - atan2(x43, x44), (1/2)*I_Pb*alpha_dot**2 + x19**2*x45 + x47*(L_us*alpha - alpha*d_y - d_x*log(x29) - x21*log(x46)), alpha_dot*(-d_x*x34 - 1/8*mu_m*w_b*x36 - x37*(chi0 - x24)) + x19*x45*(-2*alpha_dot*chi0*x9 - e*x23*x28*x40 + x15*x25 + 2*x27) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x21*(alpha_dot*x31*x49 + alpha_dot*(x31**2*x49 + 1))/x46) + x48, 0, x48)
 
 
 def out_contact_bwd_v(t, alpha, alpha_dot, p):
@@ -734,7 +808,6 @@ def out_contact_bwd_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -744,56 +817,64 @@ def out_contact_bwd_v(t, alpha, alpha_dot, p):
     mu_m = p[12]
     Y_e = p[13]
     Omega_c = p[14]
+    cos_alpha0 = p[15]
+    cos_alpha0_p_theta0 = p[16]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_alpha0_p_theta0 = p[19]
+    sin_theta0 = p[20]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = numpy.sin(x5)
-    x7 = e*x6
-    x8 = alpha + theta0 + x5
-    x9 = numpy.cos(x8)
-    x10 = 2*x9
-    x11 = numpy.cos(x1)
-    x12 = -2*chi0*x11*x2 + x0*x3 + x10*x7
-    x13 = -x12
-    x14 = 2*x3
-    x15 = numpy.sin(x8)
-    x16 = x15*x7
-    x17 = (1/2)*w_b
-    x18 = r_c + x17
-    x19 = x11*x2
-    x20 = 2*x19
-    x21 = chi0*x14 - 2*x16 + x18*x20
-    x22 = Omega_c*e
-    x23 = x22*numpy.cos(x5)
-    x24 = 1 - x14
-    x25 = alpha_dot + x4
-    x26 = alpha_dot*x0
-    x27 = numpy.cos(alpha)
-    x28 = x27**(-1.0)
-    x29 = numpy.sin(alpha)
-    x30 = x28*x29
-    x31 = d_x*x30
-    x32 = k_s*(L_us - d_y - x17*x28 + x31)
-    x33 = numpy.pi*Y_e*l_lambda
-    x34 = x13*x33
-    x35 = (1/4)*x34
-    x36 = mu_m*x35
-    x37 = Omega_c*t + theta0
-    x38 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*numpy.sin(alpha + x37)
-    x39 = numpy.sin(alpha0)
-    x40 = numpy.cos(alpha0)
-    x41 = -chi0*x39 + e*numpy.sin(theta0) - e*numpy.sin(x37) + x18*x40
-    x42 = chi0*x40 + e*numpy.cos(theta0) - e*numpy.cos(x37) + x18*x39
-    x43 = x28 + x30
-    x44 = d_x*k_s
-    x45 = (1/8)*x33
-    x46 = x27**(-2.0)
-    x47 = x36*x38
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
+    x7 = numpy.cos(x6)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = -2*chi0*x2*x4 + x0*x3 + x17*x18
+    x20 = -x19
+    x21 = (1/2)*w_b
+    x22 = r_c + x21
+    x23 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x24 = chi0*x8 + x15*x22 - x18*x23
+    x25 = alpha_dot*x0
+    x26 = Omega_c*e
+    x27 = x17*x26*x7
+    x28 = alpha_dot + x5
+    x29 = cos_alpha0*x9 - sin_alpha0*x15
+    x30 = x29**(-1.0)
+    x31 = cos_alpha0*x15 + sin_alpha0*x9
+    x32 = x30*x31
+    x33 = d_x*x32
+    x34 = k_s*(L_us - d_y - x21*x30 + x33)
+    x35 = numpy.pi*Y_e*l_lambda
+    x36 = x20*x35
+    x37 = (1/4)*x36
+    x38 = mu_m*x37
+    x39 = 1 - 2*x11**2
+    x40 = 4*x11
+    x41 = -Omega_c*r_c + (1/2)*alpha_dot*w_b - x26*(cos_alpha0_p_theta0*(x10*x12 + x15*x39) + sin_alpha0_p_theta0*(-x13*x40*x7 + x39*x9))
+    x42 = x12*x7
+    x43 = -chi0*sin_alpha0 + cos_alpha0*x22 + e*sin_theta0 - e*(cos_theta0*x42 + sin_theta0*x39)
+    x44 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x39 - sin_theta0*x42) + sin_alpha0*x22
+    x45 = (1/8)*x35
+    x46 = x30 + x32
+    x47 = d_x*k_s
+    x48 = x38*x41
+    x49 = x29**(-2.0)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x13 + _zero, x21 + _zero, alpha_dot*chi0*x24 + 2*e*x15*x25*x6 - x19*x26 - x23*x9 + _zero, x32 + _zero, -x35 + _zero, x36 + _zero, x38 + _zero, x27*x36 - x29*x35 + _zero, numpy.arcsin(x18/numpy.sqrt(x41**2 + x42**2)) - numpy.arctan2(x41, x42) + _zero, (1/2)*I_Pb*alpha_dot**2 + x12**2*x45 + x44*(L_us*alpha - alpha*d_y - d_x*numpy.log(x27) - x17*numpy.log(x43)) + _zero, alpha_dot*(-d_x*x32 - 1/8*mu_m*w_b*x34 - x35*(chi0 - x21)) + x12*x45*(-2*alpha_dot*chi0*x24 + x10*x23 - 4*x16*x25 + x20*x26) + x44*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x31 - x17*(alpha_dot*x29*x46 + alpha_dot*(x29**2*x46 + 1))/x43) + x47 + _zero, 0 + _zero, x47 + _zero)
+    return (x20 + _zero, x24 + _zero, alpha_dot*chi0*x9 + 2*e*x11*x23*x28 - x13*x25 - x27 + _zero, x34 + _zero, -x37 + _zero, x38 + _zero, x41 + _zero, x29*x38 - x31*x37 + _zero, numpy.arcsin(x22/numpy.sqrt(x43**2 + x44**2)) - numpy.arctan2(x43, x44) + _zero, (1/2)*I_Pb*alpha_dot**2 + x19**2*x45 + x47*(L_us*alpha - alpha*d_y - d_x*numpy.log(x29) - x21*numpy.log(x46)) + _zero, alpha_dot*(-d_x*x34 - 1/8*mu_m*w_b*x36 - x37*(chi0 - x24)) + x19*x45*(-2*alpha_dot*chi0*x9 - e*x23*x28*x40 + x15*x25 + 2*x27) + x47*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x33 - x21*(alpha_dot*x31*x49 + alpha_dot*(x31**2*x49 + 1))/x46) + x48 + _zero, 0 + _zero, x48 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -812,12 +893,20 @@ def gap(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[14]
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0_p_theta0 = p[19]
     x0 = (1/2)*alpha - 1/2*alpha0
     x1 = sin(x0)
-    x2 = (1/2)*Omega_c*t
-    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+    x2 = x1**2
+    x3 = cos(x0)
+    x4 = (1/2)*Omega_c*t
+    x5 = cos(x4)
+    x6 = 1 - 2*x2
+    x7 = sin(x4)
+    x8 = 2*x7
+    x9 = x1*x3
+    return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -836,14 +925,20 @@ def gap_rate(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[14]
-    x0 = (1/2)*Omega_c
-    x1 = t*x0
-    x2 = alpha + theta0 + x1
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    cos_alpha0_p_theta0 = p[16]
+    sin_alpha0_p_theta0 = p[19]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = 1 - 2*x1**2
+    x3 = x1*cos(x0)
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = cos(x5)
+    x7 = sin(x5)
+    x8 = x2*x6 - 2*x3*x7
+    x9 = x2*x7 + 2*x3*x6
+    return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
 
 
 def slip(t, alpha, alpha_dot, p):
@@ -909,27 +1004,29 @@ def static_moment(alpha, p):
     k_s = p[9]
     l_lambda = p[11]
     Y_e = p[13]
-    x0 = cos(alpha)
-    x1 = 1/x0
-    x2 = (1/2)*w_b
-    x3 = sin(alpha)
-    x4 = d_x*k_s
-    x5 = 2*r_c + w_b
-    x6 = (1/2)*alpha - 1/2*alpha0
-    x7 = sin(x6)
-    x8 = x7**2
-    x9 = x7*cos(x6)
-    x10 = 2*x9
-    x11 = chi0*x10
-    x12 = x11 - x5*x8
-    x13 = 2*x8
-    x14 = r_c + x2
-    x15 = chi0*x13 + x10*x14
-    x16 = (1/4)*pi*Y_e*l_lambda
-    x17 = x16*(chi0 - x15)
-    x18 = x0**(-2)
-    x19 = 1 - x13
-    return (-x12*x17 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -x12*x16*(-x11 - x14*x19) - x17*(chi0*x19 - x5*x9) - x4*(d_x*(x18*x3**2 + 1) - x18*x2*x3), x12, x15, x16)
+    cos_alpha0 = p[15]
+    sin_alpha0 = p[18]
+    x0 = 2*r_c + w_b
+    x1 = (1/2)*alpha - 1/2*alpha0
+    x2 = sin(x1)
+    x3 = x2**2
+    x4 = x2*cos(x1)
+    x5 = 2*x4
+    x6 = chi0*x5
+    x7 = -x0*x3 + x6
+    x8 = 2*x3
+    x9 = (1/2)*w_b
+    x10 = r_c + x9
+    x11 = chi0*x8 + x10*x5
+    x12 = (1/4)*pi*Y_e*l_lambda
+    x13 = x12*(chi0 - x11)
+    x14 = 1 - x8
+    x15 = cos_alpha0*x14 - sin_alpha0*x5
+    x16 = 1/x15
+    x17 = cos_alpha0*x5 + sin_alpha0*x14
+    x18 = d_x*k_s
+    x19 = x15**(-2)
+    return (-x13*x7 - x18*(L_us + d_x*x16*x17 - d_y - x16*x9), -x12*x7*(-x10*x14 - x6) - x13*(chi0*x14 - x0*x4) - x18*(d_x*(x17**2*x19 + 1) - x17*x19*x9), x7, x11, x12)
 
 
 def reach(Theta, p):
@@ -945,12 +1042,12 @@ def reach(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
-    x0 = cos(alpha0)
-    x1 = sin(alpha0)
-    x2 = r_c + (1/2)*w_b
-    return -x2 + sqrt((chi0*x0 - e*cos(Theta) + e*cos(theta0) + x1*x2)**2 + (-chi0*x1 - e*sin(Theta) + e*sin(theta0) + x0*x2)**2)
+    cos_alpha0 = p[15]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_theta0 = p[20]
+    x0 = r_c + (1/2)*w_b
+    return -x0 + sqrt((chi0*cos_alpha0 + cos_theta0*e - e*cos(Theta) + sin_alpha0*x0)**2 + (-chi0*sin_alpha0 + cos_alpha0*x0 + e*sin_theta0 - e*sin(Theta))**2)
 
 
 def rigid_contact(Theta, p):
@@ -969,39 +1066,38 @@ def rigid_contact(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = sin(alpha0)
-    x1 = sin(Theta)
-    x2 = e*x1
-    x3 = cos(alpha0)
-    x4 = (1/2)*w_b
-    x5 = r_c + x4
-    x6 = chi0*x0 - e*sin(theta0) + x2 - x3*x5
-    x7 = -x6
-    x8 = cos(Theta)
-    x9 = e*x8
-    x10 = chi0*x3 + e*cos(theta0) + x0*x5 - x9
-    x11 = x10**2 + x7**2
-    x12 = asin(x5/sqrt(x11)) - atan2(x7, x10)
-    x13 = 1/x11
-    x14 = x10*x9
-    x15 = x13*x6
-    x16 = x7*x9
-    x17 = x10*x2
-    x18 = x16 - x17
-    x19 = -x13*x5**2 + 1
-    x20 = 1/sqrt(x19)
-    x21 = x20*x5/x11**(3/2)
-    x22 = 2*x16 - 2*x17
-    x23 = x22/x11**2
-    x24 = e**2
-    x25 = 1/cos(x12)
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
+    cos_alpha0 = p[15]
+    cos_theta0 = p[17]
+    sin_alpha0 = p[18]
+    sin_theta0 = p[20]
+    x0 = sin(Theta)
+    x1 = e*x0
+    x2 = (1/2)*w_b
+    x3 = r_c + x2
+    x4 = chi0*sin_alpha0 - cos_alpha0*x3 - e*sin_theta0 + x1
+    x5 = -x4
+    x6 = cos(Theta)
+    x7 = e*x6
+    x8 = chi0*cos_alpha0 + cos_theta0*e + sin_alpha0*x3 - x7
+    x9 = x5**2 + x8**2
+    x10 = asin(x3/sqrt(x9)) - atan2(x5, x8)
+    x11 = 1/x9
+    x12 = x7*x8
+    x13 = x11*x4
+    x14 = x1*x8
+    x15 = e*x5*x6 - x14
+    x16 = -x11*x3**2 + 1
+    x17 = 1/sqrt(x16)
+    x18 = x17*x3/x9**(3/2)
+    x19 = 2*e*x5*x6 - 2*x14
+    x20 = x19/x9**2
+    x21 = e**2
+    x22 = 1/cos(x10)
+    return (x10, -x1*x13 + x11*x12 + x15*x18, -x1*x20*x4 - x11*x14 + x12*x20 - x13*x7 + x15*x17*x3*(3*e*x5*x6 - 3*x14)/x9**(5/2) + (1/2)*x15*x19*x3**3/(x16**(3/2)*x9**(7/2)) + x18*(-x0**2*x21 - x1*x5 - x12 - x21*x6**2), d_x*k_s*(L_us + d_x*x22*sin(x10) - d_y - x2*x22))
 
 
 def spring_potential(alpha, p):
@@ -1057,7 +1153,6 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1067,24 +1162,32 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = (1/2)*Omega_c*t
-        x6 = alpha + theta0 + x5
-        x7 = sin(x5)
-        x8 = cos(x2)
-        x9 = 2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b)
-        return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x9 - 1/4*pi*Y_e*l_lambda*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = 2*x1*x5
+        x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+        x8 = (1/2)*w_b
+        x9 = (1/2)*Omega_c*t
+        x10 = cos(x9)
+        x11 = sin(x9)
+        x12 = x10*x4 - x11*x6
+        x13 = x10*x6 + x11*x4
+        x14 = 2*chi0*x1*x5 - 2*e*x11*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x13) - x2*(2*r_c + w_b)
+        return ((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x14 - 1/4*pi*Y_e*l_lambda*x14*(-chi0*x3 + chi0 + 2*e*x11*(cos_alpha0_p_theta0*x13 + sin_alpha0_p_theta0*x12) - x6*(r_c + x8)) - d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8))/I_Pb
     elif r == 2:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1094,17 +1197,26 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = (1/2)*Omega_c*t
-        x6 = alpha + theta0 + x5
-        x7 = sin(x5)
-        x8 = cos(x2)
-        x9 = pi*Y_e*l_lambda*(2*chi0*x3*x8 - 2*e*x7*cos(x6) - x4*(2*r_c + w_b))
-        return (-d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1) - 1/8*mu_m*w_b*x9 - 1/4*x9*(-2*chi0*x4 + chi0 + 2*e*x7*sin(x6) - 2*x3*x8*(r_c + x1)))/I_Pb
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = 2*x1*x5
+        x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+        x8 = (1/2)*w_b
+        x9 = (1/2)*Omega_c*t
+        x10 = cos(x9)
+        x11 = sin(x9)
+        x12 = x10*x4 - x11*x6
+        x13 = x10*x6 + x11*x4
+        x14 = pi*Y_e*l_lambda*(2*chi0*x1*x5 - 2*e*x11*(cos_alpha0_p_theta0*x12 - sin_alpha0_p_theta0*x13) - x2*(2*r_c + w_b))
+        return (-d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8) - 1/8*mu_m*w_b*x14 - 1/4*x14*(-chi0*x3 + chi0 + 2*e*x11*(cos_alpha0_p_theta0*x13 + sin_alpha0_p_theta0*x12) - x6*(r_c + x8)))/I_Pb
     return nan
 
 
@@ -1129,12 +1241,20 @@ def surface_index(k, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[14]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
         x0 = (1/2)*alpha - 1/2*alpha0
         x1 = sin(x0)
-        x2 = (1/2)*Omega_c*t
-        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+        x2 = x1**2
+        x3 = cos(x0)
+        x4 = (1/2)*Omega_c*t
+        x5 = cos(x4)
+        x6 = 1 - 2*x2
+        x7 = sin(x4)
+        x8 = 2*x7
+        x9 = x1*x3
+        return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
     elif k == 1:
         r_c = p[0]
         e = p[1]
@@ -1168,14 +1288,20 @@ def aux_index(j, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[14]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
     elif j == 1:
         e = p[1]
         theta0 = p[5]
@@ -1226,7 +1352,6 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1235,35 +1360,45 @@ def power_index(c, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = alpha + theta0
-        x9 = Omega_c*e
-        x10 = 2*r_c + w_b
-        x11 = (1/2)*alpha - 1/2*alpha0
-        x12 = sin(x11)
-        x13 = x12**2
-        x14 = (1/2)*Omega_c
-        x15 = t*x14
-        x16 = sin(x15)
-        x17 = e*x16
-        x18 = x15 + x8
-        x19 = 2*cos(x18)
-        x20 = cos(x11)
-        x21 = -2*chi0*x12*x20 + x10*x13 + x17*x19
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = sin(x1)
+        x3 = 1 - 2*x2**2
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = 2*x6
+        x8 = 1 - x7
+        x9 = cos(x1)
+        x10 = cos(x4)
+        x11 = x10*x5
+        x12 = 4*x2
+        x13 = x8*x9
+        x14 = 2*x2
+        x15 = 2*x11
+        x16 = Omega_c*e
+        x17 = 2*r_c + w_b
+        x18 = x13 - x15*x2
+        x19 = x15*x9 + x2*x8
+        x20 = cos_alpha0_p_theta0*x18 - sin_alpha0_p_theta0*x19
+        x21 = -2*chi0*x10*x5 + e*x14*x20 + x17*x6
         x22 = -x21
         x23 = pi*Y_e*l_lambda
         x24 = (1/4)*x22*x23
-        x25 = 2*x13
-        x26 = sin(x18)
-        x27 = 2*x12*x20
-        return alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x22 - x24*(-chi0*x25 + chi0 + 2*e*x16*x26 - x27*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) - mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x9*sin(Omega_c*t + x8)) + (1/8)*x21*x23*(-2*alpha_dot*chi0*(1 - x25) + alpha_dot*x10*x27 - 4*x17*x26*(alpha_dot + x14) + x19*x9*cos(x15)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        x25 = cos_alpha0*x15 + sin_alpha0*x8
+        x26 = cos_alpha0*x8 - sin_alpha0*x15
+        x27 = 1/x26
+        x28 = x25*x27
+        x29 = d_x*x28
+        x30 = x26**(-2)
+        x31 = (1/2)*w_b
+        x32 = d_x*k_s
+        x33 = cos_alpha0_p_theta0*x19 + sin_alpha0_p_theta0*x18
+        return alpha_dot*((1/8)*pi*Y_e*l_lambda*mu_m*w_b*x22 - x24*(-chi0*x7 + chi0 + 2*e*x2*x33 - x15*(r_c + x31)) - x32*(L_us - d_y - x27*x31 + x29)) - mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*(cos_alpha0_p_theta0*(x13*x14 + x15*x3) + sin_alpha0_p_theta0*(-x11*x12*x9 + x3*x8))) + (1/8)*x21*x23*(-2*alpha_dot*chi0*x8 + alpha_dot*x15*x17 - e*x12*x33*(alpha_dot + x0) + 2*x16*x20*x9) + x32*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x29 - x31*(alpha_dot*x25*x30 + alpha_dot*(x25**2*x30 + 1))/(x27 + x28))
     elif c == 4:
         return 0
     elif c == 5:
@@ -1272,24 +1407,32 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         l_lambda = p[11]
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = Omega_c*t
-        x1 = alpha + theta0
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = (1/2)*x0
-        return -1/4*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x3*cos(x2) - 2*e*sin(x4)*cos(x1 + x4) - x3**2*(2*r_c + w_b))
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*Omega_c*t
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = 1 - 2*x5
+        x7 = cos(x0)
+        x8 = cos(x3)
+        x9 = x4*x8
+        x10 = x6*x7
+        x11 = 2*x1
+        x12 = 2*x9
+        return -1/4*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*(cos_alpha0_p_theta0*(x10*x11 + x12*x2) + sin_alpha0_p_theta0*(-4*x1*x7*x9 + x2*x6)) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x4*x8 - e*x11*(cos_alpha0_p_theta0*(-x1*x12 + x10) - sin_alpha0_p_theta0*(x1*x6 + x12*x7)) - x5*(2*r_c + w_b))
     elif c == 6:
         r_c = p[0]
         e = p[1]
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -1298,35 +1441,45 @@ def power_index(c, t, alpha, alpha_dot, p):
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = alpha + theta0
-        x9 = Omega_c*e
-        x10 = 2*r_c + w_b
-        x11 = (1/2)*alpha - 1/2*alpha0
-        x12 = sin(x11)
-        x13 = x12**2
-        x14 = (1/2)*Omega_c
-        x15 = t*x14
-        x16 = sin(x15)
-        x17 = e*x16
-        x18 = x15 + x8
-        x19 = 2*cos(x18)
-        x20 = cos(x11)
-        x21 = -2*chi0*x12*x20 + x10*x13 + x17*x19
+        cos_alpha0 = p[15]
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0 = p[18]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*Omega_c
+        x1 = t*x0
+        x2 = sin(x1)
+        x3 = 1 - 2*x2**2
+        x4 = (1/2)*alpha - 1/2*alpha0
+        x5 = sin(x4)
+        x6 = x5**2
+        x7 = 2*x6
+        x8 = 1 - x7
+        x9 = cos(x1)
+        x10 = cos(x4)
+        x11 = x10*x5
+        x12 = 4*x2
+        x13 = x8*x9
+        x14 = 2*x2
+        x15 = 2*x11
+        x16 = Omega_c*e
+        x17 = 2*r_c + w_b
+        x18 = x13 - x15*x2
+        x19 = x15*x9 + x2*x8
+        x20 = cos_alpha0_p_theta0*x18 - sin_alpha0_p_theta0*x19
+        x21 = -2*chi0*x10*x5 + e*x14*x20 + x17*x6
         x22 = pi*Y_e*l_lambda
         x23 = -x21*x22
         x24 = (1/4)*x23
-        x25 = 2*x13
-        x26 = sin(x18)
-        x27 = 2*x12*x20
-        return alpha_dot*(-1/8*mu_m*w_b*x23 - x24*(-chi0*x25 + chi0 + 2*e*x16*x26 - x27*(r_c + x6)) - x7*(L_us - d_y - x2*x6 + x4)) + mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x9*sin(Omega_c*t + x8)) + (1/8)*x21*x22*(-2*alpha_dot*chi0*(1 - x25) + alpha_dot*x10*x27 - 4*x17*x26*(alpha_dot + x14) + x19*x9*cos(x15)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        x25 = cos_alpha0*x15 + sin_alpha0*x8
+        x26 = cos_alpha0*x8 - sin_alpha0*x15
+        x27 = 1/x26
+        x28 = x25*x27
+        x29 = d_x*x28
+        x30 = x26**(-2)
+        x31 = (1/2)*w_b
+        x32 = d_x*k_s
+        x33 = cos_alpha0_p_theta0*x19 + sin_alpha0_p_theta0*x18
+        return alpha_dot*(-1/8*mu_m*w_b*x23 - x24*(-chi0*x7 + chi0 + 2*e*x2*x33 - x15*(r_c + x31)) - x32*(L_us - d_y - x27*x31 + x29)) + mu_m*x24*(-Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*(cos_alpha0_p_theta0*(x13*x14 + x15*x3) + sin_alpha0_p_theta0*(-x11*x12*x9 + x3*x8))) + (1/8)*x21*x22*(-2*alpha_dot*chi0*x8 + alpha_dot*x15*x17 - e*x12*x33*(alpha_dot + x0) + 2*x16*x20*x9) + x32*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x29 - x31*(alpha_dot*x25*x30 + alpha_dot*(x25**2*x30 + 1))/(x27 + x28))
     elif c == 7:
         return 0
     elif c == 8:
@@ -1335,15 +1488,24 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         l_lambda = p[11]
         mu_m = p[12]
         Y_e = p[13]
         Omega_c = p[14]
-        x0 = Omega_c*t
-        x1 = alpha + theta0
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = (1/2)*x0
-        return (1/4)*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*sin(x0 + x1) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x3*cos(x2) - 2*e*sin(x4)*cos(x1 + x4) - x3**2*(2*r_c + w_b))
+        cos_alpha0_p_theta0 = p[16]
+        sin_alpha0_p_theta0 = p[19]
+        x0 = (1/2)*Omega_c*t
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = (1/2)*alpha - 1/2*alpha0
+        x4 = sin(x3)
+        x5 = x4**2
+        x6 = 1 - 2*x5
+        x7 = cos(x0)
+        x8 = cos(x3)
+        x9 = x4*x8
+        x10 = x6*x7
+        x11 = 2*x1
+        x12 = 2*x9
+        return (1/4)*pi*Y_e*l_lambda*mu_m*(-Omega_c*e*(cos_alpha0_p_theta0*(x10*x11 + x12*x2) + sin_alpha0_p_theta0*(-4*x1*x7*x9 + x2*x6)) - Omega_c*r_c + (1/2)*alpha_dot*w_b)*(2*chi0*x4*x8 - e*x11*(cos_alpha0_p_theta0*(-x1*x12 + x10) - sin_alpha0_p_theta0*(x1*x6 + x12*x7)) - x5*(2*r_c + w_b))
     return nan

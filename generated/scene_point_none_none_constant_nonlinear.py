@@ -25,9 +25,9 @@ import numpy
 
 SCENE = {'contact': 'point', 'damping': 'none', 'friction': 'none', 'motion': 'constant', 'model': 'nonlinear', 'sliding_velocity': 'kinematic', 'damping_sign': 'dissipative'}
 SLUG = 'point_none_none_constant_nonlinear'
-PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_e', 'Omega_c')
+PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_e', 'Omega_c', 'cos_alpha0', 'cos_alpha0_p_theta0', 'cos_theta0', 'sin_alpha0', 'sin_alpha0_p_theta0', 'sin_theta0')
 INPUTS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_c', 'Y_b', 'nu_c', 'nu_b', 'Omega_c')
-UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
+UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'Y_e': 'Pa', 'Omega_c': 'rad/s', 'cos_alpha0': '1', 'cos_alpha0_p_theta0': '1', 'cos_theta0': '1', 'sin_alpha0': '1', 'sin_alpha0_p_theta0': '1', 'sin_theta0': '1', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}
 FLAGS = ('contact',)
 FLAG_SURFACES = {'contact': ('gap', -1)}
 REGIMES = {(False,): 'free', (True,): 'contact'}
@@ -38,7 +38,8 @@ REGIME_NAMES = ('free', 'contact')
 def pack(values):
     """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.
 
-    Computes the laws' constants (Y_e, Eq. 14) once, here, not in every kernel call.
+    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only
+    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.
     """
     r_c = float(values['r_c'])
     e = float(values['e'])
@@ -57,7 +58,13 @@ def pack(values):
     nu_b = float(values['nu_b'])
     Omega_c = float(values['Omega_c'])
     Y_e = 1/((1 - nu_c**2)/Y_c + (1 - nu_b**2)/Y_b)
-    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, Y_e, Omega_c], dtype=float)
+    cos_alpha0 = cos(alpha0)
+    cos_alpha0_p_theta0 = cos(alpha0 + theta0)
+    cos_theta0 = cos(theta0)
+    sin_alpha0 = sin(alpha0)
+    sin_alpha0_p_theta0 = sin(alpha0 + theta0)
+    sin_theta0 = sin(theta0)
+    return numpy.array([r_c, e, w_b, chi0, alpha0, theta0, d_x, d_y, L_us, k_s, I_Pb, Y_e, Omega_c, cos_alpha0, cos_alpha0_p_theta0, cos_theta0, sin_alpha0, sin_alpha0_p_theta0, sin_theta0], dtype=float)
 
 
 def cam(t, p):
@@ -163,39 +170,49 @@ def out_free(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[12]
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    sin_theta0 = p[18]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = cos(x6)
-    x8 = sin(x5)
-    x9 = 2*e*x8
-    x10 = cos(x1)
-    x11 = 2*x3
-    x12 = sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = cos(alpha)
-    x18 = 1/x17
-    x19 = x18*sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = sin(alpha0)
-    x22 = cos(alpha0)
-    x23 = -chi0*x21 + e*sin(theta0) - e*sin(x20) + x14*x22
-    x24 = chi0*x22 + e*cos(theta0) - e*cos(x20) + x14*x21
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9, chi0*x11 - x12*x9 + 2*x14*x15, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*cos(x5), k_s*(L_us + d_x*x19 - d_y - x13*x18), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*sin(alpha + x20), 0, asin(x14/sqrt(x23**2 + x24**2)) - atan2(x23, x24), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x17) - x13*log(x18 + x19)), 0, 0, 0)
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = 1/x23
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18, chi0*x8 + x15*x20 - x18*x21, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7, k_s*(L_us + d_x*x25 - d_y - x19*x24), 0, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)), 0, asin(x20/sqrt(x28**2 + x29**2)) - atan2(x28, x29), (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*log(x23) - x19*log(x24 + x25)), 0, 0, 0)
 
 
 def out_free_v(t, alpha, alpha_dot, p):
@@ -226,40 +243,50 @@ def out_free_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
     I_Pb = p[10]
     Omega_c = p[12]
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    sin_theta0 = p[18]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
+    x4 = numpy.cos(x1)
+    x5 = (1/2)*Omega_c
+    x6 = t*x5
     x7 = numpy.cos(x6)
-    x8 = numpy.sin(x5)
-    x9 = 2*e*x8
-    x10 = numpy.cos(x1)
-    x11 = 2*x3
-    x12 = numpy.sin(x6)
-    x13 = (1/2)*w_b
-    x14 = r_c + x13
-    x15 = x10*x2
-    x16 = Omega_c*e
-    x17 = numpy.cos(alpha)
-    x18 = x17**(-1.0)
-    x19 = x18*numpy.sin(alpha)
-    x20 = Omega_c*t + theta0
-    x21 = numpy.sin(alpha0)
-    x22 = numpy.cos(alpha0)
-    x23 = -chi0*x21 + e*numpy.sin(theta0) - e*numpy.sin(x20) + x14*x22
-    x24 = chi0*x22 + e*numpy.cos(theta0) - e*numpy.cos(x20) + x14*x21
+    x8 = 2*x3
+    x9 = 1 - x8
+    x10 = x7*x9
+    x11 = numpy.sin(x6)
+    x12 = 2*x11
+    x13 = x2*x4
+    x14 = x10 - x12*x13
+    x15 = 2*x13
+    x16 = x11*x9 + x15*x7
+    x17 = cos_alpha0_p_theta0*x14 - sin_alpha0_p_theta0*x16
+    x18 = e*x12
+    x19 = (1/2)*w_b
+    x20 = r_c + x19
+    x21 = cos_alpha0_p_theta0*x16 + sin_alpha0_p_theta0*x14
+    x22 = Omega_c*e
+    x23 = cos_alpha0*x9 - sin_alpha0*x15
+    x24 = x23**(-1.0)
+    x25 = x24*(cos_alpha0*x15 + sin_alpha0*x9)
+    x26 = 1 - 2*x11**2
+    x27 = x12*x7
+    x28 = -chi0*sin_alpha0 + cos_alpha0*x20 + e*sin_theta0 - e*(cos_theta0*x27 + sin_theta0*x26)
+    x29 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x26 - sin_theta0*x27) + sin_alpha0*x20
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (2*chi0*x10*x2 - x0*x3 - x7*x9 + _zero, chi0*x11 - x12*x9 + 2*x14*x15 + _zero, alpha_dot*chi0*(1 - x11) - alpha_dot*x0*x15 + 2*e*x12*x8*(alpha_dot + x4) - x16*x7*numpy.cos(x5) + _zero, k_s*(L_us + d_x*x19 - d_y - x13*x18) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x16*numpy.sin(alpha + x20) + _zero, 0 + _zero, numpy.arcsin(x14/numpy.sqrt(x23**2 + x24**2)) - numpy.arctan2(x23, x24) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x17) - x13*numpy.log(x18 + x19)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
+    return (2*chi0*x2*x4 - x0*x3 - x17*x18 + _zero, chi0*x8 + x15*x20 - x18*x21 + _zero, alpha_dot*chi0*x9 - alpha_dot*x0*x13 + 2*e*x11*x21*(alpha_dot + x5) - x17*x22*x7 + _zero, k_s*(L_us + d_x*x25 - d_y - x19*x24) + _zero, 0 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x22*(cos_alpha0_p_theta0*(x10*x12 + x15*x26) + sin_alpha0_p_theta0*(-4*x11*x13*x7 + x26*x9)) + _zero, 0 + _zero, numpy.arcsin(x20/numpy.sqrt(x28**2 + x29**2)) - numpy.arctan2(x28, x29) + _zero, (1/2)*I_Pb*alpha_dot**2 + d_x*k_s*(L_us*alpha - alpha*d_y - d_x*numpy.log(x23) - x19*numpy.log(x24 + x25)) + _zero, 0 + _zero, 0 + _zero, 0 + _zero)
 
 
 def rhs_contact(t, alpha, alpha_dot, p):
@@ -278,7 +305,6 @@ def rhs_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -286,16 +312,25 @@ def rhs_contact(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = 1/cos(alpha)
-    x1 = (1/2)*w_b
-    x2 = (1/2)*alpha - 1/2*alpha0
-    x3 = sin(x2)
-    x4 = x3**2
-    x5 = (1/2)*Omega_c*t
-    x6 = sin(x5)
-    x7 = alpha + theta0 + x5
-    x8 = cos(x2)
-    return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x4 + chi0 + 2*e*x6*sin(x7) - 2*x3*x8*(r_c + x1))*(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))*sqrt(abs(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = 1 - x3
+    x5 = cos(x0)
+    x6 = 2*x1*x5
+    x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+    x8 = (1/2)*w_b
+    x9 = (1/2)*Omega_c*t
+    x10 = sin(x9)
+    x11 = cos(x9)
+    x12 = x10*x4 + x11*x6
+    x13 = -x10*x6 + x11*x4
+    return (-4/3*Y_e*sqrt(r_c)*(-chi0*x3 + chi0 + 2*e*x10*(cos_alpha0_p_theta0*x12 + sin_alpha0_p_theta0*x13) - x6*(r_c + x8))*(2*chi0*x1*x5 - 2*e*x10*(cos_alpha0_p_theta0*x13 - sin_alpha0_p_theta0*x12) - x2*(2*r_c + w_b))*sqrt(abs(2*chi0*x1*x5 - 2*e*x10*(cos_alpha0_p_theta0*x13 - sin_alpha0_p_theta0*x12) - x2*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8))/I_Pb
 
 
 def jac_contact(t, alpha, alpha_dot, p):
@@ -315,34 +350,42 @@ def jac_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     k_s = p[9]
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
-    x0 = cos(alpha)**(-2)
-    x1 = sin(alpha)
-    x2 = (1/2)*w_b
-    x3 = (1/2)*Omega_c*t
-    x4 = alpha + theta0 + x3
-    x5 = sin(x3)
-    x6 = 2*e*x5
-    x7 = x6*cos(x4)
-    x8 = (1/2)*alpha - 1/2*alpha0
-    x9 = sin(x8)
-    x10 = x9*cos(x8)
-    x11 = 2*x10
-    x12 = chi0*x11
-    x13 = r_c + x2
-    x14 = x9**2
-    x15 = 2*x14
-    x16 = 1 - x15
-    x17 = 2*r_c + w_b
-    x18 = -x12 + x14*x17 + x7
-    x19 = Y_e*sqrt(r_c)
-    x20 = sin(x4)
-    return ((-d_x*k_s*(d_x*(x0*x1**2 + 1) - x0*x1*x2) - 4/3*x19*(-x12 - x13*x16 + x7)*(-x18)*sqrt(abs(-x18)) - 2*x19*(chi0*x16 - x10*x17 + x20*x6)*(-chi0*x15 + chi0 + 2*e*x20*x5 - x11*x13)*sqrt(abs(x18)))/I_Pb, 0)
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = x3 - 1
+    x5 = -x4
+    x6 = x1*cos(x0)
+    x7 = 2*x6
+    x8 = (cos_alpha0*x5 - sin_alpha0*x7)**(-2)
+    x9 = cos_alpha0*x7 + sin_alpha0*x5
+    x10 = (1/2)*w_b
+    x11 = chi0*x7
+    x12 = r_c + x10
+    x13 = (1/2)*Omega_c*t
+    x14 = cos(x13)
+    x15 = sin(x13)
+    x16 = x15*x7
+    x17 = x14*x5 - x16
+    x18 = x14*x7
+    x19 = x15*x5 + x18
+    x20 = 2*e*x15
+    x21 = x20*(cos_alpha0_p_theta0*x17 - sin_alpha0_p_theta0*x19)
+    x22 = 2*r_c + w_b
+    x23 = x2*x22
+    x24 = Y_e*sqrt(r_c)
+    x25 = cos_alpha0_p_theta0*x19 + sin_alpha0_p_theta0*x17
+    return ((-d_x*k_s*(d_x*(x8*x9**2 + 1) - x10*x8*x9) - 4/3*x24*(-x11 - x12*x5 + x21)*(x11 - x21 - x23)*sqrt(abs(x11 - x21 - x23)) - 2*x24*(chi0*x5 + x20*x25 - x22*x6)*(-chi0*x3 + chi0 + 2*e*x15*x25 - x12*x7)*sqrt(abs(x11 + x20*(cos_alpha0_p_theta0*(x14*x4 + x16) - sin_alpha0_p_theta0*(x15*x4 - x18)) - x23)))/I_Pb, 0)
 
 
 def out_contact(t, alpha, alpha_dot, p):
@@ -373,7 +416,6 @@ def out_contact(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -381,46 +423,61 @@ def out_contact(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    sin_theta0 = p[18]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
-    x7 = cos(x6)
-    x8 = sin(x5)
-    x9 = 2*e*x8
-    x10 = cos(x1)
-    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
-    x12 = -x11
-    x13 = 2*x3
-    x14 = sin(x6)
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = x10*x2
-    x18 = chi0*x13 - x14*x9 + 2*x16*x17
-    x19 = Omega_c*e
-    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*cos(x5)
-    x21 = cos(alpha)
-    x22 = 1/x21
-    x23 = sin(alpha)
-    x24 = x22*x23
-    x25 = d_x*x24
-    x26 = k_s*(L_us - d_y - x15*x22 + x25)
-    x27 = Y_e*sqrt(r_c)
-    x28 = (4/3)*x27
-    x29 = x28*(x12)*sqrt(abs(x12))
-    x30 = Omega_c*t + theta0
-    x31 = sin(alpha0)
-    x32 = cos(alpha0)
-    x33 = -chi0*x31 + e*sin(theta0) - e*sin(x30) + x16*x32
-    x34 = chi0*x32 + e*cos(theta0) - e*cos(x30) + x16*x31
-    x35 = x22 + x24
-    x36 = d_x*k_s
-    x37 = abs(x11)
-    x38 = x21**(-2)
-    return (x12, x18, -x20, x26, -x29, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*sin(alpha + x30), -x23*x29, asin(x16/sqrt(x33**2 + x34**2)) - atan2(x33, x34), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x27*x37**(5/2) + x36*(L_us*alpha - alpha*d_y - d_x*log(x21) - x15*log(x35)), alpha_dot*(-d_x*x26 - x29*(chi0 - x18)) + x20*x28*x37**(3/2)*(0.0 if x11 == 0 else copysign(1, x11)) + x36*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x25 - x15*(alpha_dot*x23*x38 + alpha_dot*(x23**2*x38 + 1))/x35), 0, 0)
+    x4 = x0*x3
+    x5 = cos(x1)
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = cos(x7)
+    x9 = 2*x3
+    x10 = x9 - 1
+    x11 = -x10
+    x12 = x11*x8
+    x13 = sin(x7)
+    x14 = 2*x13
+    x15 = x2*x5
+    x16 = x14*x15
+    x17 = x12 - x16
+    x18 = 2*x15
+    x19 = x18*x8
+    x20 = x11*x13 + x19
+    x21 = cos_alpha0_p_theta0*x17 - sin_alpha0_p_theta0*x20
+    x22 = e*x14
+    x23 = -2*chi0*x2*x5 + x21*x22 + x4
+    x24 = -x23
+    x25 = (1/2)*w_b
+    x26 = r_c + x25
+    x27 = cos_alpha0_p_theta0*x20 + sin_alpha0_p_theta0*x17
+    x28 = chi0*x9 + x18*x26 - x22*x27
+    x29 = Omega_c*e
+    x30 = -alpha_dot*chi0*x11 + alpha_dot*x0*x15 - 2*e*x13*x27*(alpha_dot + x6) + x21*x29*x8
+    x31 = cos_alpha0*x11 - sin_alpha0*x18
+    x32 = 1/x31
+    x33 = cos_alpha0*x18 + sin_alpha0*x11
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x25*x32 + x35)
+    x37 = Y_e*sqrt(r_c)
+    x38 = (4/3)*x37
+    x39 = x38*(x24)*sqrt(abs(x24))
+    x40 = 1 - 2*x13**2
+    x41 = x14*x8
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x26 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x40)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x40 - sin_theta0*x41) + sin_alpha0*x26
+    x44 = abs(chi0*x18 + x22*(cos_alpha0_p_theta0*(x10*x8 + x16) - sin_alpha0_p_theta0*(x10*x13 - x19)) - x4)
+    x45 = x32 + x34
+    x46 = d_x*k_s
+    x47 = x31**(-2)
+    return (x24, x28, -x30, x36, -x39, 0, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x29*(cos_alpha0_p_theta0*(x12*x14 + x18*x40) + sin_alpha0_p_theta0*(x11*x40 - 4*x13*x15*x8)), -x33*x39, asin(x26/sqrt(x42**2 + x43**2)) - atan2(x42, x43), (1/2)*I_Pb*alpha_dot**2 + (8/15)*x37*x44**(5/2) + x46*(L_us*alpha - alpha*d_y - d_x*log(x31) - x25*log(x45)), alpha_dot*(-d_x*x36 - x39*(chi0 - x28)) + x30*x38*x44**(3/2)*(0.0 if x23 == 0 else copysign(1, x23)) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x25*(alpha_dot*x33*x47 + alpha_dot*(x33**2*x47 + 1))/x45), 0, 0)
 
 
 def out_contact_v(t, alpha, alpha_dot, p):
@@ -451,7 +508,6 @@ def out_contact_v(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
@@ -459,47 +515,62 @@ def out_contact_v(t, alpha, alpha_dot, p):
     I_Pb = p[10]
     Y_e = p[11]
     Omega_c = p[12]
+    cos_alpha0 = p[13]
+    cos_alpha0_p_theta0 = p[14]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_alpha0_p_theta0 = p[17]
+    sin_theta0 = p[18]
     x0 = 2*r_c + w_b
     x1 = (1/2)*alpha - 1/2*alpha0
     x2 = numpy.sin(x1)
     x3 = x2**2
-    x4 = (1/2)*Omega_c
-    x5 = t*x4
-    x6 = alpha + theta0 + x5
-    x7 = numpy.cos(x6)
-    x8 = numpy.sin(x5)
-    x9 = 2*e*x8
-    x10 = numpy.cos(x1)
-    x11 = -2*chi0*x10*x2 + x0*x3 + x7*x9
-    x12 = -x11
-    x13 = 2*x3
-    x14 = numpy.sin(x6)
-    x15 = (1/2)*w_b
-    x16 = r_c + x15
-    x17 = x10*x2
-    x18 = chi0*x13 - x14*x9 + 2*x16*x17
-    x19 = Omega_c*e
-    x20 = -alpha_dot*chi0*(1 - x13) + alpha_dot*x0*x17 - 2*e*x14*x8*(alpha_dot + x4) + x19*x7*numpy.cos(x5)
-    x21 = numpy.cos(alpha)
-    x22 = x21**(-1.0)
-    x23 = numpy.sin(alpha)
-    x24 = x22*x23
-    x25 = d_x*x24
-    x26 = k_s*(L_us - d_y - x15*x22 + x25)
-    x27 = Y_e*numpy.sqrt(r_c)
-    x28 = (4/3)*x27
-    x29 = x28*(x12)*numpy.sqrt(numpy.abs(x12))
-    x30 = Omega_c*t + theta0
-    x31 = numpy.sin(alpha0)
-    x32 = numpy.cos(alpha0)
-    x33 = -chi0*x31 + e*numpy.sin(theta0) - e*numpy.sin(x30) + x16*x32
-    x34 = chi0*x32 + e*numpy.cos(theta0) - e*numpy.cos(x30) + x16*x31
-    x35 = x22 + x24
-    x36 = d_x*k_s
-    x37 = abs(x11)
-    x38 = x21**(-2.0)
+    x4 = x0*x3
+    x5 = numpy.cos(x1)
+    x6 = (1/2)*Omega_c
+    x7 = t*x6
+    x8 = numpy.cos(x7)
+    x9 = 2*x3
+    x10 = x9 - 1
+    x11 = -x10
+    x12 = x11*x8
+    x13 = numpy.sin(x7)
+    x14 = 2*x13
+    x15 = x2*x5
+    x16 = x14*x15
+    x17 = x12 - x16
+    x18 = 2*x15
+    x19 = x18*x8
+    x20 = x11*x13 + x19
+    x21 = cos_alpha0_p_theta0*x17 - sin_alpha0_p_theta0*x20
+    x22 = e*x14
+    x23 = -2*chi0*x2*x5 + x21*x22 + x4
+    x24 = -x23
+    x25 = (1/2)*w_b
+    x26 = r_c + x25
+    x27 = cos_alpha0_p_theta0*x20 + sin_alpha0_p_theta0*x17
+    x28 = chi0*x9 + x18*x26 - x22*x27
+    x29 = Omega_c*e
+    x30 = -alpha_dot*chi0*x11 + alpha_dot*x0*x15 - 2*e*x13*x27*(alpha_dot + x6) + x21*x29*x8
+    x31 = cos_alpha0*x11 - sin_alpha0*x18
+    x32 = x31**(-1.0)
+    x33 = cos_alpha0*x18 + sin_alpha0*x11
+    x34 = x32*x33
+    x35 = d_x*x34
+    x36 = k_s*(L_us - d_y - x25*x32 + x35)
+    x37 = Y_e*numpy.sqrt(r_c)
+    x38 = (4/3)*x37
+    x39 = x38*(x24)*numpy.sqrt(numpy.abs(x24))
+    x40 = 1 - 2*x13**2
+    x41 = x14*x8
+    x42 = -chi0*sin_alpha0 + cos_alpha0*x26 + e*sin_theta0 - e*(cos_theta0*x41 + sin_theta0*x40)
+    x43 = chi0*cos_alpha0 + cos_theta0*e - e*(cos_theta0*x40 - sin_theta0*x41) + sin_alpha0*x26
+    x44 = abs(chi0*x18 + x22*(cos_alpha0_p_theta0*(x10*x8 + x16) - sin_alpha0_p_theta0*(x10*x13 - x19)) - x4)
+    x45 = x32 + x34
+    x46 = d_x*k_s
+    x47 = x31**(-2.0)
     _zero = numpy.zeros(numpy.broadcast(t, alpha, alpha_dot).shape)
-    return (x12 + _zero, x18 + _zero, -x20 + _zero, x26 + _zero, -x29 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x19*numpy.sin(alpha + x30) + _zero, -x23*x29 + _zero, numpy.arcsin(x16/numpy.sqrt(x33**2 + x34**2)) - numpy.arctan2(x33, x34) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x27*x37**(5/2) + x36*(L_us*alpha - alpha*d_y - d_x*numpy.log(x21) - x15*numpy.log(x35)) + _zero, alpha_dot*(-d_x*x26 - x29*(chi0 - x18)) + x20*x28*x37**(3/2)*numpy.sign(x11) + x36*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x25 - x15*(alpha_dot*x23*x38 + alpha_dot*(x23**2*x38 + 1))/x35) + _zero, 0 + _zero, 0 + _zero)
+    return (x24 + _zero, x28 + _zero, -x30 + _zero, x36 + _zero, -x39 + _zero, 0 + _zero, -Omega_c*r_c + (1/2)*alpha_dot*w_b - x29*(cos_alpha0_p_theta0*(x12*x14 + x18*x40) + sin_alpha0_p_theta0*(x11*x40 - 4*x13*x15*x8)) + _zero, -x33*x39 + _zero, numpy.arcsin(x26/numpy.sqrt(x42**2 + x43**2)) - numpy.arctan2(x42, x43) + _zero, (1/2)*I_Pb*alpha_dot**2 + (8/15)*x37*x44**(5/2) + x46*(L_us*alpha - alpha*d_y - d_x*numpy.log(x31) - x25*numpy.log(x45)) + _zero, alpha_dot*(-d_x*x36 - x39*(chi0 - x28)) + x30*x38*x44**(3/2)*numpy.sign(x23) + x46*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x35 - x25*(alpha_dot*x33*x47 + alpha_dot*(x33**2*x47 + 1))/x45) + _zero, 0 + _zero, 0 + _zero)
 
 
 def gap(t, alpha, alpha_dot, p):
@@ -518,12 +589,20 @@ def gap(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[12]
+    cos_alpha0_p_theta0 = p[14]
+    sin_alpha0_p_theta0 = p[17]
     x0 = (1/2)*alpha - 1/2*alpha0
     x1 = sin(x0)
-    x2 = (1/2)*Omega_c*t
-    return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+    x2 = x1**2
+    x3 = cos(x0)
+    x4 = (1/2)*Omega_c*t
+    x5 = cos(x4)
+    x6 = 1 - 2*x2
+    x7 = sin(x4)
+    x8 = 2*x7
+    x9 = x1*x3
+    return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
 
 
 def gap_rate(t, alpha, alpha_dot, p):
@@ -542,14 +621,20 @@ def gap_rate(t, alpha, alpha_dot, p):
     w_b = p[2]
     chi0 = p[3]
     alpha0 = p[4]
-    theta0 = p[5]
     Omega_c = p[12]
-    x0 = (1/2)*Omega_c
-    x1 = t*x0
-    x2 = alpha + theta0 + x1
-    x3 = (1/2)*alpha - 1/2*alpha0
-    x4 = sin(x3)
-    return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+    cos_alpha0_p_theta0 = p[14]
+    sin_alpha0_p_theta0 = p[17]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = 1 - 2*x1**2
+    x3 = x1*cos(x0)
+    x4 = (1/2)*Omega_c
+    x5 = t*x4
+    x6 = cos(x5)
+    x7 = sin(x5)
+    x8 = x2*x6 - 2*x3*x7
+    x9 = x2*x7 + 2*x3*x6
+    return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
 
 
 def static_moment(alpha, p):
@@ -574,30 +659,32 @@ def static_moment(alpha, p):
     L_us = p[8]
     k_s = p[9]
     Y_e = p[11]
-    x0 = cos(alpha)
-    x1 = 1/x0
-    x2 = (1/2)*w_b
-    x3 = sin(alpha)
-    x4 = d_x*k_s
-    x5 = (1/2)*alpha - 1/2*alpha0
-    x6 = sin(x5)
-    x7 = x6**2
-    x8 = 2*x7
-    x9 = r_c + x2
-    x10 = x6*cos(x5)
-    x11 = 2*x10
-    x12 = chi0*x8 + x11*x9
-    x13 = chi0 - x12
-    x14 = 2*r_c + w_b
-    x15 = chi0*x11
-    x16 = -x14*x7 + x15
-    x17 = sqrt(r_c)
-    x18 = (4/3)*Y_e*x17
-    x19 = x18*(x16)*sqrt(abs(x16))
-    x20 = x0**(-2)
-    x21 = 1 - x8
-    x22 = sqrt(abs(x16))
-    return (-x13*x19 - x4*(L_us + d_x*x1*x3 - d_y - x1*x2), -2*Y_e*x13*x17*x22*(chi0*x21 - x10*x14) - x19*(-x15 - x21*x9) - x4*(d_x*(x20*x3**2 + 1) - x2*x20*x3), x16, x12, x18*x22)
+    cos_alpha0 = p[13]
+    sin_alpha0 = p[16]
+    x0 = (1/2)*alpha - 1/2*alpha0
+    x1 = sin(x0)
+    x2 = x1**2
+    x3 = 2*x2
+    x4 = (1/2)*w_b
+    x5 = r_c + x4
+    x6 = x1*cos(x0)
+    x7 = 2*x6
+    x8 = chi0*x3 + x5*x7
+    x9 = chi0 - x8
+    x10 = 2*r_c + w_b
+    x11 = chi0*x7
+    x12 = -x10*x2 + x11
+    x13 = sqrt(r_c)
+    x14 = (4/3)*Y_e*x13
+    x15 = x14*(x12)*sqrt(abs(x12))
+    x16 = 1 - x3
+    x17 = cos_alpha0*x16 - sin_alpha0*x7
+    x18 = 1/x17
+    x19 = cos_alpha0*x7 + sin_alpha0*x16
+    x20 = d_x*k_s
+    x21 = sqrt(abs(x12))
+    x22 = x17**(-2)
+    return (-x15*x9 - x20*(L_us + d_x*x18*x19 - d_y - x18*x4), -2*Y_e*x13*x21*x9*(chi0*x16 - x10*x6) - x15*(-x11 - x16*x5) - x20*(d_x*(x19**2*x22 + 1) - x19*x22*x4), x12, x8, x14*x21)
 
 
 def reach(Theta, p):
@@ -613,12 +700,12 @@ def reach(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
-    x0 = cos(alpha0)
-    x1 = sin(alpha0)
-    x2 = r_c + (1/2)*w_b
-    return -x2 + sqrt((chi0*x0 - e*cos(Theta) + e*cos(theta0) + x1*x2)**2 + (-chi0*x1 - e*sin(Theta) + e*sin(theta0) + x0*x2)**2)
+    cos_alpha0 = p[13]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_theta0 = p[18]
+    x0 = r_c + (1/2)*w_b
+    return -x0 + sqrt((chi0*cos_alpha0 + cos_theta0*e - e*cos(Theta) + sin_alpha0*x0)**2 + (-chi0*sin_alpha0 + cos_alpha0*x0 + e*sin_theta0 - e*sin(Theta))**2)
 
 
 def rigid_contact(Theta, p):
@@ -637,39 +724,38 @@ def rigid_contact(Theta, p):
     e = p[1]
     w_b = p[2]
     chi0 = p[3]
-    alpha0 = p[4]
-    theta0 = p[5]
     d_x = p[6]
     d_y = p[7]
     L_us = p[8]
     k_s = p[9]
-    x0 = sin(alpha0)
-    x1 = sin(Theta)
-    x2 = e*x1
-    x3 = cos(alpha0)
-    x4 = (1/2)*w_b
-    x5 = r_c + x4
-    x6 = chi0*x0 - e*sin(theta0) + x2 - x3*x5
-    x7 = -x6
-    x8 = cos(Theta)
-    x9 = e*x8
-    x10 = chi0*x3 + e*cos(theta0) + x0*x5 - x9
-    x11 = x10**2 + x7**2
-    x12 = asin(x5/sqrt(x11)) - atan2(x7, x10)
-    x13 = 1/x11
-    x14 = x10*x9
-    x15 = x13*x6
-    x16 = x7*x9
-    x17 = x10*x2
-    x18 = x16 - x17
-    x19 = -x13*x5**2 + 1
-    x20 = 1/sqrt(x19)
-    x21 = x20*x5/x11**(3/2)
-    x22 = 2*x16 - 2*x17
-    x23 = x22/x11**2
-    x24 = e**2
-    x25 = 1/cos(x12)
-    return (x12, x13*x14 - x15*x2 + x18*x21, -x13*x17 + x14*x23 - x15*x9 - x2*x23*x6 + x21*(-x1**2*x24 - x14 - x2*x7 - x24*x8**2) + x18*x20*x5*(3*x16 - 3*x17)/x11**(5/2) + (1/2)*x18*x22*x5**3/(x11**(7/2)*x19**(3/2)), d_x*k_s*(L_us + d_x*x25*sin(x12) - d_y - x25*x4))
+    cos_alpha0 = p[13]
+    cos_theta0 = p[15]
+    sin_alpha0 = p[16]
+    sin_theta0 = p[18]
+    x0 = sin(Theta)
+    x1 = e*x0
+    x2 = (1/2)*w_b
+    x3 = r_c + x2
+    x4 = chi0*sin_alpha0 - cos_alpha0*x3 - e*sin_theta0 + x1
+    x5 = -x4
+    x6 = cos(Theta)
+    x7 = e*x6
+    x8 = chi0*cos_alpha0 + cos_theta0*e + sin_alpha0*x3 - x7
+    x9 = x5**2 + x8**2
+    x10 = asin(x3/sqrt(x9)) - atan2(x5, x8)
+    x11 = 1/x9
+    x12 = x7*x8
+    x13 = x11*x4
+    x14 = x1*x8
+    x15 = e*x5*x6 - x14
+    x16 = -x11*x3**2 + 1
+    x17 = 1/sqrt(x16)
+    x18 = x17*x3/x9**(3/2)
+    x19 = 2*e*x5*x6 - 2*x14
+    x20 = x19/x9**2
+    x21 = e**2
+    x22 = 1/cos(x10)
+    return (x10, -x1*x13 + x11*x12 + x15*x18, -x1*x20*x4 - x11*x14 + x12*x20 - x13*x7 + x15*x17*x3*(3*e*x5*x6 - 3*x14)/x9**(5/2) + (1/2)*x15*x19*x3**3/(x16**(3/2)*x9**(7/2)) + x18*(-x0**2*x21 - x1*x5 - x12 - x21*x6**2), d_x*k_s*(L_us + d_x*x22*sin(x10) - d_y - x2*x22))
 
 
 def spring_potential(alpha, p):
@@ -724,7 +810,6 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
@@ -732,16 +817,25 @@ def rhs_index(r, t, alpha, alpha_dot, p):
         I_Pb = p[10]
         Y_e = p[11]
         Omega_c = p[12]
-        x0 = 1/cos(alpha)
-        x1 = (1/2)*w_b
-        x2 = (1/2)*alpha - 1/2*alpha0
-        x3 = sin(x2)
-        x4 = x3**2
-        x5 = (1/2)*Omega_c*t
-        x6 = sin(x5)
-        x7 = alpha + theta0 + x5
-        x8 = cos(x2)
-        return (-4/3*Y_e*sqrt(r_c)*(-2*chi0*x4 + chi0 + 2*e*x6*sin(x7) - 2*x3*x8*(r_c + x1))*(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))*sqrt(abs(2*chi0*x3*x8 - 2*e*x6*cos(x7) - x4*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x0*sin(alpha) - d_y - x0*x1))/I_Pb
+        cos_alpha0 = p[13]
+        cos_alpha0_p_theta0 = p[14]
+        sin_alpha0 = p[16]
+        sin_alpha0_p_theta0 = p[17]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = 1 - x3
+        x5 = cos(x0)
+        x6 = 2*x1*x5
+        x7 = 1/(cos_alpha0*x4 - sin_alpha0*x6)
+        x8 = (1/2)*w_b
+        x9 = (1/2)*Omega_c*t
+        x10 = sin(x9)
+        x11 = cos(x9)
+        x12 = x10*x4 + x11*x6
+        x13 = -x10*x6 + x11*x4
+        return (-4/3*Y_e*sqrt(r_c)*(-chi0*x3 + chi0 + 2*e*x10*(cos_alpha0_p_theta0*x12 + sin_alpha0_p_theta0*x13) - x6*(r_c + x8))*(2*chi0*x1*x5 - 2*e*x10*(cos_alpha0_p_theta0*x13 - sin_alpha0_p_theta0*x12) - x2*(2*r_c + w_b))*sqrt(abs(2*chi0*x1*x5 - 2*e*x10*(cos_alpha0_p_theta0*x13 - sin_alpha0_p_theta0*x12) - x2*(2*r_c + w_b))) - d_x*k_s*(L_us + d_x*x7*(cos_alpha0*x6 + sin_alpha0*x4) - d_y - x7*x8))/I_Pb
     return nan
 
 
@@ -765,12 +859,20 @@ def surface_index(k, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[12]
+        cos_alpha0_p_theta0 = p[14]
+        sin_alpha0_p_theta0 = p[17]
         x0 = (1/2)*alpha - 1/2*alpha0
         x1 = sin(x0)
-        x2 = (1/2)*Omega_c*t
-        return 2*chi0*x1*cos(x0) - 2*e*sin(x2)*cos(alpha + theta0 + x2) - x1**2*(2*r_c + w_b)
+        x2 = x1**2
+        x3 = cos(x0)
+        x4 = (1/2)*Omega_c*t
+        x5 = cos(x4)
+        x6 = 1 - 2*x2
+        x7 = sin(x4)
+        x8 = 2*x7
+        x9 = x1*x3
+        return 2*chi0*x1*x3 - e*x8*(cos_alpha0_p_theta0*(x5*x6 - x8*x9) - sin_alpha0_p_theta0*(2*x5*x9 + x6*x7)) - x2*(2*r_c + w_b)
     return nan
 
 
@@ -794,14 +896,20 @@ def aux_index(j, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         Omega_c = p[12]
-        x0 = (1/2)*Omega_c
-        x1 = t*x0
-        x2 = alpha + theta0 + x1
-        x3 = (1/2)*alpha - 1/2*alpha0
-        x4 = sin(x3)
-        return -Omega_c*e*cos(x1)*cos(x2) + alpha_dot*chi0*(1 - 2*x4**2) - alpha_dot*x4*(2*r_c + w_b)*cos(x3) + 2*e*(alpha_dot + x0)*sin(x1)*sin(x2)
+        cos_alpha0_p_theta0 = p[14]
+        sin_alpha0_p_theta0 = p[17]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = 1 - 2*x1**2
+        x3 = x1*cos(x0)
+        x4 = (1/2)*Omega_c
+        x5 = t*x4
+        x6 = cos(x5)
+        x7 = sin(x5)
+        x8 = x2*x6 - 2*x3*x7
+        x9 = x2*x7 + 2*x3*x6
+        return -Omega_c*e*x6*(cos_alpha0_p_theta0*x8 - sin_alpha0_p_theta0*x9) + alpha_dot*chi0*x2 - alpha_dot*x3*(2*r_c + w_b) + 2*e*x7*(alpha_dot + x4)*(cos_alpha0_p_theta0*x9 + sin_alpha0_p_theta0*x8)
     return nan
 
 
@@ -836,38 +944,49 @@ def power_index(c, t, alpha, alpha_dot, p):
         w_b = p[2]
         chi0 = p[3]
         alpha0 = p[4]
-        theta0 = p[5]
         d_x = p[6]
         d_y = p[7]
         L_us = p[8]
         k_s = p[9]
         Y_e = p[11]
         Omega_c = p[12]
-        x0 = sin(alpha)
-        x1 = cos(alpha)
-        x2 = 1/x1
-        x3 = x0*x2
-        x4 = d_x*x3
-        x5 = x1**(-2)
-        x6 = (1/2)*w_b
-        x7 = d_x*k_s
-        x8 = (1/2)*alpha - 1/2*alpha0
-        x9 = sin(x8)
-        x10 = x9**2
-        x11 = 2*x10
-        x12 = (1/2)*Omega_c
-        x13 = t*x12
-        x14 = sin(x13)
-        x15 = alpha + theta0 + x13
-        x16 = sin(x15)
-        x17 = cos(x8)
-        x18 = x17*x9
-        x19 = 2*r_c + w_b
-        x20 = cos(x15)
-        x21 = 2*e*x14
-        x22 = -2*chi0*x17*x9 + x10*x19 + x20*x21
-        x23 = (4/3)*Y_e*sqrt(r_c)
-        return alpha_dot*(-x23*(-chi0*x11 + chi0 + 2*e*x14*x16 - 2*x18*(r_c + x6))*(-x22)*sqrt(abs(-x22)) - x7*(L_us - d_y - x2*x6 + x4)) + x23*(Omega_c*e*x20*cos(x13) - alpha_dot*chi0*(1 - x11) + alpha_dot*x18*x19 - x16*x21*(alpha_dot + x12))*abs(x22)**(3/2)*(0.0 if x22 == 0 else copysign(1, x22)) + x7*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x4 - x6*(alpha_dot*x0*x5 + alpha_dot*(x0**2*x5 + 1))/(x2 + x3))
+        cos_alpha0 = p[13]
+        cos_alpha0_p_theta0 = p[14]
+        sin_alpha0 = p[16]
+        sin_alpha0_p_theta0 = p[17]
+        x0 = (1/2)*alpha - 1/2*alpha0
+        x1 = sin(x0)
+        x2 = x1**2
+        x3 = 2*x2
+        x4 = x3 - 1
+        x5 = -x4
+        x6 = cos(x0)
+        x7 = x1*x6
+        x8 = 2*x7
+        x9 = cos_alpha0*x8 + sin_alpha0*x5
+        x10 = cos_alpha0*x5 - sin_alpha0*x8
+        x11 = 1/x10
+        x12 = x11*x9
+        x13 = d_x*x12
+        x14 = x10**(-2)
+        x15 = (1/2)*w_b
+        x16 = d_x*k_s
+        x17 = (1/2)*Omega_c
+        x18 = t*x17
+        x19 = sin(x18)
+        x20 = cos(x18)
+        x21 = x20*x8
+        x22 = x19*x5 + x21
+        x23 = x19*x8
+        x24 = x20*x5 - x23
+        x25 = cos_alpha0_p_theta0*x22 + sin_alpha0_p_theta0*x24
+        x26 = 2*r_c + w_b
+        x27 = x2*x26
+        x28 = cos_alpha0_p_theta0*x24 - sin_alpha0_p_theta0*x22
+        x29 = 2*e*x19
+        x30 = -2*chi0*x1*x6 + x27 + x28*x29
+        x31 = (4/3)*Y_e*sqrt(r_c)
+        return alpha_dot*(-x16*(L_us - d_y - x11*x15 + x13) - x31*(-chi0*x3 + chi0 + 2*e*x19*x25 - x8*(r_c + x15))*(-x30)*sqrt(abs(-x30))) + x16*(L_us*alpha_dot - alpha_dot*d_y + alpha_dot*x13 - x15*(alpha_dot*x14*x9 + alpha_dot*(x14*x9**2 + 1))/(x11 + x12)) + x31*(Omega_c*e*x20*x28 - alpha_dot*chi0*x5 + alpha_dot*x26*x7 - x25*x29*(alpha_dot + x17))*abs(chi0*x8 - x27 + x29*(cos_alpha0_p_theta0*(x20*x4 + x23) - sin_alpha0_p_theta0*(x19*x4 - x21)))**(3/2)*(0.0 if x30 == 0 else copysign(1, x30))
     elif c == 4:
         return 0
     elif c == 5:

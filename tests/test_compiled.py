@@ -86,12 +86,31 @@ def test_oscillating_cam_agrees_with_scipy():
 def test_coulomb_stick_slip_agrees_with_scipy():
     """Section 7.2's oscillating cam at its first reversal (e = 0.7 r_c, preloaded so contact
     holds): both backends stick (Filippov mode on v_r = 0) and slip again at the same times,
-    and sample the same regimes, including the stick mode's."""
+    and sample the same friction states, including the stick mode's.
+
+    The damping law's switches (surface 'loading', psi_i_dot = 0) are not compared one by
+    one: in this run psi_i_dot hovers near -4e-9 m/s, at the integration's noise level, and
+    some of its zero touches come in pairs whose existence and spacing depend on rounding
+    (measured: one pair 0 s apart on the SciPy backend, 9.7 us apart compiled, absent from a
+    SciPy run at rtol 1e-13).  The law they switch multiplies psi_i_dot, so the motion does
+    not see them: alpha and v_r are compared at every sample."""
     rig = RIG.replace(e=0.7 * RIG.r_c, L_us=0.2)
     scene = camdyn.Scene(damping="D", friction="coulomb", motion="oscillating")
     a, b = _both(scene, camdyn.Oscillating(math.pi, 40), rig=rig, t_end=0.41, sample_rate_Hz=50_000, **TIGHT)
     assert any(s.after.endswith("_stick") for s in a.switches)
-    _assert_agree(a, b, alpha_tol=1e-9, t_tol=1e-7)
+    assert a.outcome == b.outcome
+
+    def friction(res):
+        return [s for s in res.switches if s.surface != "loading"]
+
+    def sliding(names):  # the friction part of a regime name: fwd, bwd or stick
+        return [str(n).rsplit("_", 1)[-1] for n in names]
+    fa, fb = friction(a), friction(b)
+    assert [(s.surface, sliding([s.before, s.after])) for s in fa] == \
+        [(s.surface, sliding([s.before, s.after])) for s in fb]
+    np.testing.assert_allclose([s.t for s in fb], [s.t for s in fa], rtol=0, atol=1e-7)
+    assert sliding(a.regime) == sliding(b.regime)
+    np.testing.assert_allclose(b.alpha, a.alpha, rtol=0, atol=1e-9)
     np.testing.assert_allclose(b.v_r, a.v_r, rtol=0, atol=1e-9)
 
 
@@ -201,6 +220,33 @@ def test_micro_hop_between_samples_is_caught_by_the_gap_rate():
     assert caught[0] == engine.SUCCESS and caught[2].shape[0] >= 2
     assert caught[2][0, 0] == pytest.approx(root, abs=1e-12)
     assert caught[2][0, 2:4].tolist() == [0, 1]
+
+
+@pytest.mark.parametrize("cubic, most", [((1e-2, 0.5e-2, 0.3e-2), 10), ((3e-2, -2e-2, 1e-2), 10),
+                                          ((0.0, 0.0, 1.0), 20)])
+def test_root_is_located_superlinearly_on_the_far_side(cubic, most):
+    """engine's locate on a step's interpolant: the toy gap is alpha(theta) = -1e-6 + h theta
+    (q0 + q1 theta + q2 theta^2) over a step of h = 1e-4 s.  The root is returned on the far
+    side, within xtol = 1e-14 s of the root (found by 200 bisections), in few evaluations:
+    bisection alone needs log2(1e-4 / 1e-14) = 33.  Simple roots: <= 10 (8 measured); a
+    strongly curved gap (theta^3, where false position is slowest): <= 20 (16 measured)."""
+    from camdyn.compiled.events import locate
+    tab = (np.array([[0], [1]], dtype=np.int64), np.array([-1], dtype=np.int64),
+           np.array([-1, 0, 1], dtype=np.int64), np.array([-1, -1], dtype=np.int64))
+    fns = (_toy_rhs, _toy_gap, _toy_rate, _toy_rate)
+    h, y0 = 1e-4, -1e-6
+    Q = np.zeros((2, 7))
+    Q[0, :3] = cubic
+
+    def gap(theta):
+        return y0 + h * theta * (cubic[0] + cubic[1] * theta + cubic[2] * theta ** 2)
+    t, evaluations = locate(fns, tab, 2, 1, 0, 0.0, h, y0, 0.0, Q, np.zeros(3), 0.0, h, y0, gap(1.0), 1e-14)
+    lo, hi = 0.0, 1.0
+    for _ in range(200):
+        lo, hi = (0.5 * (lo + hi), hi) if gap(0.5 * (lo + hi)) < 0 else (lo, 0.5 * (lo + hi))
+    assert gap(t / h) >= 0.0  # far side
+    assert abs(t - hi * h) <= 1e-14
+    assert evaluations <= most
 
 
 # --- trap 3: ping-pong when restarting exactly on the surface ------------------------------

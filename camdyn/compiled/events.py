@@ -46,30 +46,46 @@ def value_on_step(fns, tab, nr, r, k, tt, t, h, y0, y1, Q, p):
 
 @njit(cache=True)
 def locate(fns, tab, nr, r, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
-    """Root of value k on the interpolant in (ta, tb], returned on the far side.
+    """Root of value k on the interpolant in (ta, tb], returned on the far side; and the
+    number of values computed.
 
     ga = g(ta) != 0 and gb = g(tb) of the other sign or 0.  Illinois false position keeps
-    a bracket [lo, hi] with g(lo) on ga's side and g(hi) not; a bisection replaces any
-    iteration that fails to shrink the bracket by 5 %.  Returns hi once
+    a bracket [lo, hi] with g(lo) on ga's side and g(hi) not, halving the value of an end
+    kept twice in a row.  A trial point is kept at least half the tolerance inside the
+    bracket, so that when the estimate lands next to the root, the next value closes the
+    bracket from the other side (Brent's rule; superlinear to the end, where pushing the
+    trial point to the midpoint would fall back to bisection).  If three iterations together
+    fail to halve the bracket, the next one bisects.  Returns hi once
     hi - lo <= xtol max(1, |hi|).
     """
     if gb == 0.0:
-        return tb
+        return tb, 0
     lo, hi, glo, ghi = ta, tb, ga, gb
     near = 1.0 if ga > 0.0 else -1.0
     kept = 0  # +1: lo kept twice in a row, -1: hi kept twice in a row
+    evaluations = 0
+    w3, w2, w1 = math.inf, math.inf, math.inf  # the bracket's widths 3, 2 and 1 iterations ago
     for _ in range(400):
         width = hi - lo
-        if width <= xtol * max(1.0, abs(hi)):
+        tol = xtol * max(1.0, abs(hi))
+        if width <= tol:
             break
-        tm = hi - ghi * width / (ghi - glo)
-        if not (lo < tm < hi) or abs(tm - lo) < 0.05 * width or abs(hi - tm) < 0.05 * width:
+        if 2.0 * width > w3:
             tm = 0.5 * (lo + hi)
-            if not (lo < tm < hi):
-                break
+        else:
+            tm = hi - ghi * width / (ghi - glo)
+            margin = 0.5 * tol
+            if not tm >= lo + margin:  # also a NaN estimate
+                tm = lo + margin
+            if not tm <= hi - margin:
+                tm = hi - margin
+        if not (lo < tm < hi):
+            break
+        w3, w2, w1 = w2, w1, width
         g = value_on_step(fns, tab, nr, r, k, tm, t, h, y0, y1, Q, p)
+        evaluations += 1
         if g == 0.0:
-            return tm
+            return tm, evaluations
         if g * near > 0.0:
             lo, glo = tm, g
             if kept == -1:
@@ -80,14 +96,14 @@ def locate(fns, tab, nr, r, k, t, h, y0, y1, Q, p, ta, tb, ga, gb, xtol):
             if kept == 1:
                 glo *= 0.5
             kept = 1
-    return hi
+    return hi, evaluations
 
 
 @njit(cache=True)
 def extremum(fns, tab, nr, r, t, h, y0, y1, Q, p, ta, tb, ra, rb):
     """(t, gap) where the gap rate (ra at ta, rb at tb, of opposite signs) changes sign."""
     k_rate = tab[1].shape[0] + GAP_RATE
-    t_ext = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
+    t_ext, _ = locate(fns, tab, nr, r, k_rate, t, h, y0, y1, Q, p, ta, tb, ra, rb, 1e-15)
     return t_ext, value_on_step(fns, tab, nr, r, 0, t_ext, t, h, y0, y1, Q, p)
 
 
@@ -127,7 +143,7 @@ def turned_back(fns, tab, nr, r, direction, t, h, y0, y1, Q, p, ta, tb, ga, ra, 
     return ta, ga, True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interior, xtol, rate_check,
                    rate_flag, have_start, g_prev, r_prev, g_next):
     """Earliest crossing of any watched value over the step [t0, t1].
@@ -189,14 +205,14 @@ def first_crossing(fns, tab, nr, r, dirs, t0, t1, y0, y1, n0, n1, Q, p, n_interi
                                                    g_prev[0], r_prev[0], rb)
                     r_prev[0] = rb
                 if genuine:
-                    tk = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, lo, tb, glo, g_next[k], xtol)
+                    tk, _ = locate(fns, tab, nr, r, k, t0, h, y0, y1, Q, p, lo, tb, glo, g_next[k], xtol)
             elif k == 0 and rate:
                 rb = value(fns, tab, nr, r, nv - 1, tb, a, ad, p)
                 rb_known = True
                 t_ext, g_ext = hidden_excursion(fns, tab, nr, r, dirs[0], t0, h, y0, y1, Q, p, ta, tb,
                                                 g_prev[0], r_prev[0], rb)
                 if t_ext >= 0.0:
-                    tk = locate(fns, tab, nr, r, 0, t0, h, y0, y1, Q, p, ta, t_ext, g_prev[0], g_ext, xtol)
+                    tk, _ = locate(fns, tab, nr, r, 0, t0, h, y0, y1, Q, p, ta, t_ext, g_prev[0], g_ext, xtol)
                 r_prev[0] = rb
             if tk >= 0.0:
                 found |= 1 << k

@@ -169,7 +169,8 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
                         k = left_at_start(fns, tab, nr, r, dirs, t, t_new, y0, y1, n0, n1, p)
                         t_cross = t if k >= 0 else t_new
                 have_start = True
-            i_sample = sample(fns, tab, nr, p, t_eval, i_sample, t_cross, t, h, y0, y1, Q, r, out_y, out_r, w, wq)
+            if i_sample < t_eval.shape[0] and t_eval[i_sample] <= t_cross:
+                i_sample = sample(fns, tab, nr, p, t_eval, i_sample, t_cross, t, h, y0, y1, Q, r, out_y, out_r, w, wq)
             if ledger:
                 accumulate(fns, tab, nr, r, t, h, y0, y1, Q, p, t, t_cross, w)
             h_last = h

@@ -148,6 +148,8 @@ def initial_step(fns, nr, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol
         h0 = 1e-6
     else:
         h0 = 0.01 * d0 / d1
+    if not h0 > 0.0:  # an overflowing field (d1 = inf or NaN): SciPy's estimate is 0 too
+        return 0.0
     h0 = min(h0, length)
     z0 = y0 + h0 * y1
     z1 = y1 + h0 * f1

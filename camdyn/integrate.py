@@ -9,6 +9,7 @@ leaves the current regime, keeps a restart from triggering itself again.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -23,6 +24,10 @@ from .outcome import Outcome
 
 METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF, "LSODA": LSODA}
 _IMPLICIT = {"Radau", "BDF", "LSODA"}
+_EXPLICIT = (DOP853, RK45, RK23)
+#: steps in a row that may end short of a crossing their interpolant placed early (_state_at_crossing;
+#: as camdyn.compiled.engine.MAX_RETRIES)
+MAX_RETRIES = 1
 #: this many switches with no progress in time (relative 1e-9) is chatter, not dynamics
 CHATTER_SWITCHES = 20
 
@@ -109,6 +114,34 @@ class _Sampler:
         return np.concatenate(self.t), np.concatenate(self.y, axis=1), np.concatenate(self.names)
 
 
+def _rk_state(solver, fun, t: float, y: np.ndarray, f: np.ndarray, h: float) -> np.ndarray:
+    """One step of size h of the solver's explicit Runge-Kutta tableau from (t, y), f = fun(t, y)."""
+    K = np.empty((solver.n_stages, y.size))
+    K[0] = f
+    for s in range(1, solver.n_stages):
+        K[s] = fun(t + solver.C[s] * h, y + h * (K[:s].T @ solver.A[s, :s]))
+    return y + h * (K.T @ solver.B)
+
+
+def _state_at_crossing(crossing: Crossing, solver, fun, t0: float, y0: np.ndarray, f0: np.ndarray):
+    """The state at a crossing located inside an explicit Runge-Kutta step from (t0, y0): one
+    step of the method of size crossing.t - t0, not the interpolant (whose error, an order
+    lower and larger at loose tolerances, would be carried into the next regime at every
+    switch).  Returns (state, across): across is False when that state is not yet across the
+    surface -- the interpolant's error put the root early -- and the run may go on in the same
+    regime from there (up to MAX_RETRIES steps in a row; then integrate() takes the
+    interpolant's state, across by construction).  A state that is not finite gives the interpolant's.
+    camdyn.compiled.engine.state_at_crossing is the compiled twin."""
+    y = _rk_state(solver, fun, t0, y0, f0, crossing.t - t0)
+    g, direction = crossing.event.fn(crossing.t, y), crossing.event.direction
+    if not (np.all(np.isfinite(y)) and math.isfinite(g)):
+        return crossing.y, True  # unusable: the interpolant's state, across by construction
+    if direction == 0:
+        g0 = crossing.event.fn(t0, y0)
+        return y, g0 == 0 or g * g0 <= 0
+    return y, direction * g >= 0
+
+
 def _solver(options: SolverOptions, regime, t, y, t_end, h):
     kwargs = dict(rtol=options.rtol, atol=options.atol, max_step=options.max_step)
     if options.method in _IMPLICIT:
@@ -135,6 +168,7 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     keys: dict[str, tuple] = {}
     stats = {"nfev": 0, "njev": 0, "steps": 0}
     outcome, h, recent = Outcome.SUCCESS, None, []
+    retries = 0  # steps in a row that ended short of a crossing their interpolant placed early
     contact_time_scale = 0.1 / model.equilibrium.vartheta  # s: a tenth of a radian of the contact mode
 
     while t < t_end and outcome is Outcome.SUCCESS:
@@ -143,8 +177,10 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
         if h is not None and switches and switches[-1].before == "free":
             h = min(h, contact_time_scale)  # a free-flight step would blow up the stiff contact
         solver = _solver(options, regime, t, y, t_end, h)
-        crossing = None
+        crossing = not_yet = None
+        explicit = isinstance(solver, _EXPLICIT)
         while solver.status == "running":
+            f_old = solver.f if explicit else None
             solver.step()
             if solver.status == "failed":
                 outcome = Outcome.STEP_FAILED
@@ -158,9 +194,17 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
             if regime.events:
                 crossing = (first_crossing(regime.events, dense, t_old, t_new, y, y_new, options.events)
                             or _left_the_surface(regime.events, t_old, y, t_new, y_new))
-            sampler.take(dense, crossing.t if crossing else t_new, regime.name)
+            if crossing and explicit and t_old < crossing.t < t_new:
+                y_cross, across = _state_at_crossing(crossing, solver, regime.fun, t_old, y, f_old)
+                stats["nfev"] += solver.n_stages - 1
+                if across:
+                    crossing = dataclasses.replace(crossing, y=y_cross)
+                elif retries < MAX_RETRIES:
+                    crossing, not_yet = None, (crossing.t, y_cross)
+            retries = retries + 1 if not_yet else 0
+            sampler.take(dense, crossing.t if crossing else not_yet[0] if not_yet else t_new, regime.name)
             h = abs(t_new - t_old)
-            if crossing:
+            if crossing or not_yet:
                 break
             t, y = t_new, y_new
             if abs(y[0]) > ANGLE_LIMIT:
@@ -168,7 +212,9 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
                 break
         stats["nfev"] += solver.nfev
         stats["njev"] += getattr(solver, "njev", 0)
-        if crossing and outcome is Outcome.SUCCESS:
+        if not_yet and outcome is Outcome.SUCCESS:  # not across yet: the same regime from there
+            t, y = not_yet
+        elif crossing and outcome is Outcome.SUCCESS:
             t, y = crossing.t, np.asarray(crossing.y, dtype=float)
             key = hybrid.after(key, crossing.event.name, t, y)
             switches.append(Switch(t, crossing.event.name, regime.name, hybrid.name(key),

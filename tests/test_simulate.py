@@ -69,9 +69,12 @@ def test_impacts_alternate_and_switch_on_the_surface(impacting):
     for a, b in zip(contact, contact[1:]):
         assert (a.after == "free") != (b.after == "free")
     gap = m.bind(K.gap)
-    for s in contact:  # located on the far side, within the root tolerance (xtol ~1e-14 s)
+    for s in contact:
+        # located on the far side; the state there is one step of the method to the root of
+        # the interpolant, so its gap is the interpolant's error at rtol 1e-9, not 0
+        # (measured 3.1e-12 m on both backends; 9e-14 m at rtol 1e-11)
         g = gap(s.t, s.alpha, s.alpha_dot)
-        assert abs(g) < 1e-12
+        assert abs(g) < 1e-11
         assert (g >= 0) if s.after == "free" else (g <= 0)
 
 

@@ -8,7 +8,10 @@ them out of scope; a slip reversal where both one-sided fields point at v_r = 0 
 and sticking ends when one of them turns away; every other flag just flips.  After a
 switch from free flight into contact the first step is capped at a tenth of a radian of
 the contact mode, as in the SciPy backend (a free-flight step would blow up on the stiff
-contact).
+contact).  The state a switch restarts from is one step of the method to the located time
+(:func:`state_at_crossing`); when that state is not yet across the surface, the run goes on
+in the same regime from it, up to MAX_RETRIES steps in a row (then the crossing restarts
+from the interpolant's state, which is across by construction: time always advances).
 
 With a ledger (``out_y`` of 5 rows) the work of the drive, contact damping and friction is
 integrated along the dense output (:mod:`.ledger`) and sampled with the state.
@@ -27,8 +30,8 @@ from numba import njit
 
 from .events import NONFINITE, first_crossing, left_at_start
 from .ledger import N_FLOWS, accumulate
-from .regimes import N_EXTRA, accel, after, entering, on_true_side, watch
-from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step
+from .regimes import N_EXTRA, accel, after, entering, on_true_side, value, watch
+from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
 
 #: outcome codes of run(), by position: names of camdyn.outcome.Outcome members
 OUTCOMES = ("SUCCESS", "STEP_FAILED", "MAX_EVENTS", "CHATTER", "NONFINITE", "ANGLE_LIMIT")
@@ -100,6 +103,29 @@ def first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_
     return h_abs, 1
 
 
+#: state_at_crossing's verdicts
+ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
+#: steps in a row that may end short of a crossing their interpolant placed early (with 100,
+#: tests/test_bad_input.py ran for over 10 minutes instead of 30 s)
+MAX_RETRIES = 1
+
+
+@njit(cache=True)
+def state_at_crossing(fns, tab, nr, r, k, direction, t, y0, y1, t_cross, method, p, K):
+    """The state at a crossing located inside a step from (t, y): one Runge-Kutta step of
+    size t_cross - t (the method's order; the interpolant's error, an order lower and larger
+    at loose tolerances, would otherwise be carried into the next regime at every switch).
+    Returns (alpha, alpha_dot, verdict): ACROSS; NOT_YET when that state is not yet across
+    value k's surface (the interpolant's error put the root early: the run may go on in the
+    same regime from it; K[n] then holds f there, the next step's FSAL stage); UNUSABLE when
+    it is not finite.  K[0] must hold f(t, y); the other rows are overwritten."""
+    c0, c1 = step_impl(fns, nr, r, t, y0, y1, t_cross - t, method, p, K)
+    g = direction * value(fns, tab, nr, r, k, t_cross, c0, c1, p)
+    if not (math.isfinite(c0) and math.isfinite(c1) and math.isfinite(g)):
+        return c0, c1, UNUSABLE
+    return c0, c1, ACROSS if g >= 0.0 else NOT_YET
+
+
 @njit(cache=True)
 def zero_at_start(dirs, g):
     """Whether a watched value is exactly 0 (a step starting on its surface)."""
@@ -134,6 +160,7 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
     t, y0, y1 = t0, y_start[0], y_start[1]
     r = r0 if r0 >= 0 else entering(fns, tab, t, y0, y1, p, on_true_side(fns, tab, 0, t, y0, y1, p, True))
     h_last = -1.0
+    retries = 0  # steps in a row that ended short of a crossing their interpolant placed early
     while t < t_end and outcome == SUCCESS:
         from_free = n_sw > 0 and fset[F_CONTACT_STEP] > 0.0 and tab[0][int(sw[n_sw - 1, 2]), 0] == 0
         h_abs, nfev = first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_free, K)
@@ -180,7 +207,16 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
                 elif t_cross == t:
                     c0, c1 = y0, y1
                 else:
-                    c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
+                    c0, c1, verdict = state_at_crossing(fns, tab, nr, r, k, dirs[k], t, y0, y1, t_cross, method, p, K)
+                    stats[0] += n
+                    if verdict == NOT_YET and retries < MAX_RETRIES:  # a step to t_cross in this regime
+                        t, y0, y1, h_abs = t_cross, c0, c1, h
+                        K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
+                        have_start, retries = False, retries + 1
+                        continue
+                    if verdict != ACROSS:  # the interpolant's state, across by construction
+                        c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
+                retries = 0
                 r_new = after(fns, tab, nr, stick, r, k, t_cross, c0, c1, p)
                 sw = record(sw, n_sw, t_cross, k, r, r_new, c0, c1)
                 n_sw += 1
@@ -191,6 +227,7 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
                     outcome = CHATTER
                 break
             t, y0, y1, h_abs = t_new, n0, n1, h_next
+            retries = 0
             K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
             if abs(y0) > fset[F_ANGLE]:
                 outcome = ANGLE_LIMIT

@@ -310,12 +310,13 @@ def start_times() -> dict:
 SWEEP_RTOL = 1e-7
 
 
-def permanent_contact_tolerance(revolutions: int) -> list[tuple]:
+def permanent_contact_tolerance(revolutions: int) -> dict:
     """One permanent-contact point of the sweep (0.85 x the contact-loss speed) at several
     tolerances: wall time, steps, switches, and the largest error of its Poincare section
     (the revolutions after the transient) against rtol 1e-10.  At loose tolerances the
     integration error in psi_i_dot (whose quasi-static value is ~1e-7 m/s on this stiff
-    contact) flips the D law at the contact mode's frequency: thousands of switches."""
+    contact) flips the D law at the contact mode's frequency: thousands of switches.
+    Returns {"speed": rev/min, "rows": [(rtol, wall s, steps, switches, section error)]}."""
     rig = RIG.replace(l_lambda=0.016)
     scene = camdyn.Scene(damping="D", friction="coulomb")
     speed = 0.85 * camdyn.contact_loss_speed(rig)
@@ -327,8 +328,8 @@ def permanent_contact_tolerance(revolutions: int) -> list[tuple]:
         rows.append([rtol, time.perf_counter() - t0, res.stats["steps"], len(res.switches), res.alpha])
     ref = rows[0][4]
     half = ref.size // 2
-    return [(rtol, secs, steps, switches, float(np.max(np.abs(a[half:] - ref[half:]))))
-            for rtol, secs, steps, switches, a in rows[1:]] + [(speed,)]
+    return {"speed": speed, "rows": [(rtol, secs, steps, switches, float(np.max(np.abs(a[half:] - ref[half:]))))
+                                     for rtol, secs, steps, switches, a in rows[1:]]}
 
 
 def sweep_timing(speeds: int, revolutions: int) -> dict:
@@ -506,12 +507,12 @@ def write_report(results: list, starts: dict, sw: dict, prof: dict, peers: dict,
     lines += ["", f"In permanent contact every step resolves the contact mode ({sw['frequency_Hz']:.0f} Hz "
               "here, 16 mm line contact), so the cost is set by the number of contact periods, not by "
               "the revolutions.", ""]
-    *tol_rows, (speed,) = sw["tolerance"]
-    lines += [f"Why rtol {SWEEP_RTOL:.0e}: one permanent-contact point ({speed:.0f} rev/min, {args.revolutions} "
+    tolerance = sw["tolerance"]
+    lines += [f"Why rtol {SWEEP_RTOL:.0e}: one permanent-contact point ({tolerance['speed']:.0f} rev/min, {args.revolutions} "
               "revolutions, one process) at several tolerances; section error: the largest difference of the "
               "Poincare section (second half of the revolutions) from the same run at rtol 1e-10.", "",
               "| rtol | wall time (s) | steps | switches | section error (rad) |", "|---|---|---|---|---|"]
-    for rtol, secs, steps, switches, err in tol_rows:
+    for rtol, secs, steps, switches, err in tolerance["rows"]:
         lines.append(f"| {rtol:.0e} | {secs:.2f} | {steps} | {switches} | {err:.1e} |")
     lines += ["", "At loose tolerances the integration error in the gap rate (whose quasi-static value is "
               "~1e-7 m/s on this stiff contact) flips damping D's law at the contact mode's frequency: the "

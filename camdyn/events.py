@@ -86,6 +86,13 @@ class EventSettings:
                 raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
 
 
+#: steps in a row that may end short of a crossing their interpolant placed early, when one
+#: step of the method to the located time is not yet across the surface (both backends:
+#: camdyn.integrate, camdyn.compiled.engine); with 100, tests/test_bad_input.py ran for over
+#: 10 minutes instead of 30 s
+CROSSING_RETRIES = 1
+
+
 @dataclass(frozen=True, eq=False)
 class Crossing:
     """The earliest event crossing of a step.

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, Radau
 
 from .errors import ParameterError
-from .events import Crossing, EventSettings, first_crossing
+from .events import CROSSING_RETRIES, Crossing, EventSettings, first_crossing
 from .hybrid import Hybrid
 from .model import ANGLE_LIMIT, Model
 from .outcome import Outcome
@@ -25,9 +25,6 @@ from .outcome import Outcome
 METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23, "Radau": Radau, "BDF": BDF, "LSODA": LSODA}
 _IMPLICIT = {"Radau", "BDF", "LSODA"}
 _EXPLICIT = (DOP853, RK45, RK23)
-#: steps in a row that may end short of a crossing their interpolant placed early (_state_at_crossing;
-#: as camdyn.compiled.engine.MAX_RETRIES)
-MAX_RETRIES = 1
 #: this many switches with no progress in time (relative 1e-9) is chatter, not dynamics
 CHATTER_SWITCHES = 20
 
@@ -129,7 +126,7 @@ def _state_at_crossing(crossing: Crossing, solver, fun, t0: float, y0: np.ndarra
     lower and larger at loose tolerances, would be carried into the next regime at every
     switch).  Returns (state, across): across is False when that state is not yet across the
     surface -- the interpolant's error put the root early -- and the run may go on in the same
-    regime from there (up to MAX_RETRIES steps in a row; then integrate() takes the
+    regime from there (up to CROSSING_RETRIES steps in a row; then integrate() takes the
     interpolant's state, across by construction).  A state that is not finite gives the interpolant's.
     camdyn.compiled.engine.state_at_crossing is the compiled twin."""
     y = _rk_state(solver, fun, t0, y0, f0, crossing.t - t0)
@@ -199,7 +196,7 @@ def integrate(model: Model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
                 stats["nfev"] += solver.n_stages - 1
                 if across:
                     crossing = dataclasses.replace(crossing, y=y_cross)
-                elif retries < MAX_RETRIES:
+                elif retries < CROSSING_RETRIES:
                     crossing, not_yet = None, (crossing.t, y_cross)
             retries = retries + 1 if not_yet else 0
             sampler.take(dense, crossing.t if crossing else not_yet[0] if not_yet else t_new, regime.name)

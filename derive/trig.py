@@ -77,9 +77,10 @@ def _time_bases(Ts: list[sp.Expr]) -> dict[sp.Expr, tuple[sp.Expr, int]]:
     out = {}
     for T in Ts:
         for W in Ts:
-            ratios = [_ratio(other, W) for other in Ts if sp.simplify(other / W).is_Rational]
-            if all(r is not None for r in ratios) and _ratio(T, W) is not None:
-                out[T] = (W, _ratio(T, W))
+            m = _ratio(T, W)
+            family = [other for other in Ts if sp.simplify(other / W).is_Rational]
+            if m is not None and all(_ratio(other, W) is not None for other in family):
+                out[T] = (W, m)
                 break
     return out
 

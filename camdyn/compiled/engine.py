@@ -10,7 +10,7 @@ switch from free flight into contact the first step is capped at a tenth of a ra
 the contact mode, as in the SciPy backend (a free-flight step would blow up on the stiff
 contact).  The state a switch restarts from is one step of the method to the located time
 (:func:`state_at_crossing`); when that state is not yet across the surface, the run goes on
-in the same regime from it, up to MAX_RETRIES steps in a row (then the crossing restarts
+in the same regime from it, up to CROSSING_RETRIES steps in a row (then the crossing restarts
 from the interpolant's state, which is across by construction: time always advances).
 
 With a ledger (``out_y`` of 5 rows) the work of the drive, contact damping and friction is
@@ -28,6 +28,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..events import CROSSING_RETRIES
 from .events import NONFINITE, first_crossing, left_at_start
 from .ledger import N_FLOWS, accumulate
 from .regimes import N_EXTRA, accel, after, entering, on_true_side, value, watch
@@ -105,9 +106,6 @@ def first_step(fns, method, p, tab, nr, r, t, y0, y1, t_end, fset, h_last, from_
 
 #: state_at_crossing's verdicts
 ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
-#: steps in a row that may end short of a crossing their interpolant placed early (with 100,
-#: tests/test_bad_input.py ran for over 10 minutes instead of 30 s)
-MAX_RETRIES = 1
 
 
 @njit(cache=True)
@@ -209,7 +207,7 @@ def run(fns, method, p, tab, nr, r0, t0, t_end, y_start, t_eval, fset, iset, out
                 else:
                     c0, c1, verdict = state_at_crossing(fns, tab, nr, r, k, dirs[k], t, y0, y1, t_cross, method, p, K)
                     stats[0] += n
-                    if verdict == NOT_YET and retries < MAX_RETRIES:  # a step to t_cross in this regime
+                    if verdict == NOT_YET and retries < CROSSING_RETRIES:  # a step to t_cross in this regime
                         t, y0, y1, h_abs = t_cross, c0, c1, h
                         K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
                         have_start, retries = False, retries + 1

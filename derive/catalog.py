@@ -6,7 +6,7 @@ it by its options, with no edit in ``camdyn/``.
 """
 from __future__ import annotations
 
-from .scenes import SceneSpec
+from .vocabulary import SceneSpec
 
 _IMPACT = [SceneSpec(contact="line", damping=d, friction="coulomb") for d in ("none", "A", "B", "C", "D", "E")]
 
@@ -14,6 +14,10 @@ CATALOG: tuple[SceneSpec, ...] = tuple(_IMPACT + [
     # Section 4: the printed, anti-dissipative sign of models B and D (misprint 2)
     SceneSpec(damping="B", damping_sign="printed"),
     SceneSpec(damping="D", damping_sign="printed"),
+    # models D and E with the memoryless law switch (the sign of psi_i_dot at every instant),
+    # beside the default episode reading of Sec. 3.4
+    SceneSpec(damping="D", damping_switch="memoryless"),
+    SceneSpec(damping="E", damping_switch="memoryless"),
     # frictionless: free vibration, energy conservation, damping energy tests
     SceneSpec(damping="none", friction="none"),
     SceneSpec(damping="D", friction="none"),

@@ -1,13 +1,16 @@
-"""Code generation: SymPy functions of a scene -> a plain-Python module.
+"""Code generation: a scene's module (:class:`derive.scenes.SceneModule`) -> plain-Python text.
 
-Deterministic by construction: parameters are unpacked in one canonical
-order, common subexpressions are numbered x0, x1, ... in the order
-``sympy.cse`` returns them, and the header carries a hash of the symbolic
-inputs (the scene and every expression's ``srepr``) and the SymPy version.
+Each generated function dispatches on its mode (or surface and mode) and computes, in the
+branch of a mode, the named quantities of :mod:`derive.fields` once each, in the order of the
+derivation (``psi_i = ...``, ``F_n = ...``, ``alpha_ddot = ...``).  Modes that compute the same
+quantities share one branch (a *family*); where their laws differ (the damping law, the
+friction direction) the quantity has one ``if``/``elif``/``else`` line per law.
 
-Two flavours of each kernel: scalar code on Python floats with ``math``
-(measured ~5x faster per call than NumPy-printed code for a 1-DOF RHS), and a
-``_v`` NumPy flavour on arrays, for outputs over many samples.
+Deterministic by construction: parameters are read in one canonical order, common
+subexpressions are numbered x0, x1, ... in the order ``sympy.cse`` returns them (canonical
+ordering), families and modes come in the automaton's order, and the header carries a hash
+of the symbolic inputs and the SymPy version.  Sines and cosines are economised first
+(:mod:`derive.trig`): their parameter-only parts become constants of ``pack()``.
 """
 from __future__ import annotations
 
@@ -23,22 +26,27 @@ from sympy.printing.pycode import PythonCodePrinter
 from . import laws
 from . import symbols as S
 from . import trig
-from .scenes import FLAG_SURFACES, OUTPUTS, Function, SceneSpec, build, regimes
+from .automaton import Automaton
+from .scenes import Case, Function, SceneModule, build
+from .vocabulary import OUTPUTS, SURFACES, SceneSpec
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
 UNITS = {**{name: p.unit for name, p in S.PARAMS.items()}, "Y_e": "Pa"}
-STATE_ARGS = {"t": "time (s)", "alpha": "follower angle alpha (rad, clockwise)",
-              "alpha_dot": "follower angular velocity (rad/s)", "Theta": "cam angle (rad)",
-              "p": "parameter vector, laid out as PARAMS (SI units); build it with pack()",
-              "cam": "(Theta, Theta_dot, Theta_ddot) of the user's cam motion at t (rad, rad/s, rad/s^2)"}
-OUTPUT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_ddot_dalpha_dot": "1/s",
-                "psi_i": "m", "psi_j": "m", "psi_i_dot": "m/s", "F_s": "N", "F_n": "N", "F_f": "N",
-                "v_r": "m/s", "N_x": "N", "alpha_i": "rad", "energy": "J", "P_in": "W", "D_c": "W",
-                "D_f": "W", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2", "M": "N m",
-                "dM_dalpha": "N m/rad", "k_lambda": "N/m", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
-                "spring_moment": "N m", "reach_margin": "m", "dv_r_dt": "m/s^2", "dv_r_dalpha": "m/s/rad", "dv_r_dalpha_dot": "m/rad", "V_s": "J", "V_s_printed": "J",
-                "surface": "m or m/s", "auxiliary": "m/s, m/s^2, m/s/rad or m/rad", "power": "W"}
+ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
+        "s": "surface index: a position in SURFACES (SURFACE_<NAME> constants)",
+        "t": "time (s)", "alpha": "follower angle alpha (rad, clockwise)",
+        "alpha_dot": "follower angular velocity (rad/s)", "Theta": "cam angle (rad)",
+        "p": "parameter vector, laid out as PARAMS (SI units); build it with pack()",
+        "cam": "(Theta, Theta_dot, Theta_ddot) of the user's cam motion at t (rad, rad/s, rad/s^2)",
+        "out": "a float64 array the results are written into (length: the number of results)"}
+RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_ddot_dalpha_dot": "1/s",
+                "value": "m, m/s or m/s^2", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2",
+                "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
+                "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
+                "spring_moment": "N m", "V_s": "J", "V_s_printed": "J",
+                **{name: unit for name, (unit, _) in OUTPUTS.items()}}
+_STATE = {"t": S.t_s, "alpha": S.alpha_s, "alpha_dot": S.alpha_dot, "Theta": S.Theta_s}
 
 
 class _Scalar(PythonCodePrinter):
@@ -57,149 +65,250 @@ class _Vector(NumPyPrinter):
     def __init__(self):
         super().__init__({"fully_qualified_modules": True})
 
-    def _print_SignedPow32(self, expr):
-        x = self._print(expr.args[0])
-        return f"({x})*numpy.sqrt(numpy.abs({x}))"
+
+def _is_constant(name: str) -> bool:
+    """A trigonometric constant of derive.trig (sin_<angle>, cos_<angle>), computed by pack()."""
+    return name.startswith(("sin_", "cos_"))
 
 
 def _param_names(exprs) -> list[str]:
-    """The parameters the expressions read, in PARAM_ORDER, then the trigonometric
-    constants (derive.trig) by name."""
+    """The parameters the expressions read, in PARAM_ORDER, then the trigonometric constants."""
     names = {s.name for e in exprs for s in sp.sympify(e).free_symbols}
     return [n for n in PARAM_ORDER if n in names] + sorted(n for n in names if _is_constant(n))
 
 
-def _is_constant(name: str) -> bool:
-    return name.startswith(("sin_", "cos_"))
+def constant_name(kind: str, name: str) -> str:
+    """MODE_CONTACT_LOADING_FWD, SURFACE_GAP, OUT_PSI_I: the index constants of the module."""
+    return f"{kind}_{name.upper()}"
 
 
-@lru_cache(maxsize=None)
-def _economised(exprs: tuple[sp.Expr, ...]) -> tuple[tuple[sp.Expr, ...], tuple[tuple[sp.Symbol, sp.Expr], ...]]:
-    """derive.trig.economise of a function's expressions (as emitted), and its constants."""
-    out, constants = trig.economise(list(exprs))
-    return tuple(out), tuple(sorted(constants.items(), key=lambda kv: kv[0].name))
+# --- one family: the modes that compute the same named quantities -----------------------
+@dataclass
+class _Variant:
+    symbol: sp.Symbol
+    expr: sp.Expr
+    note: str
+    keys: list
 
 
 @dataclass
-class _Module:
-    """A scene's functions as derived (hashed) and the index kernels' branches; the
-    parameters and trigonometric constants (derive.trig) of the code emitted for both."""
-    spec: SceneSpec
-    functions: tuple[Function, ...]
+class _Family:
+    """Cases computing the same quantities; their definitions by name, with one variant per
+    distinct expression; economised and common-subexpression-eliminated."""
 
-    def __post_init__(self):
-        self.families = _index_families(self.spec, self.functions)
-        emitted = list(self.functions) + [f for fam in self.families for _, f in fam[2]]
-        self.constants = dict(sorted({kv for f in emitted for kv in _economised(f.exprs)[1]}, key=lambda kv: kv[0].name))
-        self.params = _param_names([x for f in emitted for x in _economised(f.exprs)[0]])
+    keys: list
+    order: list          # quantity names in computation order
+    variants: dict       # name -> [_Variant]
+    results: tuple       # result expressions (the same for every case of the family)
+    replacements: list = None   # [(x_k, expr)] from sympy.cse
+    constants: dict = None      # trigonometric constants used {symbol: definition}
 
-    def source_hash(self) -> str:
-        h = hashlib.sha256(repr(sorted(self.spec.as_dict().items())).encode())
-        for f in self.functions:
-            h.update(f"{f.name}{f.args}{f.outputs}".encode())
-            for x in f.exprs:
-                h.update(sp.srepr(x).encode())
-        return h.hexdigest()[:16]
+    @classmethod
+    def of(cls, cases: list[Case]) -> "_Family":
+        order, variants = [], {}
+        for case in cases:
+            for d in case.kernel.definitions:
+                if d.name not in variants:
+                    order.append(d.name)
+                    variants[d.name] = []
+                same = next((v for v in variants[d.name] if v.expr == d.expr), None)
+                if same is None:
+                    variants[d.name].append(_Variant(d.symbol, d.expr, d.note, [case.key]))
+                else:
+                    same.keys.append(case.key)
+        fam = cls([c.key for c in cases], order, variants, cases[0].kernel.results)
+        fam._reduce()
+        return fam
 
+    def _all(self) -> list[_Variant]:
+        return [v for name in self.order for v in self.variants[name]]
 
-def _function_code(f: Function, params: list[str]) -> str:
-    lines = [f"def {f.name}({', '.join(f.args)}):"]
-    doc = [f.doc, "", "Arguments:"]
-    doc += [f"    {a}: {STATE_ARGS[a]}" for a in f.args]
-    doc += ["Returns" + (" (a tuple):" if len(f.outputs) > 1 else ":")]
-    doc += [f"    {o} ({OUTPUT_UNITS[o]})" for o in f.outputs]
-    lines.append(textwrap.indent('"""' + "\n".join(doc) + '\n"""', "    "))
-    return "\n".join(lines + _body_lines(f, params))
+    def _reduce(self):
+        """derive.trig's economy of sines and cosines, then common subexpressions."""
+        items = self._all()
+        exprs = [sp.sympify(v.expr) for v in items] + [sp.sympify(r) for r in self.results]
+        exprs, constants = _economised(tuple(exprs))
+        replacements, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("x"), order="canonical")
+        for v, e in zip(items, reduced):
+            v.expr = e
+        self.results = tuple(reduced[len(items):])
+        self.replacements = list(replacements)
+        self.constants = constants
 
-
-def _body_lines(f: Function, params: list[str]) -> list[str]:
-    """The statements of a function (parameter unpacking, CSE, return), indented once."""
-    printer = _Vector() if f.vectorised else _Scalar()
-    exprs = list(_economised(f.exprs)[0])
-    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="canonical")
-    used = _param_names(exprs)
-    lines = []
-    if "cam" in f.args:
-        lines.append("    Theta, Theta_dot, Theta_ddot = cam")
-    lines += [f"    {n} = p[{params.index(n)}]" for n in used]
-    lines += [f"    {sym} = {printer.doprint(val)}" for sym, val in replacements]
-    if f.vectorised:
-        arrays = ", ".join(a for a in f.args if a in ("t", "alpha", "alpha_dot", "Theta"))
-        lines.append(f"    _zero = numpy.zeros(numpy.broadcast({arrays}).shape)")
-        values = [f"{printer.doprint(r)} + _zero" for r in reduced]
-    else:
-        values = [printer.doprint(r) for r in reduced]
-    lines.append("    return " + (values[0] if len(values) == 1 else "(" + ", ".join(values) + ")"))
-    return lines
+    def expressions(self) -> list[sp.Expr]:
+        return [e for _, e in self.replacements] + [v.expr for v in self._all()] + list(self.results)
 
 
-#: Index-dispatched kernels for compiled engines (numba): one self-contained function
-#: per family, selecting a branch by an integer, with no call to another kernel.
-INDEX_ARGS = {"r": "regime index, position in REGIME_NAMES", "k": "flag index, position in FLAGS",
-              "j": "auxiliary index: 0 gap rate; 1, 2, 3 the partials of v_r (Coulomb scenes)",
-              "c": "3 r + i: regime r = REGIME_NAMES[c // 3], flow i = (P_in, D_c, D_f)[c % 3]"}
+@lru_cache(maxsize=None)
+def _economised(exprs: tuple[sp.Expr, ...]) -> tuple[tuple[sp.Expr, ...], dict]:
+    out, constants = trig.economise(list(exprs))
+    return tuple(out), dict(sorted(constants.items(), key=lambda kv: kv[0].name))
 
 
-def _index_function_code(name: str, selector: str, branches: list[tuple[str, Function]], doc: str,
-                         output: str, params: list[str]) -> str:
-    """``name(selector, t, alpha, alpha_dot, p)``: the scalar body of ``branches[i]`` where
-    ``selector == i``; NaN for an index out of range.  Plain ``math``, so numba can compile it
-    (e.g. as a ``cfunc``) with the parameter vector passed as an array."""
-    args = (selector, "t", "alpha", "alpha_dot", "p")
-    lines = [f"def {name}({', '.join(args)}):"]
-    text = [doc, "", "Arguments:", f"    {selector}: {INDEX_ARGS[selector]}"]
-    text += [f"    {a}: {STATE_ARGS[a]}" for a in args[1:]]
-    text += ["Branches:"] + [f"    {i}: {label}" for i, (label, _) in enumerate(branches)]
-    text += ["Returns:", f"    {output} ({OUTPUT_UNITS[output]}); nan for an index out of range"]
-    lines.append(textwrap.indent('"""' + "\n".join(text) + '\n"""', "    "))
-    for i, (_, f) in enumerate(branches):
-        lines.append(f"    {'if' if i == 0 else 'elif'} {selector} == {i}:")
-        lines += ["    " + line for line in _body_lines(f, params)]
-    lines.append("    return nan")
-    return "\n".join(lines)
+def _families(cases: tuple[Case, ...]) -> list[_Family]:
+    """Cases grouped by the names they define and their results, in order of first appearance."""
+    groups: dict = {}
+    for case in cases:
+        signature = (tuple(d.name for d in case.kernel.definitions), tuple(sp.srepr(r) for r in case.kernel.results))
+        groups.setdefault(signature, []).append(case)
+    return [_Family.of(group) for group in groups.values()]
 
 
-def _index_families(spec: SceneSpec, functions: tuple[Function, ...]) -> list[tuple]:
-    """The index-dispatched kernels of a compiled engine, as (name, selector, branches, doc,
-    output) for _index_function_code:
+# --- printing -----------------------------------------------------------------------------
+class _Writer:
+    """Prints one function: guards from dispatch keys, families, variants, results."""
 
-    - ``rhs_index`` over the regimes;
-    - with flags, ``surface_index`` over the flags' surfaces;
-    - in non-linear scenes, ``aux_index``: the gap rate (micro-hops hidden inside a step)
-      and, with Coulomb friction, the partials of v_r (the Filippov stick mode);
-    - ``power_index`` over (regime, flow): the energy ledger's P_in, D_c, D_f (OUTPUTS[10:13]).
-    """
-    if spec.motion == "user":  # its kernels need the user's Python callables: not compilable
-        return []
-    by_name = {f.name: f for f in functions}
-    names = [r.name for r in regimes(spec)]
-    out = [("rhs_index", "r", [(n, by_name[f"rhs_{n}"]) for n in names],
-            "Angular acceleration (rad/s^2) of regime REGIME_NAMES[r]: rhs_<regime> by index.", "alpha_ddot")]
-    if spec.flags:
-        surfaces = [(f"{flag}: {FLAG_SURFACES[flag][0]}", by_name[FLAG_SURFACES[flag][0]]) for flag in spec.flags]
-        out.append(("surface_index", "k", surfaces,
-                    "Switching surface of flag FLAGS[k] (FLAG_SURFACES): gap, gap_rate or slip by index.", "surface"))
-    if "gap_rate" in by_name:
-        aux = [("psi_i_dot", by_name["gap_rate"])] + _single_outputs(by_name.get("slip_partials"))
-        out.append(("aux_index", "j", aux, "Auxiliary scalars of the hybrid loop by index: the gap rate and, "
-                    "with Coulomb friction, the partials of v_r.", "auxiliary"))
-    flows = [pair for n in names for pair in _single_outputs(by_name[f"out_{n}"], OUTPUTS[10:13], f"{n}: ")]
-    out.append(("power_index", "c", flows, "Power flows of the energy ledger by index: P_in (cam drive), D_c "
-                "(contact damping), D_f (friction) of each regime.", "power"))
-    return out
+    def __init__(self, f: Function, automaton: Automaton, params: list[str]):
+        self.f, self.automaton, self.params = f, automaton, params
+        self.printer = _Vector() if f.style == "numpy" else _Scalar()
+
+    def _value_name(self, arg: str, value: int) -> str:
+        if arg == "m":
+            return constant_name("MODE", self.automaton.modes[value].name)
+        return constant_name("SURFACE", self.automaton.surfaces[value])
+
+    def guard(self, keys, context) -> str:
+        """A condition on the dispatch arguments that holds for ``keys`` among ``context``."""
+        dispatch = self.f.dispatch
+        varying = [i for i in range(len(dispatch)) if len({k[i] for k in context}) > 1]
+        if not varying:
+            return "True"
+        if len(varying) == 2:  # (m, s): by surface, then the modes where it is not all of them
+            m_all = {k[0] for k in context}
+            terms = []
+            for s in sorted({k[1] for k in keys}):
+                ms = sorted(k[0] for k in keys if k[1] == s)
+                term = f"s == {self._value_name('s', s)}"
+                if set(ms) != m_all:
+                    term += " and (" + " or ".join(f"m == {self._value_name('m', m)}" for m in ms) + ")"
+                terms.append(term)
+            return terms[0] if len(terms) == 1 else " or ".join(f"({t})" if " and " in t else t for t in terms)
+        i = varying[0]
+        arg = dispatch[i]
+        return " or ".join(f"{arg} == {self._value_name(arg, v)}" for v in sorted({k[i] for k in keys}))
+
+    def family_lines(self, fam: _Family) -> list[str]:
+        lines = [f"{n} = p[{self.params.index(n)}]" for n in _param_names(fam.expressions())]
+        rep = dict(fam.replacements)
+        index = {sym: i for i, (sym, _) in enumerate(fam.replacements)}
+        keys_of = self._replacement_keys(fam, index)
+        done: set = set()
+
+        def deps(expr) -> list:
+            """Replacements an expression needs, transitively, not yet printed, in CSE order."""
+            found, stack = set(), [expr]
+            while stack:
+                for s in sp.sympify(stack.pop()).free_symbols:
+                    if s in rep and s not in found and s not in done:
+                        found.add(s)
+                        stack.append(rep[s])
+            return sorted(found, key=index.get)
+
+        def emit(syms, out):
+            for s in syms:
+                out.append(f"{s} = {self.printer.doprint(rep[s])}")
+                done.add(s)
+
+        for name in fam.order:
+            variants = fam.variants[name]
+            if len(variants) == 1:
+                emit(deps(variants[0].expr), lines)
+                lines += self._definition(variants[0])
+                continue
+            shared = [s for v in variants for s in deps(v.expr) if not set(keys_of[s]) <= set(v.keys)]
+            emit(sorted(set(shared), key=index.get), lines)
+            for k, v in enumerate(variants):
+                head = "else:" if k == len(variants) - 1 else \
+                    f"{'if' if k == 0 else 'elif'} {self.guard(v.keys, fam.keys)}:"
+                body: list[str] = []
+                emit(deps(v.expr), body)
+                lines += [head] + ["    " + x for x in body + self._definition(v)]
+        for r in fam.results:
+            emit(deps(r), lines)
+        return lines + self._results(fam.results)
+
+    def _replacement_keys(self, fam: _Family, index) -> dict:
+        """The cases that use each replacement (directly or through later ones)."""
+        keys = {sym: set() for sym, _ in fam.replacements}
+        users = [(v.expr, set(v.keys)) for v in fam._all()] + [(r, set(fam.keys)) for r in fam.results]
+        for expr, ks in users:
+            for s in sp.sympify(expr).free_symbols:
+                if s in keys:
+                    keys[s] |= ks
+        for sym, expr in reversed(fam.replacements):
+            for s in sp.sympify(expr).free_symbols:
+                if s in keys:
+                    keys[s] |= keys[sym]
+        return keys
+
+    def _definition(self, v: _Variant) -> list[str]:
+        note = f"  # {v.note}" if v.note else ""
+        return [f"{v.symbol} = {self.printer.doprint(v.expr)}{note}"]
+
+    def _results(self, results) -> list[str]:
+        style = self.f.style
+        code = [self.printer.doprint(r) for r in results]
+        if style == "return":
+            return [f"return {code[0]}"]
+        if style == "fill":
+            target = [constant_name("OUT", n) if self.f.name == "outputs" else str(i)
+                      for i, n in enumerate(self.f.results)]
+            return [f"out[{t}] = {c}" for t, c in zip(target, code)] + ["return"]
+        if style == "numpy":
+            arrays = ", ".join(a for a in self.f.args if a in _STATE)
+            return [f"_zero = numpy.zeros(numpy.broadcast({arrays}).shape)",
+                    "return (" + ", ".join(f"{c} + _zero" for c in code) + ")"]
+        return ["return (" + ", ".join(code) + ")" if len(code) > 1 else f"return {code[0]}"]
+
+    def _missing(self) -> list[str]:
+        return ["out[:] = nan", "return"] if self.f.style == "fill" else ["return nan"]
+
+    def source(self, families: list[_Family], universe: set) -> str:
+        f = self.f
+        text = [f.doc, "", "Arguments: " + ", ".join(f.args) + " (see the module docstring)."]
+        text.append("Returns " + ("(written to out): " if f.style == "fill" else ": ") + ", ".join(
+            f"{n} ({RESULT_UNITS[n]})" for n in f.results) + ".")
+        lines = [f"def {f.name}({', '.join(f.args)}):", textwrap.indent('"""' + "\n".join(text) + '\n"""', "    ")]
+        if "cam" in f.args:
+            lines.append("    Theta, Theta_dot, Theta_ddot = cam")
+        remaining = set(universe)
+        for k, fam in enumerate(families):
+            body = self.family_lines(fam)
+            covers = set(fam.keys) == remaining
+            if covers and k == len(families) - 1:
+                lines += ["    " + x for x in body]
+            else:
+                lines += [f"    if {self.guard(fam.keys, remaining)}:"] + ["        " + x for x in body]
+            remaining -= set(fam.keys)
+        if remaining:
+            lines += ["    " + x for x in self._missing()]
+        return "\n".join(lines)
 
 
-def _single_outputs(f: Function | None, outputs: tuple[str, ...] | None = None,
-                    prefix: str = "") -> list[tuple[str, Function]]:
-    """One single-output Function per output of ``f`` (those named in ``outputs``, or all)."""
-    if f is None:
-        return []
-    wanted = f.outputs if outputs is None else outputs
-    return [(prefix + o, Function(f"{f.name}_{o}", f.args, (o,), (f.exprs[f.outputs.index(o)],), f.doc))
-            for o in wanted]
+def _universe(f: Function, automaton: Automaton) -> set:
+    if f.dispatch == ("m",):
+        return {(m,) for m in range(len(automaton.modes))}
+    if f.dispatch == ("m", "s"):
+        return {(m, s) for m in range(len(automaton.modes)) for s in range(len(automaton.surfaces))}
+    return {()}
 
 
-def _pack_code(params: list[str], constants: dict[sp.Symbol, sp.Expr]) -> tuple[str, list[str]]:
+# --- the module -----------------------------------------------------------------------------
+def _hash(mod: SceneModule) -> str:
+    h = hashlib.sha256(repr(sorted(mod.spec.as_dict().items())).encode())
+    h.update(repr(mod.automaton).encode())
+    for f in mod.functions:
+        h.update(f"{f.name}{f.args}{f.results}{f.style}".encode())
+        for case in f.cases:
+            h.update(repr(case.key).encode())
+            for d in case.kernel.definitions:
+                h.update((d.name + sp.srepr(d.expr)).encode())
+            for r in case.kernel.results:
+                h.update(sp.srepr(r).encode())
+    return h.hexdigest()[:16]
+
+
+def _pack_code(params: list[str], constants: dict) -> tuple[str, list[str]]:
     derived = {**laws.CONSTANTS, **constants}
     inputs = [n for n in PARAM_ORDER if n in params and n not in {s.name for s in laws.CONSTANTS}]
     for sym, definition in derived.items():
@@ -221,49 +330,82 @@ def _pack_code(params: list[str], constants: dict[sp.Symbol, sp.Expr]) -> tuple[
     return "\n".join(lines), inputs
 
 
+def _index_constants(kind: str, names) -> list[str]:
+    return [f"{constant_name(kind, n)} = {i}" for i, n in enumerate(names)]
+
+
+def _automaton_code(A: Automaton) -> list[str]:
+    mode = {m.name: constant_name("MODE", m.name) for m in A.modes}
+    surf = {s: constant_name("SURFACE", s) for s in A.surfaces}
+
+    def targets(ts) -> str:
+        items = [f"({mode[t.mode]}, (" + "".join(f"({surf[c.surface]}, {c.sign}), " for c in t.conditions) + "))"
+                 for t in ts]
+        return "(" + ", ".join(items) + ",)"
+
+    lines = ["# --- the hybrid automaton (derive.automaton) ---",
+             "MODES = " + repr(tuple(m.name for m in A.modes))] + _index_constants("MODE", [m.name for m in A.modes])
+    lines += ["#: per mode: the follower touches the cam (Eq. 10) or flies (Eq. 15)",
+              "CONTACT_OF_MODE = " + repr(tuple(m.contact for m in A.modes)),
+              "#: per mode: the damping law of models D, E ('impact' t_a..t_b, 'viscous' after), or None",
+              "PHASE_OF_MODE = " + repr(tuple(m.phase for m in A.modes)),
+              "#: per mode: Coulomb friction, sliding forward ('fwd', v_r > 0), backward, or 'stick', or None",
+              "SLIP_OF_MODE = " + repr(tuple(m.slip for m in A.modes)),
+              "SURFACES = " + repr(A.surfaces)] + _index_constants("SURFACE", A.surfaces)
+    rate = [surf[A.rates[s]] if s in A.rates else "-1" for s in A.surfaces]
+    lines += ["#: per surface: the surface that is its time derivative (-1: none); an excursion across",
+              "#: zero and back inside one step is found where the derivative changes sign",
+              "RATE_OF_SURFACE = (" + "".join(f"{r}, " for r in rate) + ")",
+              "RESETS = " + repr(A.resets)] + _index_constants("RESET", A.resets)
+    lines += ["#: the initial mode: the first candidate (mode, conditions) whose conditions (surface, sign)",
+              "#: hold, i.e. sign * value >= 0 (looked ahead along the motion where a value is exactly 0)",
+              "INITIAL = " + targets(A.initial),
+              "#: (source mode, surface, direction, candidate targets, reset): leave the source where the",
+              "#: surface's value crosses zero upward (+1: from < 0 to >= 0) or downward (-1), for the first",
+              "#: target whose conditions hold",
+              "TRANSITIONS = ("]
+    lines += [f"    ({mode[tr.source]}, {surf[tr.surface]}, {tr.direction:+d}, {targets(tr.targets)}, "
+              f"{constant_name('RESET', tr.reset)})," for tr in A.transitions]
+    return lines + [")"]
+
+
+def _module_doc(spec: SceneSpec, A: Automaton) -> list[str]:
+    return [f'"""Generated kernels of the scene {spec.slug!r}.', "",
+            "Scene: " + ", ".join(f"{k}={v!r}" for k, v in spec.as_dict().items()) + ".", "",
+            "The hybrid automaton is data (MODES, SURFACES, INITIAL, TRANSITIONS, RESETS; the rules that",
+            "read it are camdyn.derive.automaton's docstring) and the kernels compute, per mode, the",
+            "named quantities of the derivation once each.", "",
+            "Arguments of every kernel, in this order where it takes them:"] + [
+            f"    {a}: {ARGS[a]}" for a in ("m", "s", "t", "alpha", "alpha_dot", "p", "cam", "out")
+            if a != "cam" or spec.motion == "user"] + [
+            "Surfaces: " + "; ".join(f"{s} ({SURFACES[s][0]})" for s in A.surfaces) + "." if A.surfaces else
+            "No switching surfaces (sliding contact throughout).", '"""']
+
+
 def module_source(spec: SceneSpec) -> str:
     """The complete text of a scene's generated module."""
-    mod = _Module(spec, build(spec))
-    params = mod.params
-    pack, inputs = _pack_code(params, mod.constants)
-    regime_table = {r.key: r.name for r in regimes(spec)}
-    flags = spec.flags
-    header = [
-        "# Generated by camdyn.derive -- DO NOT EDIT. Regenerate with: python -m camdyn.derive",
-        f"# scene: {spec.slug}",
-        f"# symbolic-input hash: {mod.source_hash()}",
-        f"# sympy: {sp.__version__}",
-    ]
-    doc = [
-        f'"""Generated kernels of the scene {spec.slug!r}.',
-        "",
-        "Scene: " + ", ".join(f"{k}={v!r}" for k, v in spec.as_dict().items()) + ".",
-        "",
-        "Every kernel takes the parameter vector p laid out as PARAMS; build it with",
-        "pack(values), values a mapping of the INPUTS names to SI floats.",
-        "State kernels take (t, alpha, alpha_dot, p" + (", cam" if spec.motion == "user" else "") + ").",
-        "",
-        "Regimes: REGIMES maps the discrete state (one value per name in FLAGS, None where",
-        "a flag does not apply) to a regime name; rhs_<regime>, jac_<regime>, out_<regime>",
-        "and out_<regime>_v are its kernels.  FLAG_SURFACES gives, per flag, the surface",
-        "function whose sign sets it and the sign where the flag is True.",
-        '"""',
-    ]
-    data = [
-        "SCENE = " + repr(spec.as_dict()),
-        f"SLUG = {spec.slug!r}",
-        "PARAMS = " + repr(tuple(params)),
-        "INPUTS = " + repr(tuple(inputs)),
-        "UNITS = " + repr({n: UNITS.get(n, "1" if _is_constant(n) else None)
-                           for n in params + [i for i in inputs if i not in params]}),
-        "FLAGS = " + repr(flags),
-        "FLAG_SURFACES = " + repr({f: FLAG_SURFACES[f] for f in flags}),
-        "REGIMES = " + repr(regime_table),
-        "OUTPUTS = " + repr(OUTPUTS),
-        "REGIME_NAMES = " + repr(tuple(regime_table.values())),
-    ]
-    body = [_function_code(f, params) for f in mod.functions]
-    body += [_index_function_code(*family, params) for family in mod.families]
+    mod = build(spec)
+    A = mod.automaton
+    families = {f.name: _families(f.cases) for f in mod.functions}
+    constants: dict = {}
+    exprs: list = []
+    for fams in families.values():
+        for fam in fams:
+            constants.update(fam.constants)
+            exprs += fam.expressions()
+    constants = dict(sorted(constants.items(), key=lambda kv: kv[0].name))
+    params = _param_names(exprs)
+    pack, inputs = _pack_code(params, constants)
+    header = ["# Generated by camdyn.derive -- DO NOT EDIT. Regenerate with: python -m camdyn.derive",
+              f"# scene: {spec.slug}", f"# symbolic-input hash: {_hash(mod)}", f"# sympy: {sp.__version__}"]
+    data = ["SCENE = " + repr(spec.as_dict()), f"SLUG = {spec.slug!r}", "PARAMS = " + repr(tuple(params)),
+            "INPUTS = " + repr(tuple(inputs)),
+            "UNITS = " + repr({n: UNITS.get(n, "1" if _is_constant(n) else None)
+                               for n in params + [i for i in inputs if i not in params]})]
+    data += _automaton_code(A)
+    data += ["# --- output quantities (camdyn.derive.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
+    data += _index_constants("OUT", OUTPUTS)
+    body = [_Writer(f, A, params).source(families[f.name], _universe(f, A)) for f in mod.functions]
     imports = ["from math import *  # noqa: F401,F403  (sin, cos, sqrt, ... on floats)", "", "import numpy"]
-    parts = ["\n".join(header), "\n".join(doc), "\n".join(imports), "\n".join(data), pack] + body
+    parts = ["\n".join(header), "\n".join(_module_doc(spec, A)), "\n".join(imports), "\n".join(data), pack] + body
     return "\n\n\n".join(parts[:3]) + "\n\n" + parts[3] + "\n\n\n" + "\n\n\n".join(parts[4:]) + "\n"

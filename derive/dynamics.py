@@ -10,17 +10,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from types import SimpleNamespace
 
 import sympy as sp
 from sympy.physics.vector import Point, Vector
 
-from . import laws
+from . import laws, vocabulary
 from . import symbols as S
+from .graph import Definition, flatten, quantity, substitutions
 from .geometry import N, E_to_Gc, P_to_Ob, chi, follower_frame, psi_i_conditioned, psi_j_conditioned
 from .symbols import Theta, alpha, t
 
 B = follower_frame(alpha)
-SLIDING_VELOCITY_FORMS = ("kinematic", "printed")
+SLIDING_VELOCITY_FORMS = vocabulary.SLIDING_VELOCITY_FORMS
 
 
 @lru_cache(maxsize=None)
@@ -106,23 +108,79 @@ class Forces:
     v_r: sp.Expr   # sliding velocity used by the friction law
 
 
-def forces(regime: ContactRegime | None) -> Forces:
-    """Forces in a contact regime, or with no contact (``regime=None``, Eq. 15)."""
-    F_s = laws.spring_force(alpha)
+#: Symbols of the named quantities of the contact mechanics (as they appear in generated code).
+Q = SimpleNamespace(**{name: quantity(name) for name in (
+    "psi_i", "psi_i_dot", "psi_j", "chi", "F_s", "k_lambda", "c_lambda", "F_n", "v_r", "mu", "F_f",
+    "alpha_ddot")})
+
+
+def mechanics(regime: ContactRegime | None) -> tuple[Definition, ...]:
+    """The named quantities of one mode, in the order they are computed: the gap and its rate
+    (Eqs. 6, 8), psi_j and the moment arm chi (Eqs. 7, 2), the spring force (Eq. 11), the
+    contact stiffness and damping (Eqs. 13/34, 24-28), the normal force (Eq. 12), the sliding
+    velocity, the friction coefficient and force.  With no contact (``regime=None``, Eq. 15)
+    only the spring acts.  Expressions are in alpha(t), Theta(t) and earlier quantities."""
+    F_s = Definition(Q.F_s, laws.spring_force(alpha), "spring force (Eq. 11)")
     if regime is None:
-        zero = sp.Integer(0)
-        return Forces(F_s, zero, zero, sliding_velocity("kinematic"))
-    psi_i = gap()
-    k = laws.contact_stiffness(regime.contact, psi_i)
-    c = laws.damping_coefficient(regime.damping, regime.phase, k, psi_i, regime.damping_sign)
-    F_n = laws.elastic_force(regime.contact, psi_i) - c * gap_rate()
-    v_r = sliding_velocity(regime.sliding_velocity) if regime.friction != "none" else \
-        sliding_velocity("kinematic")
-    mu = laws.friction_coefficient(regime.friction, v_r, regime.direction)
-    return Forces(F_s, F_n, mu * F_n, v_r)
+        return (F_s,)
+    defs = [Definition(Q.psi_i, gap(), "gap (Eq. 6); contact deflection where negative"),
+            Definition(Q.psi_i_dot, gap_rate(), "gap rate (Eq. 8)"),
+            Definition(Q.psi_j, psi_j(), "sliding of the contact point along the bar (Eq. 7)"),
+            Definition(Q.chi, S.chi0 - Q.psi_j, "moment arm of F_n about P (Eq. 2)"),
+            F_s,
+            Definition(Q.k_lambda, laws.contact_stiffness(regime.contact, Q.psi_i),
+                       "contact stiffness (Eq. 13 line, Eq. 34 point)"),
+            Definition(Q.c_lambda, laws.damping_coefficient(regime.damping, regime.phase, _stiffness(regime), Q.psi_i,
+                                                            regime.damping_sign),
+                       f"contact damping, model {regime.damping} (Eqs. 24-28)"),
+            Definition(Q.F_n, laws.elastic_force(regime.contact, Q.psi_i, Q.k_lambda) - Q.c_lambda * Q.psi_i_dot,
+                       "normal contact force (Eq. 12)")]
+    if regime.friction != "none":
+        defs += [Definition(Q.v_r, sliding_velocity(regime.sliding_velocity),
+                            f"sliding velocity ({regime.sliding_velocity} form)"),
+                 Definition(Q.mu, laws.friction_coefficient(regime.friction, Q.v_r, regime.direction),
+                            f"friction coefficient ({regime.friction})"),
+                 Definition(Q.F_f, Q.mu * Q.F_n, "friction force")]
+    return tuple(defs)
 
 
-def applied_forces(f: Forces) -> list[tuple[Vector, Vector]]:
+def _stiffness(regime: ContactRegime) -> sp.Expr:
+    """k_lambda as the damping laws of models B and D read it: the named quantity where it is
+    smooth (line contact: a constant); for point contact its law in psi_i itself, because
+    k ~ |psi_i|^0.5 has no derivative at psi_i = 0 while beta k |psi_i| ~ |psi_i|^1.5 does, and
+    the chain rule through the named k would give 0 * inf there (Jacobians, by forward mode)."""
+    if regime.contact == "line":
+        return Q.k_lambda
+    return laws.contact_stiffness(regime.contact, Q.psi_i)
+
+
+def named_forces(regime: ContactRegime | None) -> Forces:
+    """The forces as the symbols of :func:`mechanics` (zero where a mode has none)."""
+    zero = sp.Integer(0)
+    if regime is None:
+        return Forces(Q.F_s, zero, zero, zero)
+    friction = regime.friction != "none"
+    return Forces(Q.F_s, Q.F_n, Q.F_f if friction else zero, Q.v_r if friction else zero)
+
+
+def acceleration(regime: ContactRegime | None) -> Definition:
+    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free), in the named forces."""
+    chi_ = S.chi0 if regime is None else Q.chi  # no normal force in free flight: chi does not enter
+    moment = sp.expand(sp.trigsimp(moment_about_P(named_forces(regime), chi_)))
+    return Definition(Q.alpha_ddot, moment / S.I_Pb,
+                      "angular acceleration (Eq. 10)" if regime else "angular acceleration (Eq. 15)")
+
+
+def forces(regime: ContactRegime | None) -> Forces:
+    """Forces in a contact regime, or with no contact (``regime=None``, Eq. 15), as functions
+    of alpha(t), Theta(t): :func:`mechanics` with every quantity substituted."""
+    flat = substitutions(mechanics(regime))
+    zero = sp.Integer(0)
+    kinematic = sliding_velocity("kinematic")
+    return Forces(flat[Q.F_s], flat.get(Q.F_n, zero), flat.get(Q.F_f, zero), flat.get(Q.v_r, kinematic))
+
+
+def applied_forces(f: Forces, chi_: sp.Expr | None = None) -> list[tuple[Vector, Vector]]:
     """(point relative to P, force vector on the follower) pairs.
 
     Spring: vertical, at horizontal distance d_x (Eq. 11 acts as a vertical force).
@@ -130,7 +188,7 @@ def applied_forces(f: Forces) -> list[tuple[Vector, Vector]]:
     Friction: -F_f u at O_b, opposing the follower's sliding velocity v_r u
     relative to the cam (F_f = mu F_n with mu of the sign of v_r).
     """
-    r_Ob = P_to_Ob(B, chi())
+    r_Ob = P_to_Ob(B, chi() if chi_ is None else chi_)
     r_spring = S.d_x * N.x + (-S.d_x * sp.tan(alpha)) * N.y
     return [
         (r_spring, f.F_s * N.y),
@@ -139,9 +197,10 @@ def applied_forces(f: Forces) -> list[tuple[Vector, Vector]]:
     ]
 
 
-def moment_about_P(f: Forces) -> sp.Expr:
-    """Clockwise moment about P of the applied forces (alpha is clockwise)."""
-    total = sum((r.cross(F) for r, F in applied_forces(f)), Vector(0))
+def moment_about_P(f: Forces, chi_: sp.Expr | None = None) -> sp.Expr:
+    """Clockwise moment about P of the applied forces (alpha is clockwise); ``chi_`` the moment
+    arm of the contact forces (default: chi0 - psi_j, Eq. 2)."""
+    total = sum((r.cross(F) for r, F in applied_forces(f, chi_)), Vector(0))
     return -total.dot(N.z)
 
 
@@ -156,5 +215,5 @@ def bearing_force_x(f: Forces) -> sp.Expr:
 
 
 def angular_acceleration(regime: ContactRegime | None) -> sp.Expr:
-    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free)."""
-    return moment_about_P(forces(regime)) / S.I_Pb
+    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free), in alpha(t), Theta(t)."""
+    return flatten(acceleration(regime).expr, mechanics(regime))

@@ -8,11 +8,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import symbols as S
-
-CONTACT_LAWS = ("line", "point")
-DAMPING_MODELS = ("none", "A", "B", "C", "D", "E")
-FRICTION_MODELS = ("none", "coulomb", "tanh")
-DAMPING_SIGNS = ("dissipative", "printed")
+from .vocabulary import CONTACT_LAWS, DAMPING_MODELS, DAMPING_SIGNS, FRICTION_MODELS  # noqa: F401
 
 
 def spring_compression(a: sp.Expr) -> sp.Expr:
@@ -65,11 +61,14 @@ class SignedPow32(sp.Function):
         return sp.Rational(3, 2) * sp.sqrt(sp.Abs(self.args[0]))
 
 
-def elastic_force(law: str, psi_i: sp.Expr) -> sp.Expr:
-    """-k_lambda(psi_i) psi_i, the elastic part of F_n in Eq. 12."""
+def elastic_force(law: str, psi_i: sp.Expr, k_lambda: sp.Expr | None = None) -> sp.Expr:
+    """-k_lambda(psi_i) psi_i, the elastic part of F_n in Eq. 12.
+
+    ``k_lambda``: the stiffness as already computed (a named quantity), used as it is for the
+    line law; the point law is written with :class:`SignedPow32` for a clean derivative."""
     if law == "point":
         return -sp.Rational(4, 3) * Y_e * sp.sqrt(S.r_c) * SignedPow32(psi_i)
-    return -contact_stiffness(law, psi_i) * psi_i
+    return -(contact_stiffness(law, psi_i) if k_lambda is None else k_lambda) * psi_i
 
 
 def contact_potential(law: str, psi_i: sp.Expr) -> sp.Expr:

@@ -2,13 +2,8 @@
 """Generated scene kernels of camdyn (written by ``camdyn.derive``, committed).
 
 Each ``scene_<slug>`` module holds the plain-arithmetic kernels of one scene;
-:data:`SCENES` maps a scene's slug to its module.  The slug is built from the
-scene's options as in ``camdyn.derive.scenes.SceneSpec.slug``.
+:data:`SCENES` maps a scene's slug (``camdyn.derive.vocabulary.SceneSpec.slug``) to its module.
 """
-
-OPTIONS = {'contact': ('line', 'point'), 'damping': ('none', 'A', 'B', 'C', 'D', 'E'), 'friction': ('none', 'coulomb', 'tanh'), 'motion': ('constant', 'oscillating', 'user'), 'model': ('nonlinear', 'linear_paper', 'linear_exact'), 'sliding_velocity': ('kinematic', 'printed'), 'damping_sign': ('dissipative', 'printed')}
-
-DEFAULTS = {'contact': 'line', 'damping': 'D', 'friction': 'coulomb', 'motion': 'constant', 'model': 'nonlinear', 'sliding_velocity': 'kinematic', 'damping_sign': 'dissipative'}
 
 SCENES = {
     'line_a_coulomb_constant_nonlinear': 'scene_line_a_coulomb_constant_nonlinear',
@@ -20,6 +15,7 @@ SCENES = {
     'line_d_coulomb_constant_linear_exact': 'scene_line_d_coulomb_constant_linear_exact',
     'line_d_coulomb_constant_linear_paper': 'scene_line_d_coulomb_constant_linear_paper',
     'line_d_coulomb_constant_nonlinear': 'scene_line_d_coulomb_constant_nonlinear',
+    'line_d_coulomb_constant_nonlinear_memoryless': 'scene_line_d_coulomb_constant_nonlinear_memoryless',
     'line_d_coulomb_constant_nonlinear_printedsign': 'scene_line_d_coulomb_constant_nonlinear_printedsign',
     'line_d_coulomb_constant_nonlinear_vrprinted': 'scene_line_d_coulomb_constant_nonlinear_vrprinted',
     'line_d_coulomb_oscillating_nonlinear': 'scene_line_d_coulomb_oscillating_nonlinear',
@@ -32,6 +28,7 @@ SCENES = {
     'line_d_tanh_oscillating_nonlinear_vrprinted': 'scene_line_d_tanh_oscillating_nonlinear_vrprinted',
     'line_d_tanh_user_nonlinear': 'scene_line_d_tanh_user_nonlinear',
     'line_e_coulomb_constant_nonlinear': 'scene_line_e_coulomb_constant_nonlinear',
+    'line_e_coulomb_constant_nonlinear_memoryless': 'scene_line_e_coulomb_constant_nonlinear_memoryless',
     'line_none_coulomb_constant_nonlinear': 'scene_line_none_coulomb_constant_nonlinear',
     'line_none_none_constant_nonlinear': 'scene_line_none_none_constant_nonlinear',
     'point_d_coulomb_constant_nonlinear': 'scene_point_d_coulomb_constant_nonlinear',

@@ -1,0 +1,226 @@
+"""What each mode of a scene computes, as named definitions in plain symbols.
+
+For one mode of the automaton (:mod:`derive.automaton`) this module derives
+
+* :func:`field`: alpha_ddot, the second component of the vector field (Eqs. 10, 15; the
+  Filippov sliding mode on v_r = 0 for a stuck follower; Eqs. 36-38 for the linear models);
+* :func:`surface`: the value of one switching surface under the mode's laws;
+* :func:`outputs`: the output quantities of :data:`derive.vocabulary.OUTPUTS`;
+* :func:`jacobian`: d(alpha_ddot)/d(alpha, alpha_dot), by the chain rule through the named
+  quantities (Eqs. 21-22).
+
+Each is a :class:`Kernel`: definitions (``psi_i = ...``, ``F_n = ...``) in the order they are
+computed, and the results.  Expressions are in the plain symbols t, alpha, alpha_dot and the
+parameters, with the scene's cam motion substituted (a constant speed folds Theta_ddot = 0
+out); a user cam motion keeps Theta, Theta_dot, Theta_ddot as inputs.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy as sp
+
+from . import dynamics, energy, geometry, laws, linear
+from . import symbols as S
+from .automaton import Mode
+from .dynamics import Q
+from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
+from .vocabulary import OUTPUTS, SceneSpec
+
+
+@dataclass(frozen=True)
+class Kernel:
+    """Definitions in computation order, and the results (expressions in their symbols)."""
+
+    definitions: tuple[Definition, ...]
+    results: tuple[sp.Expr, ...]
+
+    def pruned(self) -> "Kernel":
+        """Only the definitions the results need."""
+        return Kernel(used(self.definitions, self.results), self.results)
+
+    def flat(self) -> tuple[sp.Expr, ...]:
+        """The results with every named quantity substituted (for oracles and tests)."""
+        return tuple(flatten(r, self.definitions) for r in self.results)
+
+
+def motion_substitution(motion: str) -> dict:
+    """Theta(t) of the cam motions of Section 7 as plain-symbol substitutions."""
+    tt = S.t_s
+    if motion == "constant":
+        return {S.Theta_s: S.theta0 + S.Omega_c * tt, S.Theta_dot: S.Omega_c, S.Theta_ddot: 0}
+    if motion == "oscillating":
+        half = S.Theta_p / 2
+        return {S.Theta_s: S.theta0 + half * sp.sin(S.omega_c * tt),
+                S.Theta_dot: half * S.omega_c * sp.cos(S.omega_c * tt),
+                S.Theta_ddot: -half * S.omega_c**2 * sp.sin(S.omega_c * tt)}
+    if motion == "user":
+        return {}
+    raise ValueError(f"motion {motion!r} is not a cam motion of Section 7")
+
+
+def plain(expr: sp.Expr, motion: str) -> sp.Expr:
+    """An expression of alpha(t), Theta(t) in plain symbols, with the cam motion substituted."""
+    return S.to_plain(expr).subs(motion_substitution(motion))
+
+
+def _plain_all(defs, motion: str) -> tuple[Definition, ...]:
+    return tuple(Definition(d.symbol, plain(d.expr, motion), d.note) for d in defs)
+
+
+def regime(spec: SceneSpec, mode: Mode, direction: int | None = None) -> dynamics.ContactRegime | None:
+    """The laws of a mode (None in free flight).  ``direction`` overrides the friction sign
+    (the one-sided fields of a stuck follower)."""
+    if not mode.contact:
+        return None
+    phase = "unloading" if mode.phase == "viscous" or spec.model != "nonlinear" else "loading"
+    if direction is None:
+        direction = {"fwd": 1, "bwd": -1}.get(mode.slip, 0)
+    return dynamics.ContactRegime(contact=spec.contact, damping=spec.damping, phase=phase,
+                                  friction=spec.friction, direction=direction,
+                                  damping_sign=spec.damping_sign, sliding_velocity=spec.sliding_velocity)
+
+
+# --- the pieces ---------------------------------------------------------------------------
+V_R_PARTIALS = tuple(quantity(n) for n in ("dv_r_dt", "dv_r_dalpha", "dv_r_dalpha_dot"))
+
+
+def _slip_partials(spec: SceneSpec) -> tuple[Definition, ...]:
+    """v_r and its partial derivatives in t, alpha, alpha_dot (the sliding mode's ingredients)."""
+    v = plain(dynamics.sliding_velocity(spec.sliding_velocity), spec.motion)
+    notes = ("dv_r/dt at fixed state", "dv_r/dalpha", "dv_r/dalpha_dot")
+    return (Definition(Q.v_r, v, f"sliding velocity ({spec.sliding_velocity} form)"),) + tuple(
+        Definition(sym, v.diff(x), note) for sym, x, note in zip(V_R_PARTIALS, (S.t_s, S.alpha_s, S.alpha_dot), notes))
+
+
+def _sliding_mode(spec: SceneSpec) -> tuple[Definition, ...]:
+    """alpha_ddot of a follower stuck on v_r = 0 (Filippov sliding mode, misprint 12): the
+    acceleration that keeps dv_r/dt = v_t + v_a alpha_dot + v_ad alpha_ddot = 0."""
+    v_t, v_a, v_ad = V_R_PARTIALS
+    return _slip_partials(spec) + (
+        Definition(Q.alpha_ddot, -(v_t + v_a * S.alpha_dot) / v_ad, "stuck: keeps dv_r/dt = 0 (Filippov)"),)
+
+
+def _mechanics(spec: SceneSpec, mode: Mode, direction: int | None = None) -> tuple[Definition, ...]:
+    """The named forces of a mode and its (non-linear) alpha_ddot."""
+    r = regime(spec, mode, direction)
+    return _plain_all(dynamics.mechanics(r) + (dynamics.acceleration(r),), spec.motion)
+
+
+def _linear_field(spec: SceneSpec, mode: Mode) -> Definition:
+    """alpha_ddot of the linear models (Section 8) in a sliding mode."""
+    if spec.model == "linear_exact":
+        nonlinear = flatten(Q.alpha_ddot, _mechanics(spec, mode))
+        return Definition(Q.alpha_ddot, linear.exact_linear_rhs(nonlinear), "exact linearization about alpha*")
+    r = regime(spec, mode)
+    c = laws.damping_coefficient(spec.damping, "unloading", 0, 0)
+    mu = laws.friction_coefficient(spec.friction, 0, r.direction)
+    rhs = linear.paper_linear_rhs(linear.paper_linear_model(c, mu, "printed"))
+    return Definition(Q.alpha_ddot, rhs.subs(motion_substitution(spec.motion)), "Eqs. 36-38 as printed")
+
+
+# --- the kernels --------------------------------------------------------------------------
+def field(spec: SceneSpec, mode: Mode) -> Kernel:
+    """alpha_ddot of the mode."""
+    if spec.model != "nonlinear":
+        return Kernel((_linear_field(spec, mode),), (Q.alpha_ddot,))
+    defs = _sliding_mode(spec) if mode.slip == "stick" else _mechanics(spec, mode)
+    return Kernel(defs, (Q.alpha_ddot,)).pruned()
+
+
+def jacobian(spec: SceneSpec, mode: Mode) -> Kernel:
+    """d(alpha_ddot)/d(alpha) and d(alpha_ddot)/d(alpha_dot) of the mode's field (Eqs. 21-22)."""
+    f = field(spec, mode)
+    by_alpha = derivatives(f.definitions, S.alpha_s)
+    by_rate = derivatives(f.definitions, S.alpha_dot)
+    results = (derivative_symbol("alpha_ddot", S.alpha_s, by_alpha),
+               derivative_symbol("alpha_ddot", S.alpha_dot, by_rate))
+    return Kernel(f.definitions + by_alpha + by_rate, results).pruned()
+
+
+def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
+    """The value of surface ``name`` under the mode's laws (None where it has no meaning)."""
+    if name == "gap":
+        return Kernel((Definition(Q.psi_i, plain(dynamics.gap(), spec.motion), "gap (Eq. 6)"),), (Q.psi_i,))
+    if name == "gap_rate":
+        return Kernel((Definition(Q.psi_i_dot, plain(dynamics.gap_rate(), spec.motion), "gap rate (Eq. 8)"),),
+                      (Q.psi_i_dot,))
+    if name == "slip":
+        return Kernel(_slip_partials(spec)[:1], (Q.v_r,))
+    if name in ("slip_rate_fwd", "slip_rate_bwd") and mode.contact:
+        side = _mechanics(spec, mode, direction=1 if name == "slip_rate_fwd" else -1)
+        v_t, v_a, v_ad = V_R_PARTIALS
+        rate = v_t + v_a * S.alpha_dot + v_ad * Q.alpha_ddot
+        return Kernel(side + _slip_partials(spec)[1:], (rate,)).pruned()
+    return None
+
+
+def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
+    """A stuck follower: alpha_ddot of the sliding mode and the friction force that produces it
+    (Eq. 10 solved for F_f; F_f / F_n is the equivalent friction coefficient, inside +-mu_m
+    while stuck)."""
+    stuck = _sliding_mode(spec)[1:]  # the partials and alpha_ddot (v_r is already defined)
+    free_f = plain(dynamics.acceleration(regime(spec, mode, direction=1)).expr, spec.motion)
+    a0, a1 = free_f.subs(Q.F_f, 0), free_f.diff(Q.F_f)
+    return stuck + (Definition(Q.F_f, (Q.alpha_ddot - a0) / a1, "friction force that keeps the follower stuck"),)
+
+
+@lru_cache(maxsize=None)
+def _energy_terms(contact: str):
+    """V_s(alpha), its derivative, and in contact V_c(psi_i), in plain symbols (psi_i named).
+
+    V_s is built as the integral of the spring moment d_x F_s (derive.energy), so its
+    derivative is d_x F_s: checked here, then used in the named form d_x F_s."""
+    V_s = S.to_plain(energy.spring_potential())
+    moment = S.d_x * laws.spring_force(S.alpha_s)
+    if sp.simplify(V_s.diff(S.alpha_s) - moment) != 0:
+        raise RuntimeError("dV_s/dalpha is not the spring moment d_x F_s: check derive.energy.spring_potential")
+    return V_s, S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i)
+
+
+def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
+    """The output quantities (vocabulary.OUTPUTS order) in the mode."""
+    r = regime(spec, mode)
+    zero = sp.Integer(0)
+    if mode.slip == "stick":
+        defs = _mechanics(spec, mode, direction=1)[:-1]  # the forces without Coulomb's F_f, alpha_ddot
+        defs = tuple(d for d in defs if d.symbol not in (Q.mu, Q.F_f)) + _stuck_friction(spec, mode)
+    else:
+        defs = _mechanics(spec, mode)
+    geometry_defs = []
+    for sym, expr, note in ((Q.psi_i, dynamics.gap(), "gap (Eq. 6)"), (Q.psi_i_dot, dynamics.gap_rate(), "Eq. 8"),
+                            (Q.psi_j, dynamics.psi_j(), "Eq. 7")):
+        if sym not in {d.symbol for d in defs}:
+            geometry_defs.append(Definition(sym, plain(expr, spec.motion), note))
+    defs = tuple(geometry_defs) + defs
+    names = {d.symbol for d in defs}
+    kinematic = plain(dynamics.sliding_velocity("kinematic"), spec.motion)
+    if Q.v_r in names and spec.sliding_velocity == "kinematic":
+        v_kin = Q.v_r
+    else:
+        v_kin = quantity("v_r_kinematic")
+        defs += (Definition(v_kin, kinematic, "relative velocity of the contact points along the bar"),)
+    v_r_out = Q.v_r if Q.v_r in names else v_kin
+    forces = dynamics.Forces(Q.F_s, Q.F_n if r else zero, Q.F_f if Q.F_f in names else zero, v_r_out)
+    V_s, dV_s, V_c = _energy_terms(spec.contact)
+    E = S.I_Pb * S.alpha_dot**2 / 2 + V_s + (V_c if r else zero)
+    if r is None:  # free flight: no contact force, nothing delivered or dissipated
+        dE_dt = D_c = D_f = zero
+    else:
+        F_d = -Q.c_lambda * Q.psi_i_dot  # the damping part of F_n (Eq. 12)
+        D_c, D_f = -F_d * Q.psi_i_dot, forces.F_f * v_kin
+        dE_dt = (S.I_Pb * Q.alpha_ddot + dV_s) * S.alpha_dot + V_c.diff(Q.psi_i) * Q.psi_i_dot
+    named = [(quantity("N_x"), plain(dynamics.bearing_force_x(forces), spec.motion), "bearing force (Eq. 35)"),
+             (quantity("alpha_i"), plain(geometry.rigid_contact_angle(S.Theta), spec.motion),
+              "follower angle in rigid contact (Eq. 29)"),
+             (quantity("energy"), E, "T + V_s + V_c (Section 5)"),
+             (quantity("D_c"), D_c, "power dissipated by contact damping"),
+             (quantity("D_f"), D_f, "power dissipated by friction"),
+             (quantity("P_in"), dE_dt + quantity("D_c") + quantity("D_f"),
+              "power of the cam drive: dE/dt + D_c + D_f")]
+    defs += tuple(Definition(sym, expr, note) for sym, expr, note in named)
+    values = {"psi_i": Q.psi_i, "psi_j": Q.psi_j, "psi_i_dot": Q.psi_i_dot, "F_s": Q.F_s, "F_n": forces.F_n,
+              "F_f": forces.F_f, "v_r": v_r_out}
+    results = tuple(values.get(name, quantity(name)) for name in OUTPUTS)
+    return Kernel(defs, results).pruned()

@@ -35,8 +35,8 @@ def static_equilibrium(rig: Rig, contact: str = "line") -> Equilibrium:
 class NaturalFrequency:
     """Eigen-analysis of the state Jacobian at the static equilibrium (Eqs. 21-23).
 
-    ``damped_rad_s`` is |Im(eig J)| (misprint 4: no square root), ``undamped_rad_s``
-    is |eig J| = sqrt(-J21); ``Hz`` is damped_rad_s / 2 pi.
+    ``damped_rad_s`` is ``|Im(eig J)|`` (misprint 4: no square root), ``undamped_rad_s``
+    is ``|eig J| = sqrt(-J21)``; ``Hz`` is ``damped_rad_s / 2 pi``.
     """
 
     eigenvalues: tuple[complex, complex]
@@ -64,18 +64,27 @@ def natural_frequency(rig: Rig, scene: Scene | None = None, cam: CamMotion | Non
     """
     scene = scene or Scene(damping="none", friction="none")
     model = Model(rig, scene, cam or ConstantSpeed(0.0))
-    a, names = model.equilibrium.alpha, list(model.regimes.values())
-    contact = [n for n in names if n != "free" and "_loading" not in n]
-    if any(n.endswith(("_fwd", "_bwd")) for n in contact):
-        out = model.bind(getattr(model.kernels, f"out_{contact[0]}_v"))(0.0, a, 0.0)
-        suffix = "_fwd" if out[6] >= 0 else "_bwd"
-        contact = [n for n in contact if n.endswith(suffix)]
-    name = contact[0]
-    d0, d1 = model.bind(getattr(model.kernels, f"jac_{name}"))(0.0, a, 0.0)
+    m = sliding_mode(model, 0.0, model.equilibrium.alpha, 0.0)
+    name = model.kernels.MODES[m]
+    d0, d1 = model.jacobian(m, 0.0, model.equilibrium.alpha, 0.0)
     eig = np.linalg.eigvals(np.array([[0.0, 1.0], [d0, d1]]))
     wn = math.sqrt(max(-d0, 0.0))
     return NaturalFrequency((complex(eig[0]), complex(eig[1])), float(abs(eig[0].imag)), wn,
                             float(-d1 / (2 * wn)) if wn else math.nan, name)
+
+
+def sliding_mode(model: Model, t: float, alpha: float, alpha_dot: float) -> int:
+    """The mode of sliding contact at a state: in contact, under the viscous law of models D
+    and E (their law after maximum compression), sliding in the direction of v_r there (not
+    stuck).  Read from the automaton's mode tables, not from names."""
+    K = model.kernels
+    modes = [i for i, contact in enumerate(K.CONTACT_OF_MODE)
+             if contact and K.PHASE_OF_MODE[i] in (None, "viscous") and K.SLIP_OF_MODE[i] != "stick"]
+    if any(K.SLIP_OF_MODE[i] is not None for i in modes):
+        v_r = model.surface(modes[0], K.SURFACE_SLIP, t, alpha, alpha_dot)
+        side = "fwd" if v_r >= 0 else "bwd"
+        modes = [i for i in modes if K.SLIP_OF_MODE[i] == side]
+    return modes[0]
 
 
 def rigid_contact_angle(rig: Rig, theta, contact: str = "line") -> np.ndarray:
@@ -168,6 +177,25 @@ class ResidualStats:
 
 
 def residual_stats(result: Result, *, transient_revolutions: float = 0.0) -> ResidualStats:
+    """The rms and peak-to-peak of the residual response alpha_r (Section 4, Fig. 4).
+
+    Parameters
+    ----------
+    result : camdyn.Result
+        A run.
+    transient_revolutions : float, optional
+        Cam revolutions left out at the start (0 for a cam with no period).
+
+    Returns
+    -------
+    ResidualStats
+        ``rms`` (of alpha_r about its mean) and ``peak_to_peak``, in rad.
+
+    Raises
+    ------
+    camdyn.ParameterError
+        If a transient is asked for on a cam with no period.
+    """
     if not math.isfinite(result.period) and transient_revolutions:
         raise ParameterError("transient_revolutions", transient_revolutions, "0 for a cam with no period")
     r = result.after(result.t[0] + transient_revolutions * result.period) if transient_revolutions else result

@@ -56,7 +56,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from . import analysis
-from .cam import CamMotion, ConstantSpeed
+from .cam import CamMotion
 from .errors import CamdynError
 from .rig import PARAMETERS, Rig
 from .scene import Scene

@@ -43,8 +43,9 @@ class ConstantSpeed:
 
     @property
     def period(self) -> float:
-        """One cam revolution (s); infinite for a cam at rest."""
-        return math.inf if self.speed_rpm == 0 else abs(2 * math.pi / self.Omega_c)
+        """One cam revolution (s); infinite for a cam at rest (or so slow that Omega_c underflows)."""
+        omega = self.Omega_c
+        return math.inf if omega == 0 else abs(2 * math.pi / omega)
 
     def values(self) -> dict[str, float]:
         return {"Omega_c": self.Omega_c}

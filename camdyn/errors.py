@@ -7,7 +7,9 @@ do not know camdyn. All of them can be pickled (for process pools).
 
 from __future__ import annotations
 
+import difflib
 import functools
+import re
 from numbers import Real
 from typing import Any
 
@@ -40,7 +42,14 @@ class ParameterError(CamdynError, ValueError):
     reason : str, optional
         Appended in parentheses: the parameter's meaning and unit, and the likely mistake.
 
-    Example message: ``k_s = -5.0 is out of range: must be > 0 (follower spring stiffness, N/m)``.
+    Example messages:
+
+    - a value out of range:
+      ``k_s = -5.0 is out of range: must be > 0 (follower spring stiffness, N/m)``;
+    - a string where a number is asked for:
+      ``k_s = '2000' is not a real number (str): must be > 0``;
+    - a string that is not one of the names ``valid`` lists:
+      ``method = 'RK54' is not valid (did you mean 'RK45'?): must be one of ('RK45', 'DOP853')``.
     """
 
     def __init__(self, name: str, value: Any, valid: str, *, reason: str | None = None):
@@ -49,6 +58,9 @@ class ParameterError(CamdynError, ValueError):
             message = f"{name} is not given: {valid}"
         elif isinstance(value, Real) and not isinstance(value, bool):
             message = f"{name} = {value} is out of range: must be {valid}"
+        elif isinstance(value, str) and not _NUMERIC.search(valid):
+            # a name chosen from a list (a method, a backend, a preset): not a number problem
+            message = f"{name} = {value!r} is not valid{_did_you_mean(value, valid)}: must be {valid}"
         else:
             kind = type(value).__name__
             message = f"{name} = {value!r} is not a real number ({kind}): must be {valid}"
@@ -59,6 +71,17 @@ class ParameterError(CamdynError, ValueError):
     def __reduce__(self):
         rebuild = functools.partial(type(self), reason=self.reason)
         return rebuild, (self.name, self.value, self.valid)
+
+
+#: words of a ``valid`` text that asks for a number (a string value is then "not a real number")
+_NUMERIC = re.compile(r"number|finite|integer|[<>]|^\s*[-+0-9]")
+
+
+def _did_you_mean(value: str, valid: str) -> str:
+    """`` (did you mean 'X'?)`` for the closest of the quoted names in ``valid``, else ''."""
+    names = re.findall(r"'([^']+)'", valid)
+    close = difflib.get_close_matches(value, names, n=1) or [n for n in names if n.lower() == value.lower()]
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 class RigFileError(CamdynError, ValueError):

@@ -15,12 +15,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
+from .engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
 from .scene import Scene
 
-#: |alpha| beyond this is treated as the singular 90 degrees of Eq. 11 (tan, sec).
-ANGLE_LIMIT = math.pi / 2 - 0.02
 _DERIVED = ("alpha_star", "chi_star", "vartheta")
 _CAM = ("Omega_c", "Theta_p", "omega_c")
 
@@ -113,8 +112,6 @@ class Model:
         values = {**rig.to_dict(), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta,
                   **cam.values()}
         self.p = self.kernels.pack({k: values[k] for k in self.kernels.INPUTS})
-        self.flags = self.kernels.FLAGS
-        self.regimes = self.kernels.REGIMES
 
     def _check_reach(self):
         """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""
@@ -132,23 +129,39 @@ class Model:
     def period(self) -> float:
         return self.cam.period
 
-    def regime_functions(self, name: str):
-        K = self.kernels
-        return getattr(K, f"rhs_{name}"), getattr(K, f"jac_{name}"), getattr(K, f"out_{name}_v")
-
     def cam_state(self, t):
         """(Theta, Theta_dot, Theta_ddot) at t (scalar or array)."""
         if self.scene.motion == "user":
             return self.cam(t)
-        return self.kernels.cam_v(t, self.p) if np.ndim(t) else self.kernels.cam(t, self.p)
+        return self.kernels.cam(t, self.p)
 
-    def bind(self, fn):
-        """A kernel f(t, alpha, alpha_dot, p[, cam]) as g(t, alpha, alpha_dot)."""
-        p = self.p
-        if self.scene.motion == "user":
-            cam = self.cam
-            return lambda t, a, ad: fn(t, a, ad, p, cam(t))
-        return lambda t, a, ad: fn(t, a, ad, p)
+    def mode(self, name: str) -> int:
+        """The index of a mode of the scene's automaton (``MODES``)."""
+        return self.kernels.MODES.index(name)
+
+    def _extra(self, t) -> tuple:
+        """The kernels' argument after p: the user cam's state at t, or nothing."""
+        return (self.cam(t),) if self.scene.motion == "user" else ()
+
+    def rhs(self, m: int, t: float, alpha: float, alpha_dot: float) -> float:
+        """alpha_ddot in mode m (the generated ``rhs``)."""
+        return self.kernels.rhs(m, t, alpha, alpha_dot, self.p, *self._extra(t))
+
+    def surface(self, m: int, s: int, t: float, alpha: float, alpha_dot: float) -> float:
+        """Surface s's value under mode m's laws (the generated ``surface``)."""
+        return self.kernels.surface(m, s, t, alpha, alpha_dot, self.p, *self._extra(t))
+
+    def jacobian(self, m: int, t: float, alpha: float, alpha_dot: float) -> tuple[float, float]:
+        """(d alpha_ddot/d alpha, d alpha_ddot/d alpha_dot) in mode m (Eqs. 21-22)."""
+        out = np.empty(2)
+        self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        return float(out[0]), float(out[1])
+
+    def outputs(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
+        """The output quantities (``OUTPUTS``) in mode m at one state, by name."""
+        out = np.empty(len(self.kernels.OUTPUTS))
+        self.kernels.outputs(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        return dict(zip(self.kernels.OUTPUTS, map(float, out)))
 
     def static_state(self) -> np.ndarray:
         return np.array([self.equilibrium.alpha, 0.0])

@@ -6,8 +6,8 @@ import enum
 
 class Outcome(enum.Enum):
     SUCCESS = "the run reached t_end"
-    STEP_FAILED = ("the ODE solver could not take a step (step size underflow); tighten or loosen "
-                   "rtol/atol, or try method='Radau' for a very stiff contact")
+    STEP_FAILED = ("the Runge-Kutta method could not take a step (step size underflow); tighten or "
+                   "loosen rtol/atol; a very stiff contact (large Y_c, Y_b) may need max_step")
     MAX_EVENTS = ("more regime switches than EventSettings.max_events; the run may be chattering "
                   "(Zeno-like impacts or Coulomb stick): raise max_events or use friction='tanh'")
     CHATTER = ("a switching surface was crossed back and forth with no progress in time "

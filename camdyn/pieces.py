@@ -20,7 +20,8 @@ from typing import Callable
 
 import numpy as np
 
-from .integrate import SolverOptions, Trajectory
+from .engine.config import SolverOptions
+from .engine.driver import Trajectory
 from .model import Model
 from .outcome import Outcome
 
@@ -35,8 +36,9 @@ def kernel_period(model: Model) -> float:
 
 def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, float], y0,
                         t_eval: np.ndarray, options: SolverOptions) -> Trajectory:
-    """``integrate`` (a backend's integrate(model, t_span, y0, t_eval, options, key=...)) over
-    t_span in phase-wrapped pieces; a short run, or a cam without a period, in one call."""
+    """``integrate`` (the engine's integrate(model, t_span, y0, t_eval, options, mode=...), its
+    backend chosen) over t_span in phase-wrapped pieces; a short run, or a cam without a
+    period, in one call."""
     t0, t_end = map(float, t_span)
     P = kernel_period(model)
     length = PIECE_PERIODS * P
@@ -46,7 +48,7 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
     t_eval = np.asarray(t_eval, dtype=float)
     parts: list[Trajectory] = []
     work = np.zeros(3)
-    y, key, start, i = np.asarray(y0, dtype=float), None, t0, 0
+    y, mode, start, i = np.asarray(y0, dtype=float), None, t0, 0
     budget = options.events.max_events
     while start < t_end:
         end = min(start + length, t_end)
@@ -56,7 +58,7 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
         local_end = phase + (end - start)
         local = np.append(phase + (own - start), local_end) if extra else phase + (own - start)
         opts = dataclasses.replace(options, events=dataclasses.replace(options.events, max_events=budget))
-        tr = integrate(model, (phase, local_end), y, local, opts, key=key)
+        tr = integrate(model, (phase, local_end), y, local, opts, mode=mode)
         kept = min(tr.t.size, own.size)
         shift = start - phase
         parts.append(_absolute(tr, own[:kept], kept, shift, work))
@@ -66,7 +68,7 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
         y = tr.y[:2, -1].copy()
         if options.ledger:
             work = work + tr.y[2:5, -1]
-        key = tr.keys[tr.regime[-1]]
+        mode = tr.end_mode
         start, i = end, hi
     return _joined(parts)
 
@@ -77,7 +79,7 @@ def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.n
     if y.shape[0] == 5:
         y[2:5] += work[:, None]
     switches = [dataclasses.replace(s, t=s.t + shift) for s in tr.switches]
-    return dataclasses.replace(tr, t=t.copy(), y=y, regime=tr.regime[:kept], switches=switches)
+    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches)
 
 
 def _joined(parts: list[Trajectory]) -> Trajectory:
@@ -87,9 +89,7 @@ def _joined(parts: list[Trajectory]) -> Trajectory:
         for name, value in p.stats.items():
             stats[name] = stats.get(name, 0) + value if isinstance(value, (int, float)) else value
     stats["pieces"] = len(parts)
-    keys = {}
-    for p in parts:
-        keys.update(p.keys)
-    return Trajectory(np.concatenate([p.t for p in parts]), np.concatenate([p.y for p in parts], axis=1),
-                      np.concatenate([p.regime for p in parts]), keys,
-                      [s for p in parts for s in p.switches], last.outcome, stats)
+    return dataclasses.replace(last, t=np.concatenate([p.t for p in parts]),
+                               y=np.concatenate([p.y for p in parts], axis=1),
+                               mode=np.concatenate([p.mode for p in parts]),
+                               switches=[s for p in parts for s in p.switches], stats=stats)

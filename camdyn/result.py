@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .integrate import Switch
+from .engine.driver import Switch
 from .outcome import Outcome
 
 
@@ -50,14 +50,19 @@ class Result:
 
     @property
     def in_contact(self) -> np.ndarray:
-        return self.regime != "free"
+        """Whether the follower touches the cam at each sample (the generated CONTACT_OF_MODE)."""
+        contact = self.meta["contact"]
+        return np.array([contact[name] for name in self.regime], dtype=bool)
 
     def impacts(self) -> np.ndarray:
-        """Times at which contact starts (the gap closes)."""
-        return np.array([s.t for s in self.switches if s.surface == "contact" and s.before == "free"])
+        """Times at which contact starts (a switch from a free mode to a contact mode)."""
+        contact = self.meta["contact"]
+        return np.array([s.t for s in self.switches if not contact[s.before] and contact[s.after]])
 
     def separations(self) -> np.ndarray:
-        return np.array([s.t for s in self.switches if s.surface == "contact" and s.after == "free"])
+        """Times at which contact ends."""
+        contact = self.meta["contact"]
+        return np.array([s.t for s in self.switches if contact[s.before] and not contact[s.after]])
 
     def after(self, t0: float) -> "Result":
         """The samples at t >= t0 (e.g. to drop a transient)."""

@@ -1,10 +1,10 @@
 """The paper's PRINTED equations, transcribed by hand (Sundar, Dreyer & Singh, JSV 332 (2013) 4280-4295).
 
 This is the only place in the test suite where printed formulas live.  They are
-transcribed from ``/work/shared/paper/EQUATIONS.md`` and the extracted paper text
-(``000_5512ff7d629cb876.txt``), *including* their misprints, so the tests can show
-where the derivation (``camdyn.derive``) agrees with the paper and where it departs
-from it on purpose (the numbered misprints of EQUATIONS.md).  Nothing here is
+transcribed from the printed paper (restated in ``docs/equations.md``), *including*
+their misprints, so the tests can show where the derivation (``camdyn.derive``)
+agrees with the paper and where it departs from it on purpose (the numbered
+misprints of ``docs/misprints.md``).  Nothing here is
 imported from the derivation except its symbols, so a transcription error cannot
 hide a derivation error.
 

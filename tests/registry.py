@@ -5,7 +5,8 @@ import math
 
 import camdyn
 from camdyn import generated
-from camdyn.simulation import BACKENDS as _BACKENDS
+from camdyn.engine.config import METHODS as _METHODS
+from camdyn.simulation import BACKENDS as _BACKENDS  # "compiled", "python"
 
 RIG = camdyn.example_rig()
 
@@ -25,12 +26,12 @@ def cam_for(scene: camdyn.Scene, speed_rpm: float = 300.0):
     omega = speed_rpm * camdyn.cam.RPM
     th0 = RIG.theta0
     return camdyn.UserMotion(lambda t: th0 + omega * t, lambda t: omega + 0 * t, lambda t: 0 * t,
-                             period=2 * math.pi / omega)
+                             period=2 * math.pi / abs(omega) if omega else math.inf)
 
 
 #: every generated scene, by slug
 SCENES = sorted(generated.SCENES)
-#: SciPy methods the reference backend supports with events
-METHODS = ["DOP853", "RK45", "Radau", "BDF", "LSODA"]
+#: the engine's Runge-Kutta pairs
+METHODS = list(_METHODS)
 #: every backend of camdyn.simulate: the hard cases run on each (issue 5)
 BACKENDS = list(_BACKENDS)

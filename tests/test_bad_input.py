@@ -3,7 +3,6 @@
 SciPy, a NaN in a result, or a hang (runs are kept short, so a hang would show as a timeout)."""
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -112,3 +111,18 @@ def test_hostile_command_lines(argv, capsys):
     out = capsys.readouterr()
     assert code in (0, 2, 3)
     assert "Traceback" not in out.err
+
+
+def test_a_name_that_is_not_one_of_the_choices_is_not_called_a_number():
+    """A string where a name from a list is asked for (a method, a backend, a preset) is "not
+    valid", with a suggestion; a string where a number is asked for stays "not a real number"
+    (issue 14, D: '--backend compiled --method Radau' said "is not a real number (str)")."""
+    from camdyn.errors import ParameterError
+
+    message = str(ParameterError("method", "Radua", "one of ['BDF', 'DOP853', 'Radau']"))
+    assert message == "method = 'Radua' is not valid (did you mean 'Radau'?): must be one of ['BDF', 'DOP853', 'Radau']"
+    assert "real number" not in str(ParameterError("backend", "numba", "one of ('scipy', 'compiled')"))
+    assert "is not a real number (str)" in str(ParameterError("k_s", "2000", "a finite real number > 0"))
+    with pytest.raises(ParameterError) as info:
+        camdyn.load_rig("exmaple")
+    assert "did you mean 'example'" in str(info.value) and "real number" not in str(info.value)

@@ -1,6 +1,6 @@
 """The derivation (camdyn.derive) against the paper's printed equations (tests/paper_printed.py).
 
-Each test proves one equation or names one misprint of /work/shared/paper/EQUATIONS.md.
+Each test proves one equation (docs/equations.md) or names one misprint of docs/misprints.md.
 "Proves" means exact symbolic equality: the difference is shown to be 0 by
 ``sp.expand`` / ``sp.expand_trig`` + ``sp.expand`` (cheap) or else ``sp.simplify``.
 Where a test falls back to numbers, its docstring says so and why.

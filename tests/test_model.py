@@ -16,7 +16,6 @@ from registry import RIG
 def test_equilibrium_satisfies_eqs_16_to_18():
     eq = analysis.static_equilibrium(RIG)
     K = camdyn.Scene(damping="none", friction="none").kernels()
-    from camdyn.model import _DERIVED, _CAM  # noqa: F401
     m = Model(RIG, camdyn.Scene(damping="none", friction="none"), camdyn.ConstantSpeed(0))
     M, dM, psi_i, psi_j, k = K.static_moment(eq.alpha, m.p)
     scale = k * abs(eq.psi_i) * eq.chi  # the contact moment being balanced

@@ -51,7 +51,7 @@ def edit(path: Path, old: str, new: str) -> None:
 
 def one_scene_catalog(derive: Path, *specs: str) -> None:
     (derive / "catalog.py").write_text(
-        "from .scenes import SceneSpec\n\nCATALOG = (\n" + "".join(f"    SceneSpec({s}),\n" for s in specs) + ")\n")
+        "from .vocabulary import SceneSpec\n\nCATALOG = (\n" + "".join(f"    SceneSpec({s}),\n" for s in specs) + ")\n")
 
 
 def load_generated(folder: Path, name: str):
@@ -112,7 +112,7 @@ def test_drift_check_catches_a_hand_edit_of_generated_code(tmp_path, capfd):
     assert main(["regenerate", "--derive", str(derive), "--out", str(out), "--jobs", "1"]) == 0
     assert main(["regenerate", "--derive", str(derive), "--out", str(out), "--check", "--jobs", "1"]) == 0
     module = out / "scene_line_none_none_constant_nonlinear.py"
-    module.write_text(module.read_text().replace("def gap(", "def gap(  ", 1))
+    module.write_text(module.read_text().replace("def rhs(", "def rhs(  ", 1))
     capfd.readouterr()
     assert main(["regenerate", "--derive", str(derive), "--out", str(out), "--check", "--jobs", "1"]) == 1
     captured = capfd.readouterr()
@@ -132,7 +132,7 @@ def test_a_new_law_option_and_scene_need_no_edit_in_the_runtime(tmp_path):
               if p.relative_to(pkg).parts[0] not in ("derive", "generated")}
 
     # the edit: a new friction law "atan" (derive/laws.py) and one scene that uses it (derive/catalog.py)
-    edit(derive / "laws.py", 'FRICTION_MODELS = ("none", "coulomb", "tanh")',
+    edit(derive / "vocabulary.py", 'FRICTION_MODELS = ("none", "coulomb", "tanh")',
          'FRICTION_MODELS = ("none", "coulomb", "tanh", "atan")')
     edit(derive / "laws.py", TANH, TANH + '\n    if model == "atan":\n        ' + ATAN)
     one_scene_catalog(derive, 'damping="D", friction="atan"', 'damping="D", friction="tanh"')
@@ -175,8 +175,9 @@ def test_regenerate_refuses_a_folder_that_is_not_derive(tmp_path, capsys):
 
 
 def test_the_documented_law_texts_still_exist():
-    """docs/model-editing.md and notebook 04 edit these lines of derive/laws.py."""
+    """docs/model-editing.md and notebook 04 edit these lines of derive/laws.py and vocabulary.py."""
     laws = (package_dir("camdyn.derive") / "laws.py").read_text()
-    assert TANH in laws and 'FRICTION_MODELS = ("none", "coulomb", "tanh")' in laws
+    vocabulary = (package_dir("camdyn.derive") / "vocabulary.py").read_text()
+    assert TANH in laws and 'FRICTION_MODELS = ("none", "coulomb", "tanh")' in vocabulary
     doc = (Path(__file__).resolve().parent.parent / "docs" / "model-editing.md").read_text()
     assert TANH in doc and ATAN in doc

@@ -1,4 +1,4 @@
-"""The compiled Runge-Kutta core against SciPy and against the mathematics.
+"""The engine's Runge-Kutta core against SciPy and against the mathematics.
 
 Same coefficients as SciPy's RK45 and DOP853; the tableau refuses a corrupted coefficient;
 on a smooth problem the compiled stepper takes SciPy's steps (same times, same RHS count);
@@ -16,15 +16,18 @@ from scipy.integrate import DOP853 as SciDOP853
 from scipy.integrate import RK45 as SciRK45
 from scipy.integrate._ivp import dop853_coefficients as sci853
 
-from camdyn.compiled import stepper, tableau
-from camdyn.compiled.kernels import SIGNATURE
+from camdyn.engine import stepper, tableau
+from camdyn.engine.kernels import RHS
+from camdyn.engine.problem import Kernels, Problem
+from camdyn.engine.tables import tables
+from toy import BOUNCE, settings
 
 METHODS = {"RK45": SciRK45, "DOP853": SciDOP853}
 
 
 # --- a smooth test problem: damped Duffing oscillator, alpha'' = -p0 alpha - p1 alpha^3 - p2 alpha'
-@numba.cfunc(SIGNATURE)
-def duffing(r, t, a, ad, p):
+@numba.cfunc(RHS)
+def duffing(m, t, a, ad, p):
     p[3] += 1.0  # counts evaluations in the caller's array (no global state)
     return -p[0] * a - p[1] * a ** 3 - p[2] * ad
 
@@ -33,36 +36,38 @@ def _duffing_py(t, y, p=(4.0, 1.0, 0.1)):
     return np.array([y[1], -p[0] * y[0] - p[1] * y[0] ** 3 - p[2] * y[1]])
 
 
+def _problem(p) -> Problem:
+    """The Duffing oscillator as a one-mode problem (the toy automaton's tables are not used)."""
+    return Problem(Kernels(duffing, duffing, duffing, duffing), tables(BOUNCE), np.asarray(p, dtype=float))
+
+
 @numba.njit
-def _adaptive(rhs, method, p, t0, t_end, y0, y1, rtol, atol, times):
+def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
     """Drive stepper.step like SciPy's solver loop; records the accepted times."""
-    fns = (rhs, rhs, rhs, rhs)  # one generated regime (nr = 1): accel calls rhs(0, ...)
-    K = np.empty((method[0].shape[0], 2))
-    K[0, 0], K[0, 1] = y1, rhs(0, t0, y0, y1, p)
-    error_order = -1.0 / method[9] - 1.0
-    h = stepper.initial_step(fns, 1, 0, t0, y0, y1, K[0, 1], t_end, math.inf, error_order, rtol, atol, p)
+    K = np.empty((method.A.shape[0], 2))
+    K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t0, y0, y1, prob.p)
+    h = stepper.initial_step(prob, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
     t, n, nfev = t0, 0, 2
     while t < t_end:
-        status, t, y0, y1, h, f, _ = stepper.step(fns, 1, 0, t, y0, y1, h, t_end, method, p, K, rtol, atol, math.inf)
+        status, t, y0, y1, h, f, _ = stepper.step(prob, 0, t, y0, y1, h, t_end, method, K, cfg)
         nfev += f
         times[n] = t
         n += 1
-        K[0, 0], K[0, 1] = K[method[6], 0], K[method[6], 1]
+        K[0, 0], K[0, 1] = K[method.n_stages, 0], K[method.n_stages, 1]
     return n, nfev, y0, y1
 
 
 @numba.njit
-def _fixed(rhs, method, p, h, n_steps, y0, y1, theta):
+def _fixed(prob, method, h, n_steps, y0, y1, theta):
     """n_steps fixed steps of size h; returns the end state and the interpolant at theta of the last step."""
-    fns = (rhs, rhs, rhs, rhs)
-    K = np.empty((method[0].shape[0], 2))
-    Q = np.empty((2, method[5].shape[1]))
+    K = np.empty((method.A.shape[0], 2))
+    Q = np.empty((2, method.P.shape[1]))
     t = 0.0
     d0 = d1 = 0.0
     for _ in range(n_steps):
-        K[0, 0], K[0, 1] = y1, rhs(0, t, y0, y1, p)
-        n0, n1 = stepper.step_impl(fns, 1, 0, t, y0, y1, h, method, p, K)
-        stepper.dense_coefficients(fns, 1, 0, t, y0, y1, h, method, p, K, Q)
+        K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t, y0, y1, prob.p)
+        n0, n1 = stepper.step_impl(prob, 0, t, y0, y1, h, method, K)
+        stepper.dense_coefficients(prob, 0, t, y0, y1, h, method, K, Q)
         d0, d1 = stepper.dense_eval(t + theta * h, t, h, y0, y1, Q)
         t, y0, y1 = t + h, n0, n1
     return y0, y1, d0, d1
@@ -135,13 +140,14 @@ def test_same_steps_and_evaluations_as_scipy_on_a_smooth_problem(name, rtol):
     while solver.status == "running":
         solver.step()
         ref.append(solver.t)
-    p = np.array([4.0, 1.0, 0.1, 0.0])
+    prob = _problem([4.0, 1.0, 0.1, 0.0])
     times = np.empty(100_000)
-    n, nfev, a, ad = _adaptive(duffing, tableau.arrays(tableau.TABLEAUS[name]), p, 0.0, t_end, *y0, rtol, atol, times)
+    n, nfev, a, ad = _adaptive(prob, tableau.arrays(tableau.TABLEAUS[name]), settings(rtol=rtol, atol=atol), 0.0,
+                               t_end, *y0, times)
     assert n == len(ref) > 10
     np.testing.assert_allclose(times[:n], ref, rtol=1e-6, atol=0)
     np.testing.assert_allclose([a, ad], solver.y, rtol=0, atol=10 * rtol)
-    assert nfev == solver.nfev == p[3]  # the stepper's count, SciPy's, and the calls counted by the RHS
+    assert nfev == solver.nfev == prob.p[3]  # the stepper's count, SciPy's, and the calls counted by the RHS
 
 
 @pytest.mark.parametrize("name, order, dense_order", [("RK45", 5, 4), ("DOP853", 8, 7)])
@@ -149,14 +155,14 @@ def test_measured_order_of_convergence(name, order, dense_order):
     """Harmonic oscillator (p1 = p2 = 0), exact solution cos(2t): the global error of fixed
     steps falls as h^order, the interpolant's local error at mid-step as h^(dense_order+1)."""
     method = tableau.arrays(tableau.TABLEAUS[name])
-    p = np.array([4.0, 0.0, 0.0, 0.0])
+    prob = _problem([4.0, 0.0, 0.0, 0.0])
     T = 1.0
     hs = [T / 8, T / 16] if name == "DOP853" else [T / 32, T / 64]
     glob, local = [], []
     for h in hs:
-        a, _, _, _ = _fixed(duffing, method, p, h, int(round(T / h)), 1.0, 0.0, 0.5)
+        a, _, _, _ = _fixed(prob, method, h, int(round(T / h)), 1.0, 0.0, 0.5)
         glob.append(abs(a - math.cos(2 * T)))
-        _, _, d, _ = _fixed(duffing, method, p, 4 * h, 1, 1.0, 0.0, 0.5)  # one step, interpolant at 2h
+        _, _, d, _ = _fixed(prob, method, 4 * h, 1, 1.0, 0.0, 0.5)  # one step, interpolant at 2h
         local.append(abs(d - math.cos(2 * 2 * h)))
     assert math.log2(glob[0] / glob[1]) == pytest.approx(order, abs=0.35)
     assert math.log2(local[0] / local[1]) >= dense_order + 1 - 0.35

@@ -1,8 +1,11 @@
 """The paper's studies, reproduced on the reference rig, one command each.
 
 ``python -m camdyn.studies <name>`` runs one study: it writes its figure
-(``docs/img/repro_<name>.png``), its numbers, and its section of
-``docs/reproduction.md`` (the paper's statement beside camdyn's result).
+(``<out>/img/repro_<name>.png``), its numbers, and its section of
+``<out>/reproduction.md`` (the paper's statement beside camdyn's result).  ``<out>`` is the
+checkout's ``docs/`` when camdyn runs from a source checkout (an editable install), else
+``./camdyn-reproduction`` in the working directory: nothing is written inside an installed
+package.
 ``python -m camdyn.studies list`` lists them; ``--fast`` (or the environment variable
 ``CAMDYN_FAST=1``) runs a reduced version (fewer revolutions and speeds) for tests.
 
@@ -12,22 +15,21 @@ From Python::
     out = studies.run("fig10", fast=True, out="/tmp/repro")   # -> StudyOutput
     out.numbers, out.figures, out.markdown
 
-Studies: reference-rig (identify the reference rig; writes camdyn/data/reference*.toml and
-docs/reference-rig.md), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
+Studies: reference-rig (identify the reference rig; writes the presets reference*.toml into the
+checkout's camdyn/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
 """
 from __future__ import annotations
 
 import importlib
-import sys
 from pathlib import Path
 
-from .common import FAST_ENV, ORDER, Context, StudyOutput, fast_default, repo_root, update_report
+from .common import DEFAULT_OUT, FAST_ENV, ORDER, Context, StudyOutput, default_out, fast_default, update_report
 
-__all__ = ["STUDIES", "run", "Context", "StudyOutput", "FAST_ENV", "report_path"]
+__all__ = ["STUDIES", "run", "Context", "StudyOutput", "FAST_ENV", "DEFAULT_OUT", "report_path"]
 
 #: study name -> (module, one-line description)
 STUDIES = {
-    "reference-rig": ("reference_rig", "identify the reference rig (presets + docs/reference-rig.md)"),
+    "reference-rig": ("reference_rig", "identify the reference rig (presets + reference-rig.md)"),
     "fig4-5": ("fig04_05", "alpha_r rms and peak-to-peak vs speed, damping A-E; time histories at 155 rev/min"),
     "chaos-scan": ("chaos_scan", "the chaos onsets of Sec. 4 against the assumed geometry (also in reference-rig.md)"),
     "fig6": ("fig06", "alpha_r in time and frequency at 155 rev/min, damping D"),
@@ -43,7 +45,7 @@ assert list(STUDIES) == ORDER
 
 
 def report_path(out: str | Path | None = None) -> Path:
-    return Path(out) / "reproduction.md" if out is not None else repo_root() / "docs" / "reproduction.md"
+    return (Path(out) if out is not None else default_out()) / "reproduction.md"
 
 
 def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, write_docs: bool = True,
@@ -51,9 +53,10 @@ def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, w
     """Run one study; write its figure(s) and its section of ``<out>/reproduction.md``.
 
     ``fast`` (default: the environment variable CAMDYN_FAST) reduces speeds and revolutions.
-    ``out`` is the folder of the report (default: the checkout's ``docs/``); figures go to
-    ``<out>/img``. ``data_dir`` is where ``reference-rig`` writes the presets (default:
-    the installed ``camdyn/data``).
+    ``out`` is the folder of the report (default: the checkout's ``docs/`` when camdyn runs
+    from a source checkout, else ``./camdyn-reproduction``); figures go to ``<out>/img``.
+    ``data_dir`` is where ``reference-rig`` writes the presets (default: the checkout's
+    ``camdyn/data``, else ``<out>/rigs``).  Nothing is written inside an installed package.
     """
     if name not in STUDIES:
         import difflib
@@ -61,7 +64,9 @@ def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, w
         raise KeyError(f"no study {name!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
                        + f"; studies: {', '.join(STUDIES)}")
     fast = fast_default() if fast is None else bool(fast)
-    out_dir = Path(out) if out is not None else repo_root() / "docs"
+    out_dir = Path(out) if out is not None else default_out()
+    if out is None and out_dir.name == DEFAULT_OUT:
+        log(f"camdyn is not running from a source checkout: writing to {out_dir} (choose with --out DIR)")
     out_dir.mkdir(parents=True, exist_ok=True)
     ctx = Context(fast=fast, out=out_dir, write_docs=write_docs,
                   data_dir=Path(data_dir) if data_dir is not None else None, log=log)

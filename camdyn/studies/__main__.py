@@ -14,9 +14,10 @@ def main(argv=None) -> int:
     parser.add_argument("name", help="a study name, 'all', or 'list'")
     parser.add_argument("--fast", action="store_true", default=None,
                         help="reduced speeds and revolutions (also: CAMDYN_FAST=1)")
-    parser.add_argument("--out", default=None, help="folder of reproduction.md and img/ (default: docs/)")
-    parser.add_argument("--data-dir", default=None, help="where reference-rig writes the presets "
-                                                         "(default: camdyn/data)")
+    parser.add_argument("--out", default=None, help="folder of reproduction.md and img/ (default: the checkout's "
+                                                    "docs/ in a source checkout, else ./camdyn-reproduction)")
+    parser.add_argument("--data-dir", default=None, help="where reference-rig writes the presets (default: the "
+                                                         "checkout's camdyn/data, else <out>/rigs)")
     parser.add_argument("--no-docs", action="store_true", help="do not update the report")
     parser.add_argument("--json", action="store_true", help="print the study's numbers as JSON on stdout "
                                                             "(always on for 'numbers')")

@@ -6,7 +6,6 @@ the context (fast mode, output folder) and writes the study's section of
 """
 from __future__ import annotations
 
-import inspect
 import json
 import math
 import os
@@ -52,12 +51,36 @@ def fast_default() -> bool:
     return os.environ.get(FAST_ENV, "0").strip().lower() not in ("", "0", "false", "no")
 
 
-def repo_root() -> Path:
-    """The source checkout camdyn runs from (docs/ lives there), else the working directory."""
-    here = Path(camdyn.__file__).resolve().parent.parent
-    if (here / "pyproject.toml").exists() and (here / "camdyn").is_dir():
-        return here
-    return Path.cwd()
+#: the folder (in the working directory) the studies write to when camdyn is not a source checkout
+DEFAULT_OUT = "camdyn-reproduction"
+
+
+def checkout_root(package_dir: Path | None = None) -> Path | None:
+    """The source checkout camdyn runs from (an editable install: ``pip install -e .``), or None
+    when camdyn is an installed copy (site-packages), which the studies never write into."""
+    package = Path(package_dir) if package_dir is not None else Path(camdyn.__file__).resolve().parent
+    root = package.parent
+    pyproject = root / "pyproject.toml"
+    try:
+        text = pyproject.read_text(encoding="utf-8")
+    except OSError:
+        return None
+    if re.search(r'^name\s*=\s*"camdyn"', text, flags=re.M) and (root / "docs").is_dir():
+        return root
+    return None
+
+
+def default_out() -> Path:
+    """Where a study writes when not told: the checkout's ``docs/``, else ``./camdyn-reproduction``."""
+    root = checkout_root()
+    return root / "docs" if root is not None else Path.cwd() / DEFAULT_OUT
+
+
+def default_data_dir(out: Path) -> Path:
+    """Where ``reference-rig`` writes the rig presets when not told: the checkout's ``camdyn/data``
+    (they are shipped from there), else ``<out>/rigs`` -- never inside an installed package."""
+    root = checkout_root()
+    return root / "camdyn" / "data" if root is not None else Path(out) / "rigs"
 
 
 @dataclass
@@ -67,7 +90,7 @@ class Context:
     fast: bool
     out: Path                 # the folder holding reproduction.md and img/
     write_docs: bool = True   # update reproduction.md / reference-rig.md
-    data_dir: Path | None = None  # where reference-rig writes the presets (None: camdyn/data)
+    data_dir: Path | None = None  # where reference-rig writes the presets (None: default_data_dir(out))
     log: Any = print
 
     @property
@@ -114,28 +137,11 @@ def _preset(name: str) -> camdyn.Rig:
 # ----------------------------------------------------------------------------- simulation
 
 
-def _has_backend() -> bool:
-    return "backend" in inspect.signature(camdyn.simulate).parameters
-
-
-def simulate(rig, scene, cam=None, *, prefer_compiled: bool = True, fallback: bool = True, **kw):
-    """camdyn.simulate, on the compiled backend when it exists and supports the run, else SciPy.
-
-    A compiled run that stops early for a numerical reason (anything but the follower
-    reaching 90 degrees) is rerun on the SciPy reference backend (``fallback=False`` keeps
-    the compiled result).  The backend used is recorded in ``result.meta["backend"]``.
-    """
-    if prefer_compiled and _has_backend() and getattr(cam, "kind", "constant") != "user":
-        try:
-            result = camdyn.simulate(rig, scene, cam, backend="compiled", **kw)
-            result.meta["backend"] = "compiled"
-            # a stop the SciPy reference may handle: run it there
-            if result.ok or result.outcome.name == "ANGLE_LIMIT" or not fallback:
-                return result
-        except (ImportError, NotImplementedError, CamdynError):  # not supported there: the reference
-            pass
+def simulate(rig, scene, cam=None, **kw):
+    """camdyn.simulate on the default (compiled) engine; the backend is recorded in
+    ``result.meta["backend"]``.  A run that stops early is reported as it ended: no rerun."""
     result = camdyn.simulate(rig, scene, cam, **kw)
-    result.meta["backend"] = "scipy"
+    result.meta["backend"] = result.stats.get("backend")
     return result
 
 

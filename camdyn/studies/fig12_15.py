@@ -26,7 +26,7 @@ def _runs(rig, fast):
         for vr, _ in VR:
             for fr, *_ in FRICTION:
                 scene = camdyn.Scene(contact="line", damping="D", friction=fr, motion=motion, sliding_velocity=vr)
-                out[motion, vr, fr] = simulate(rig, scene, cam, revolutions=periods, fallback=not fast,
+                out[motion, vr, fr] = simulate(rig, scene, cam, revolutions=periods,
                                                sample_rate_Hz=5000.0 if fast else 20000.0)
     return out
 

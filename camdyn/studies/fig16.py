@@ -24,12 +24,11 @@ def instantaneous_frequency(rig, scene, cam, result) -> np.ndarray:
     model = Model(rig, scene, cam)
     out = np.full(result.t.size, np.nan)
     for name in set(result.regime.tolist()):
-        fn = getattr(model.kernels, f"jac_{name}", None)
-        if fn is None or name == "free":
+        m = model.mode(name)
+        if not model.kernels.CONTACT_OF_MODE[m]:
             continue
-        jac = model.bind(fn)
         for i in np.flatnonzero(result.regime == name):
-            d0 = jac(result.t[i], result.alpha[i], result.alpha_dot[i])[0]
+            d0 = model.jacobian(m, result.t[i], result.alpha[i], result.alpha_dot[i])[0]
             out[i] = np.sqrt(-d0) / (2 * np.pi) if d0 < 0 else np.nan
     return out
 

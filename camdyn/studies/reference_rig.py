@@ -10,14 +10,13 @@ by stated assumptions, and writes the presets ``reference`` (Sections 6-8 settin
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import camdyn
 from camdyn import calibrate as cal
 from camdyn.analysis import contact_loss_speed, static_equilibrium
 from camdyn.cam import ConstantSpeed
 
-from .common import PAPER, Context, StudyOutput, fmt, md_table, recorded_numbers
+from .common import PAPER, Context, StudyOutput, default_data_dir, fmt, md_table, recorded_numbers
 
 NAME = "reference-rig"
 TITLE = "The reference rig"
@@ -350,7 +349,7 @@ def run(ctx: Context) -> StudyOutput:
             start = None
     result = identify(start)
     exp_rig = experiment_variant(result)
-    data_dir = ctx.data_dir or Path(camdyn.__file__).resolve().parent / "data"
+    data_dir = ctx.data_dir or default_data_dir(ctx.out)
     data_dir.mkdir(parents=True, exist_ok=True)
     result.rig.to_toml(data_dir / "reference.toml")
     exp_rig.to_toml(data_dir / "reference-experiment.toml")

@@ -10,12 +10,13 @@ such method must satisfy (row sums, the bushy-tree order conditions of ``b``, er
 summing to zero, the interpolant reproducing ``y_new`` at theta = 1), so a typo in a
 coefficient is an error at import, not a silent loss of order.
 
-:func:`arrays` turns a tableau into the NumPy arrays the compiled stepper reads.
+:func:`arrays` turns a tableau into the :class:`Method` (named arrays) the engine's stepper reads.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction as Fr
+from typing import NamedTuple
 
 import numpy as np
 
@@ -177,12 +178,28 @@ DOP853 = Tableau(
 TABLEAUS = {"RK45": DOPRI5, "DOP853": DOP853}
 
 
-def arrays(tab: Tableau):
-    """The tableau as the tuple of arrays the compiled stepper takes.
+class Method(NamedTuple):
+    """A tableau as the arrays the stepper reads (:mod:`camdyn.engine.stepper`).
 
-    (A_all, C_all, B, E, E3, P, n_stages, n_extra, kind, exponent): A_all and C_all hold the
-    stages, a zero FSAL row, and the extra stages; kind is 0 (embedded) or 1 (dop853).
-    """
+    ``A`` and ``C`` hold the stages, then a row for the first-same-as-last stage (``A`` row = b,
+    ``C`` = 1), then the extra stages of the interpolant (DOP853); ``P`` is the dense output in
+    power form over all of them."""
+
+    A: np.ndarray
+    C: np.ndarray
+    B: np.ndarray
+    E: np.ndarray
+    E3: np.ndarray
+    P: np.ndarray
+    n_stages: int
+    n_extra: int
+    error_kind: int    # position in ERROR_KINDS
+    exponent: float    # step-size control exponent, -1 / (error_order + 1)
+    order: int         # of the propagated solution
+
+
+def arrays(tab: Tableau) -> Method:
+    """The tableau as the :class:`Method` the stepper takes."""
     s, x = tab.n_stages, tab.n_extra
     total = s + 1 + x
     A = np.zeros((total, total))
@@ -194,8 +211,8 @@ def arrays(tab: Tableau):
     C[:s], C[s] = tab.c, 1.0
     C[s + 1:] = tab.c_extra
     E3 = np.array(tab.e3 if tab.e3 else np.zeros(s + 1), float)
-    return (A, C, np.array(tab.b, float), np.array(tab.e, float), E3, np.array(tab.dense, float),
-            s, x, ERROR_KINDS.index(tab.error_kind), -1.0 / (tab.error_order + 1))
+    return Method(A, C, np.array(tab.b, float), np.array(tab.e, float), E3, np.array(tab.dense, float),
+                  s, x, ERROR_KINDS.index(tab.error_kind), -1.0 / (tab.error_order + 1), tab.order)
 
 
 def stages_per_step(tab: Tableau, dense: bool) -> int:
@@ -203,4 +220,4 @@ def stages_per_step(tab: Tableau, dense: bool) -> int:
     return tab.n_stages + (tab.n_extra if dense else 0)
 
 
-__all__ = ["Tableau", "TableauError", "DOPRI5", "DOP853", "TABLEAUS", "arrays", "stages_per_step"]
+__all__ = ["Tableau", "TableauError", "Method", "DOPRI5", "DOP853", "TABLEAUS", "arrays", "stages_per_step"]

@@ -1,16 +1,14 @@
-"""The compiled explicit Runge-Kutta stepper with dense output (numba), SciPy's algorithm.
+"""The explicit Runge-Kutta step with dense output: SciPy's algorithm, one source for the
+compiled and the interpreted loop (:mod:`camdyn.engine.jit`).
 
-The state is the follower's ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot,
-accel(fns, nr, r, t, alpha, alpha_dot, p))``: regime r's field (:func:`.regimes.accel`,
-the generated ``rhs_index`` compiled as a numba ``cfunc``, or a stick mode's), ``p`` the
-parameter vector.  Everything is a small ``njit`` function, in the same split as SciPy's
-``RungeKutta``: :func:`step_impl` computes one attempt (stages, solution), :func:`error_norm`
-its error, and :func:`step` does the bookkeeping (accept or reject, the next step size)
-exactly as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's.
+The state is ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot, rhs(m, t, alpha,
+alpha_dot, p))`` in mode m (the generated kernel, a numba ``cfunc`` when compiled).  The split
+is SciPy's ``RungeKutta``: :func:`step_impl` computes one attempt (stages and solution),
+:func:`error_norm` its error, and :func:`step` does the bookkeeping (accept or reject, the next
+step size) as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's.
 :func:`dense_coefficients` and :func:`dense_eval` are the interpolant (``RkDenseOutput`` /
-``Dop853DenseOutput`` in power form).  The method is the tuple of arrays from
-:func:`camdyn.compiled.tableau.arrays`; the stage buffer ``K`` has one row per stage, the
-FSAL stage and the extra dense-output stages.
+``Dop853DenseOutput`` in power form).  The method is a :class:`~camdyn.engine.tableau.Method`;
+the stage buffer ``K`` has one row per stage, the FSAL stage and the interpolant's extra stages.
 
 One deliberate difference from SciPy: an attempt whose error is not finite (a stage that
 overshot into a region where a law is undefined) is rejected and retried with a step five
@@ -21,9 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from .regimes import accel
+from .jit import jitable
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -33,15 +30,16 @@ MAX_FACTOR = 10.0
 ACCEPTED, TOO_SMALL = 0, 1
 
 
-@njit(cache=True, inline="always")
+@jitable
 def _norm(x0, x1):
     """SciPy's RMS norm of a 2-vector."""
     return math.sqrt(0.5 * (x0 * x0 + x1 * x1))
 
 
-@njit(cache=True, inline="always")
-def stages(fns, nr, r, t, y0, y1, h, A, C, p, K, first, last):
+@jitable
+def stages(prob, m, t, y0, y1, h, method, K, first, last):
     """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y))."""
+    A, C, rhs, p = method.A, method.C, prob.kernels.rhs, prob.p
     for s in range(first, last):
         d0 = 0.0
         d1 = 0.0
@@ -51,14 +49,14 @@ def stages(fns, nr, r, t, y0, y1, h, A, C, p, K, first, last):
             d1 += K[j, 1] * a
         z1 = y1 + d1 * h
         K[s, 0] = z1
-        K[s, 1] = accel(fns, nr, r, t + C[s] * h, y0 + d0 * h, z1, p)
+        K[s, 1] = rhs(m, t + C[s] * h, y0 + d0 * h, z1, p)
 
 
-@njit(cache=True, inline="always")
-def step_impl(fns, nr, r, t, y0, y1, h, method, p, K):
+@jitable
+def step_impl(prob, m, t, y0, y1, h, method, K):
     """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
-    A, C, B, n = method[0], method[1], method[2], method[6]
-    stages(fns, nr, r, t, y0, y1, h, A, C, p, K, 1, n)
+    B, n = method.B, method.n_stages
+    stages(prob, m, t, y0, y1, h, method, K, 1, n)
     d0 = 0.0
     d1 = 0.0
     for j in range(n):
@@ -67,14 +65,14 @@ def step_impl(fns, nr, r, t, y0, y1, h, method, p, K):
     n0 = y0 + h * d0
     n1 = y1 + h * d1
     K[n, 0] = n1
-    K[n, 1] = accel(fns, nr, r, t + h, n0, n1, p)
+    K[n, 1] = prob.kernels.rhs(m, t + h, n0, n1, prob.p)
     return n0, n1
 
 
-@njit(cache=True, inline="always")
+@jitable
 def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     """SciPy's error norm of the attempt (RK45: embedded difference; DOP853: 5th/3rd blend)."""
-    E, E3, n, kind = method[3], method[4], method[6], method[8]
+    E, E3, n = method.E, method.E3, method.n_stages
     s0 = atol + max(abs(y0), abs(n0)) * rtol
     s1 = atol + max(abs(y1), abs(n1)) * rtol
     e0 = 0.0
@@ -82,7 +80,7 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     for j in range(n + 1):
         e0 += K[j, 0] * E[j]
         e1 += K[j, 1] * E[j]
-    if kind == 0:
+    if method.error_kind == 0:
         return _norm(e0 * h / s0, e1 * h / s1)
     f0 = 0.0
     f1 = 0.0
@@ -96,17 +94,17 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 2.0)
 
 
-@njit(cache=True, inline="always")
-def step(fns, nr, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_step):
+@jitable
+def step(prob, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
 
     Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections);
     K then holds the accepted attempt's stages with f(t_new, y_new) in row n_stages.
     """
-    n, exponent = method[6], method[9]
+    exponent = method.exponent
     min_step = 10.0 * abs(np.nextafter(t, math.inf) - t)
-    if h_abs > max_step:
-        h_abs = max_step
+    if h_abs > cfg.max_step:
+        h_abs = cfg.max_step
     elif h_abs < min_step:
         h_abs = min_step
     nfev = 0
@@ -119,9 +117,9 @@ def step(fns, nr, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_st
             t_new = t_bound
         h = t_new - t
         h_abs = abs(h)
-        n0, n1 = step_impl(fns, nr, r, t, y0, y1, h, method, p, K)
-        nfev += n
-        err = error_norm(K, h, y0, y1, n0, n1, rtol, atol, method)
+        n0, n1 = step_impl(prob, m, t, y0, y1, h, method, K)
+        nfev += method.n_stages
+        err = error_norm(K, h, y0, y1, n0, n1, cfg.rtol, cfg.atol, method)
         if err < 1.0:
             factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** exponent)
             if rejected:
@@ -134,12 +132,13 @@ def step(fns, nr, r, t, y0, y1, h_abs, t_bound, method, p, K, rtol, atol, max_st
         rejected += 1
 
 
-@njit(cache=True)
-def initial_step(fns, nr, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol, atol, p):
+@jitable
+def initial_step(prob, m, t, y0, y1, f1, t_bound, method, cfg):
     """SciPy's ``select_initial_step`` (Hairer, Norsett & Wanner II.4), one RHS evaluation."""
     length = abs(t_bound - t)
     if length == 0.0:
         return 0.0
+    rtol, atol = cfg.rtol, cfg.atol
     s0 = atol + abs(y0) * rtol
     s1 = atol + abs(y1) * rtol
     d0 = _norm(y0 / s0, y1 / s1)
@@ -153,23 +152,23 @@ def initial_step(fns, nr, r, t, y0, y1, f1, t_bound, max_step, error_order, rtol
     h0 = min(h0, length)
     z0 = y0 + h0 * y1
     z1 = y1 + h0 * f1
-    g1 = accel(fns, nr, r, t + h0, z0, z1, p)
+    g1 = prob.kernels.rhs(m, t + h0, z0, z1, prob.p)
     d2 = _norm((z1 - y1) / s0, (g1 - f1) / s1) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (error_order + 1))
-    return min(100.0 * h0, h1, length, max_step)
+        h1 = (0.01 / max(d1, d2)) ** (-method.exponent)
+    return min(100.0 * h0, h1, length, cfg.max_step)
 
 
-@njit(cache=True, inline="always")
-def dense_coefficients(fns, nr, r, t, y0, y1, h, method, p, K, Q):
+@jitable
+def dense_coefficients(prob, m, t, y0, y1, h, method, K, Q):
     """Q = K^T P after computing the extra stages (DOP853): y(t + theta h) = y + h theta (Q0 + Q1 theta + ...).
 
     Returns the number of RHS evaluations spent (the extra stages)."""
-    A, C, P, n, n_extra = method[0], method[1], method[5], method[6], method[7]
+    P, n, n_extra = method.P, method.n_stages, method.n_extra
     if n_extra:
-        stages(fns, nr, r, t, y0, y1, h, A, C, p, K, n + 1, n + 1 + n_extra)
+        stages(prob, m, t, y0, y1, h, method, K, n + 1, n + 1 + n_extra)
     rows, deg = P.shape
     for k in range(deg):
         q0 = 0.0
@@ -182,7 +181,7 @@ def dense_coefficients(fns, nr, r, t, y0, y1, h, method, p, K, Q):
     return n_extra
 
 
-@njit(cache=True, inline="always")
+@jitable
 def dense_eval(tt, t, h, y0, y1, Q):
     """The interpolant at time tt of the step [t, t + h] (Horner in theta)."""
     theta = (tt - t) / h

@@ -1,0 +1,115 @@
+"""The engine's settings: validated options for users, named tuples for the loop.
+
+Users set :class:`SolverOptions` (method, tolerances, :class:`EventSettings`, the energy
+ledger); the driver turns them, with the rules' own constants below, into a :class:`Settings`
+named tuple that crosses into compiled code as it is (named fields, no positional arrays).
+
+The constants of the hybrid rules are defined here, once, whatever runs the loop.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import ParameterError
+from .tableau import TABLEAUS
+
+_EPS = float(np.finfo(float).eps)
+
+#: this many switches within CHATTER_WINDOW (relative) of time is chatter, not dynamics
+CHATTER_SWITCHES = 20
+CHATTER_WINDOW = 1e-9
+#: steps in a row that may end short of a crossing their interpolant placed early, when one step
+#: of the method to the located time is not yet across the surface (then the interpolant's state,
+#: across by construction, is taken); with 100, tests/test_bad_input.py ran for over 10 minutes
+CROSSING_RETRIES = 1
+#: the first step after contact starts is at most this many radians of the contact mode
+#: (a free-flight step size would blow up on the stiff contact)
+CONTACT_STEP_RADIANS = 0.1
+#: exactly on a surface, the side is read this long (relative) later along the motion
+LOOK_AHEAD = 1e-9
+#: |alpha| beyond this is the singular 90 degrees of Eq. 11 (tan, sec)
+ANGLE_LIMIT = math.pi / 2 - 0.02
+METHODS = tuple(TABLEAUS)
+#: who runs the loop: numba-compiled (cfunc kernels, cached on disk) or the same code in Python
+BACKENDS = ("compiled", "python")
+
+
+@dataclass(frozen=True)
+class EventSettings:
+    """Tolerances of event location.
+
+    ``xtol``: relative time tolerance of a located switch, ``|t_found - t_root| <= xtol *
+    max(1, |t|)``; ``4 eps <= xtol < 1``.  ``interior_points``: equally spaced samples of each
+    watched surface inside every step besides its ends, so that an excursion out and back
+    within one step (a micro-hop) is still seen when a sample falls inside it; ``>= 0``.
+    ``max_events``: the most regime switches one run may have; ``>= 1``.
+    """
+
+    xtol: float = 1e-14
+    interior_points: int = 3
+    max_events: int = 1_000_000
+
+    def __post_init__(self) -> None:
+        if isinstance(self.xtol, bool) or not isinstance(self.xtol, (int, float)) or not (4 * _EPS <= self.xtol < 1):
+            raise ParameterError("xtol", self.xtol, f"4*eps = {4 * _EPS:.3g} <= xtol < 1")
+        for name, low in (("interior_points", 0), ("max_events", 1)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ParameterError(name, value, f"an integer >= {low}")
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Method and tolerances of a run (rtol, atol as in ``scipy.integrate.solve_ivp``)."""
+
+    method: str = "DOP853"
+    rtol: float = 1e-8
+    atol: float = 1e-12
+    max_step: float = math.inf
+    events: EventSettings = field(default_factory=EventSettings)
+    ledger: bool = False   # integrate the work of the drive, contact damping and friction
+
+    def __post_init__(self):
+        if self.method not in METHODS:
+            raise ParameterError("method", self.method, f"one of {METHODS} (explicit Runge-Kutta pairs with "
+                                 "dense output; implicit methods do not pay on this model: docs/performance.md)")
+        if isinstance(self.rtol, bool) or not (isinstance(self.rtol, (int, float)) and 1e-14 <= self.rtol <= 1e-2):
+            raise ParameterError("rtol", self.rtol, "1e-14 <= rtol <= 1e-2")
+        if isinstance(self.atol, bool) or not (isinstance(self.atol, (int, float)) and 0 < self.atol <= 1e-2):
+            raise ParameterError("atol", self.atol, "0 < atol <= 1e-2")
+        if isinstance(self.max_step, bool) or not (isinstance(self.max_step, (int, float)) and self.max_step > 0):
+            raise ParameterError("max_step", self.max_step, "max_step > 0 (s)")
+        if not isinstance(self.events, EventSettings):
+            raise ParameterError("events", self.events, "an EventSettings")
+
+
+class Settings(NamedTuple):
+    """Everything the loop reads besides the model and the method (see :func:`settings`)."""
+
+    rtol: float
+    atol: float
+    max_step: float
+    xtol: float
+    interior_points: int
+    max_events: int
+    angle_limit: float
+    chatter_switches: int
+    chatter_window: float
+    contact_step: float     # s; 0 for no cap
+    crossing_retries: int
+    look_ahead: float
+    ledger: bool
+
+
+def settings(options: SolverOptions, contact_frequency: float) -> Settings:
+    """The loop's settings for ``options`` on a model whose contact mode has ``contact_frequency``
+    (rad/s: the undamped linearized frequency vartheta, Eq. 23)."""
+    ev = options.events
+    step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
+    return Settings(float(options.rtol), float(options.atol), float(options.max_step), float(ev.xtol),
+                    int(ev.interior_points), int(ev.max_events), ANGLE_LIMIT, CHATTER_SWITCHES, CHATTER_WINDOW,
+                    step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))

@@ -1,0 +1,239 @@
+"""The hybrid loop: steps, crossings, switches and samples, compiled or interpreted.
+
+From the start state, the loop steps mode m's field with the method (:mod:`.stepper`), checks
+m's transitions on each accepted step (:mod:`.rules`), and at a crossing restarts from the
+state at the located time in the mode the transition leads to.  That restart state is one
+step of the method to the located time (the method's order; the interpolant's error, an order
+lower and larger at loose tolerances, would otherwise be carried into the next mode at every
+switch); when that state is not yet across the surface, the run goes on in the same mode from
+it, up to ``crossing_retries`` steps in a row (then it restarts from the interpolant's state,
+across by construction, so time always advances).  The first step after contact starts is
+capped at ``contact_step``.
+
+:func:`run` is written once (:mod:`.jit`): :func:`run_compiled` is the same code compiled
+(numba, cached on disk; the kernels arrive as first-class functions, so one compiled loop
+serves every scene, rig and sweep point) and :func:`run_interpreted` runs it in Python (a
+user's cam motion, whose kernels call Python).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from . import cache
+from .jit import jitable
+from .ledger import N_FLOWS, accumulate
+from .rules import (NONFINITE, Scratch, across, chattering, first_crossing, initial_mode, left_at_start, switch,
+                    zero_at_start)
+from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
+
+cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
+
+#: outcome codes of run(), by position: names of camdyn.Outcome members
+OUTCOMES = ("SUCCESS", "STEP_FAILED", "MAX_EVENTS", "CHATTER", "NONFINITE", "ANGLE_LIMIT")
+SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = range(6)
+#: one switch: when, which transition (row of Tables), the modes before and after, the state after
+SWITCH = np.dtype([("t", np.float64), ("transition", np.int64), ("before", np.int64), ("after", np.int64),
+                   ("alpha", np.float64), ("alpha_dot", np.float64)])
+
+
+class Start(NamedTuple):
+    t: float
+    t_end: float
+    alpha: float
+    alpha_dot: float
+    mode: int            # -1: chosen by the automaton's initial candidates
+
+
+class Samples(NamedTuple):
+    """The times to sample (t) and where the samples go: y rows alpha, alpha_dot and, with the
+    ledger, the work of the drive, contact damping and friction; mode the mode at each."""
+
+    t: np.ndarray
+    y: np.ndarray
+    mode: np.ndarray
+
+
+class Run(NamedTuple):
+    outcome: int
+    n_samples: int
+    switches: np.ndarray      # SWITCH records
+    nfev: int
+    steps: int
+    rejected: int
+    mode: int                 # at the end
+    t: float
+    alpha: float
+    alpha_dot: float
+
+
+@jitable
+def _record(sw, n, t, w, before, after, a, ad):
+    """Append a switch, doubling the buffer when full; returns the buffer."""
+    if n == sw.shape[0]:
+        bigger = np.empty(2 * n, dtype=SWITCH)
+        bigger[:n] = sw[:n]
+        sw = bigger
+    sw["t"][n], sw["transition"][n], sw["before"][n], sw["after"][n] = t, w, before, after
+    sw["alpha"][n], sw["alpha_dot"][n] = a, ad
+    return sw
+
+
+@jitable
+def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf):
+    """Write the samples at times <= t_stop from the step's interpolant; the next index.  With a
+    ledger, ledger_work is the work at the step's start t."""
+    n = samples.t.shape[0]
+    ledger = samples.y.shape[0] > 2
+    while i < n and samples.t[i] <= t_stop:
+        ts = samples.t[i]
+        samples.y[0, i], samples.y[1, i] = dense_eval(ts, t, h, y0, y1, Q)
+        if ledger:
+            ledger_tmp[:] = ledger_work
+            accumulate(prob, m, t, h, y0, y1, Q, t, ts, buf, ledger_tmp)
+            samples.y[2:2 + N_FLOWS, i] = ledger_tmp
+        samples.mode[i] = m
+        i += 1
+    return i
+
+
+@jitable
+def _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K):
+    """K[0] = f(t, y) and the first step in mode m: SciPy's estimate at the start, else the
+    last step's size (capped at contact_step when contact just started).  (h, evaluations)."""
+    K[0, 0], K[0, 1] = y1, prob.kernels.rhs(m, t, y0, y1, prob.p)
+    if h_last < 0.0:
+        return initial_step(prob, m, t, y0, y1, K[0, 1], t_end, method, cfg), 2
+    h_abs = min(h_last, t_end - t)
+    if capped and cfg.contact_step > 0.0:
+        h_abs = min(h_abs, cfg.contact_step)
+    return h_abs, 1
+
+
+#: _restart_state's verdicts
+ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
+
+
+@jitable
+def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
+    """The state at a crossing inside the step from (t, y): one step of the method to t_cross,
+    and whether it is ACROSS transition w's surface, NOT_YET (K[n] then holds f there, the next
+    step's first stage) or UNUSABLE (not finite).  K[0] must hold f(t, y)."""
+    c0, c1 = step_impl(prob, m, t, y0, y1, t_cross - t, method, K)
+    if not (math.isfinite(c0) and math.isfinite(c1)):
+        return c0, c1, UNUSABLE
+    g_ok = across(prob, m, w, t_cross, c0, c1)
+    return c0, c1, ACROSS if g_ok else NOT_YET
+
+
+@jitable
+def run(prob, method, cfg, start, samples):
+    """Integrate the hybrid model from ``start`` (see the module docstring); a :class:`Run`."""
+    tab = prob.tables
+    n = method.n_stages
+    K = np.empty((method.A.shape[0], 2))
+    Q = np.empty((2, method.P.shape[1]))
+    n_watch = max(1, tab.surface.shape[0])
+    n_surf = max(1, tab.surface_rate.shape[0])
+    work = Scratch(np.zeros(n_watch), np.zeros(n_watch), np.zeros(n_surf), np.zeros(n_surf, dtype=np.bool_))
+    buf = np.empty(max(tab.n_outputs, 2))
+    ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
+    ledger = samples.y.shape[0] > 2
+    sw = np.empty(16, dtype=SWITCH)
+    n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
+    t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
+    m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
+    h_last, retries, capped = -1.0, 0, False
+    while t < t_end and outcome == SUCCESS:
+        h_abs, f = _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K)
+        nfev += f
+        watched = tab.watch_start[m + 1] > tab.watch_start[m]
+        have_start = False
+        while t < t_end:
+            status, t_new, n0, n1, h_next, f, rej = step(prob, m, t, y0, y1, h_abs, t_end, method, K, cfg)
+            nfev += f
+            rejected += rej
+            if status != ACCEPTED:
+                outcome = STEP_FAILED
+                break
+            steps += 1
+            if not (math.isfinite(n0) and math.isfinite(n1)):
+                outcome = NONFINITE_STATE
+                break
+            h = t_new - t
+            if watched or ledger or (i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_new):
+                nfev += dense_coefficients(prob, m, t, y0, y1, h, method, K, Q)
+            w, t_cross = -1, t_new
+            if watched:
+                on_surface = not have_start or zero_at_start(prob, m, work)
+                w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
+                if w == NONFINITE:
+                    outcome = NONFINITE_STATE
+                    break
+                if w < 0:
+                    t_cross = t_new
+                    if on_surface:
+                        w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
+                        t_cross = t if w >= 0 else t_new
+                have_start = True
+            if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
+                i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)
+            if ledger:
+                accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
+            h_last = h
+            if w >= 0:
+                if t_cross == t_new:
+                    c0, c1 = n0, n1
+                elif t_cross == t:
+                    c0, c1 = y0, y1
+                else:
+                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K)
+                    nfev += n
+                    if verdict == NOT_YET and retries < cfg.crossing_retries:  # on in this mode from there
+                        t, y0, y1, h_abs = t_cross, c0, c1, h
+                        K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
+                        have_start, retries = False, retries + 1
+                        continue
+                    if verdict != ACROSS:  # the interpolant's state, across by construction
+                        c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
+                retries = 0
+                m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
+                capped = tab.mode_contact[m] == 0 and tab.mode_contact[m_new] == 1
+                sw = _record(sw, n_sw, t_cross, w, m, m_new, c0, c1)
+                n_sw += 1
+                t, y0, y1, m = t_cross, c0, c1, m_new
+                if n_sw >= cfg.max_events:
+                    outcome = MAX_EVENTS
+                elif chattering(sw["t"], n_sw, cfg.chatter_window, cfg.chatter_switches):
+                    outcome = CHATTER
+                break
+            t, y0, y1, h_abs = t_new, n0, n1, h_next
+            retries = 0
+            capped = False
+            K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
+            if abs(y0) > cfg.angle_limit:
+                outcome = ANGLE_LIMIT
+                break
+    return Run(outcome, i_sample, sw[:n_sw].copy(), nfev, steps, rejected, m, t, y0, y1)
+
+
+@njit(cache=True, error_model="numpy")
+def _run_compiled(prob, method, cfg, start, samples):
+    r = run(prob, method, cfg, start, samples)
+    # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
+    # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
+    return (r.outcome, r.n_samples, r.switches, r.nfev, r.steps, r.rejected, r.mode, r.t, r.alpha, r.alpha_dot)
+
+
+def run_compiled(prob, method, cfg, start, samples) -> Run:
+    """:func:`run`, compiled; the kernels of ``prob`` must be numba cfuncs."""
+    return Run(*_run_compiled(prob, method, cfg, start, samples))
+
+
+def run_interpreted(prob, method, cfg, start, samples) -> Run:
+    """:func:`run` in Python, with Python kernels."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return run(prob, method, cfg, start, samples)

@@ -1,0 +1,347 @@
+"""The rules of the hybrid automaton, once, for every run of camdyn.
+
+The automaton is data (:mod:`camdyn.engine.tables`, from ``camdyn.derive.automaton``); these
+small functions are its semantics, called by the loop (:mod:`camdyn.engine.loop`) after every
+accepted step, compiled or interpreted (:mod:`camdyn.engine.jit`):
+
+*Crossings.*  Mode m watches the surfaces of its transitions.  Each is sampled at the step's
+start, at ``interior_points`` equally spaced times on the interpolant, and at its end.  A
+transition fires where its surface's value crosses zero in its direction: +1 from < 0 to
+>= 0, -1 from > 0 to <= 0; a value exactly 0 at a sample never *starts* a crossing (a run
+restarts on the far side of the surface it just crossed, and must not cross it again).  The
+earliest crossing wins; ties go to the transition listed first.
+
+*Far-side roots.*  A crossing is located on the interpolant (Illinois false position) to
+``xtol * max(1, |t|)`` and returned at the end of its final bracket that lies across the
+surface, so the restart state is across and time always advances.
+
+*Excursions.*  A surface with a declared rate (``RATE_OF_SURFACE``: the gap and the gap rate) is
+also checked between samples: when the rate turns from approaching zero to leaving it, the
+extremum is located and, if the value there is across, the crossing out and back within one
+step (a micro-hop) is found.  A sign change that starts moving *away* from the watched
+direction can only follow a turn of the rate; if the rate never turns, it is rounding noise
+(a restart just across the surface, where the gap is ~1e-19 m), not a crossing.
+
+*Targets.*  A transition enters its first candidate whose conditions hold: (surface, sign)
+holds where sign * value >= 0, the value taken under the candidate's laws; exactly 0, the value
+a moment later along the motion (alpha moved by alpha_dot over ``look_ahead`` relative) decides.
+
+*Starting on a surface.*  A step that starts exactly on a watched surface (value 0: a start
+there, or a restart at a root located exactly) and ends strictly on its leaving side has left
+the mode at its start.
+
+*Chatter.*  More than ``chatter_switches`` switches within ``chatter_window`` (relative) of the
+latest is a run making no progress: it stops (``Outcome.CHATTER``).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .jit import jitable
+from .stepper import dense_eval
+
+#: first_crossing's transition index when a surface value is not finite
+NONFINITE = -2
+
+
+class Scratch(NamedTuple):
+    """Work arrays of :func:`first_crossing`: per watched transition, its surface's value and
+    rate at the previous sample; per surface, the value at the current sample and whether it
+    is known."""
+
+    g_prev: np.ndarray
+    r_prev: np.ndarray
+    values: np.ndarray
+    known: np.ndarray
+
+
+def scratch(n_transitions: int, n_surfaces: int) -> Scratch:
+    n, s = max(1, n_transitions), max(1, n_surfaces)
+    return Scratch(np.zeros(n), np.zeros(n), np.zeros(s), np.zeros(s, dtype=np.bool_))
+
+
+@jitable
+def crossed(g0, g1, direction):
+    """Whether g going from g0 to g1 crosses zero in direction (+1, -1, or 0 for both)."""
+    up = g0 < 0.0 <= g1
+    down = g0 > 0.0 >= g1
+    if direction > 0:
+        return up
+    if direction < 0:
+        return down
+    return up or down
+
+
+@jitable
+def value(prob, m, s, t, a, ad):
+    """Surface s's value at the state under mode m's laws."""
+    return prob.kernels.surface(m, s, t, a, ad, prob.p)
+
+
+# --- targets ------------------------------------------------------------------------------
+@jitable
+def side(prob, m, s, t, a, ad, look_ahead):
+    """Surface s's value; exactly 0, its value a moment later along the motion."""
+    g = value(prob, m, s, t, a, ad)
+    if g == 0.0:
+        h = look_ahead * max(1.0, abs(t))
+        g = value(prob, m, s, t + h, a + h * ad, ad)
+    return g
+
+
+@jitable
+def target(prob, row, t, a, ad, look_ahead):
+    """The first candidate of target row ``row`` whose conditions hold at the state."""
+    tab = prob.tables
+    first, last = tab.target_start[row], tab.target_start[row + 1]
+    for c in range(first, last):
+        m = tab.target_mode[c]
+        holds = True
+        for q in range(tab.condition_start[c], tab.condition_start[c + 1]):
+            if tab.condition_sign[q] * side(prob, m, tab.condition_surface[q], t, a, ad, look_ahead) < 0.0:
+                holds = False
+                break
+        if holds:
+            return m
+    return tab.target_mode[last - 1]
+
+
+@jitable
+def initial_mode(prob, t, a, ad, look_ahead):
+    """The mode a run starts in: the initial candidates (the row after the transitions)."""
+    return target(prob, prob.tables.surface.shape[0], t, a, ad, look_ahead)
+
+
+# --- location on the interpolant ------------------------------------------------------------
+@jitable
+def value_on_step(prob, m, s, tt, t, h, y0, y1, Q):
+    """Surface s's value at time tt on the interpolant of the step [t, t + h]."""
+    a, ad = dense_eval(tt, t, h, y0, y1, Q)
+    return value(prob, m, s, tt, a, ad)
+
+
+@jitable
+def locate(prob, m, s, t, h, y0, y1, Q, ta, tb, ga, gb, xtol):
+    """Root of surface s on the interpolant in (ta, tb], returned on the far side; and the
+    number of values computed.
+
+    ga = g(ta) != 0 and gb = g(tb) of the other sign or 0.  Illinois false position keeps a
+    bracket [lo, hi] with g(lo) on ga's side and g(hi) not, halving the value of an end kept
+    twice in a row.  A trial point is kept at least half the tolerance inside the bracket, so
+    that when the estimate lands next to the root the next value closes the bracket from the
+    other side (Brent's rule: superlinear to the end).  If three iterations together fail to
+    halve the bracket, the next one bisects.  Returns hi once hi - lo <= xtol max(1, |hi|).
+    """
+    if gb == 0.0:
+        return tb, 0
+    lo, hi, glo, ghi = ta, tb, ga, gb
+    near = 1.0 if ga > 0.0 else -1.0
+    kept = 0  # +1: lo kept twice in a row, -1: hi kept twice in a row
+    evaluations = 0
+    w3, w2, w1 = math.inf, math.inf, math.inf  # the bracket's widths 3, 2 and 1 iterations ago
+    for _ in range(400):
+        width = hi - lo
+        tol = xtol * max(1.0, abs(hi))
+        if width <= tol:
+            break
+        if 2.0 * width > w3:
+            tm = 0.5 * (lo + hi)
+        else:
+            tm = hi - ghi * width / (ghi - glo)
+            margin = 0.5 * tol
+            if not tm >= lo + margin:  # also a NaN estimate
+                tm = lo + margin
+            if not tm <= hi - margin:
+                tm = hi - margin
+        if not (lo < tm < hi):
+            break
+        w3, w2, w1 = w2, w1, width
+        g = value_on_step(prob, m, s, tm, t, h, y0, y1, Q)
+        evaluations += 1
+        if g == 0.0:
+            return tm, evaluations
+        if g * near > 0.0:
+            lo, glo = tm, g
+            if kept == -1:
+                ghi *= 0.5
+            kept = -1
+        else:
+            hi, ghi = tm, g
+            if kept == 1:
+                glo *= 0.5
+            kept = 1
+    return hi, evaluations
+
+
+@jitable
+def extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb):
+    """(t, value of s) where surface s's rate (ra at ta, rb at tb, of opposite signs) is 0."""
+    t_ext, _ = locate(prob, m, rate, t, h, y0, y1, Q, ta, tb, ra, rb, 1e-15)
+    return t_ext, value_on_step(prob, m, s, t_ext, t, h, y0, y1, Q)
+
+
+@jitable
+def hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb):
+    """(t_ext, g_ext) when surface s crosses zero and comes back inside (ta, tb), else (-1, 0).
+
+    Both ends are on the watched side; if the rate turns from approaching zero to leaving it,
+    the extremum is located and the value read there.  A rate exactly 0 at an end is no turn."""
+    up = direction >= 0 and ga < 0.0 and ra > 0.0 > rb
+    down = direction <= 0 and ga > 0.0 and ra < 0.0 < rb
+    if not (up or down):
+        return -1.0, 0.0
+    t_ext, g_ext = extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb)
+    if (up and g_ext >= 0.0) or (down and g_ext <= 0.0):
+        return t_ext, g_ext
+    return -1.0, 0.0
+
+
+@jitable
+def turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb):
+    """Start (t, g) of the bracket of a sign change of surface s over (ta, tb], and whether it
+    is a crossing: if s moves away from the watched direction at ta it can reach zero only
+    after its rate turns (the bracket then starts at the turn); if the rate never turns, the
+    sign change is rounding noise."""
+    if ra * direction >= 0.0:
+        return ta, ga, True
+    if rb * direction < 0.0:
+        return ta, ga, False
+    t_ext, g_ext = extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb)
+    if g_ext * direction < 0.0:
+        return t_ext, g_ext, True
+    return ta, ga, True
+
+
+@jitable
+def _sample(prob, m, s, t, a, ad, work):
+    """Surface s's value at the current sample, computed once per sample."""
+    if not work.known[s]:
+        work.values[s] = value(prob, m, s, t, a, ad)
+        work.known[s] = True
+    return work.values[s]
+
+
+@jitable
+def _start_values(prob, m, w0, w1, t0, y0, y1, work):
+    """The watched values (and rates) at the step's start, into g_prev and r_prev."""
+    tab = prob.tables
+    work.known[:] = False
+    for w in range(w0, w1):
+        s = tab.surface[w]
+        work.g_prev[w - w0] = _sample(prob, m, s, t0, y0, y1, work)
+        if tab.surface_rate[s] >= 0:
+            work.r_prev[w - w0] = _sample(prob, m, tab.surface_rate[s], t0, y0, y1, work)
+
+
+@jitable
+def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
+    """Earliest crossing of mode m's watched transitions over the step [t0, t1].
+
+    Returns (w, t): the transition's row and the located far-side time; w = -1 when nothing
+    crosses, NONFINITE when a value is not finite.  ``have_start``: work.g_prev and
+    work.r_prev already hold the values at t0 (the previous step's end); with no crossing,
+    they hold the values at t1 on return.
+    """
+    tab = prob.tables
+    w0, w1 = tab.watch_start[m], tab.watch_start[m + 1]
+    h = t1 - t0
+    n_int = cfg.interior_points
+    if not have_start:
+        _start_values(prob, m, w0, w1, t0, y0, y1, work)
+    best_w, best_t = -1, math.inf
+    found = 0
+    for i in range(1, n_int + 2):
+        ta = t0 + h * (i - 1) / (n_int + 1)
+        last = i == n_int + 1
+        tb = t1 if last else t0 + h * i / (n_int + 1)
+        if tb >= best_t:
+            break  # a root in (ta, tb] cannot beat one already located before tb
+        if last:
+            a, ad = n0, n1
+        else:
+            a, ad = dense_eval(tb, t0, h, y0, y1, Q)
+        work.known[:] = False
+        for w in range(w0, w1):
+            k = w - w0
+            if (found >> k) & 1:
+                continue
+            s, direction, rate = tab.surface[w], tab.direction[w], tab.surface_rate[tab.surface[w]]
+            ga, gb = work.g_prev[k], _sample(prob, m, s, tb, a, ad, work)
+            if not (math.isfinite(ga) and math.isfinite(gb)):
+                return NONFINITE, tb
+            rb = _sample(prob, m, rate, tb, a, ad, work) if rate >= 0 else 0.0
+            tk = -1.0
+            if crossed(ga, gb, direction):
+                lo, glo, genuine = ta, ga, True
+                if rate >= 0:
+                    lo, glo, genuine = turned_back(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
+                                                   work.r_prev[k], rb)
+                if genuine:
+                    tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, lo, tb, glo, gb, cfg.xtol)
+            elif rate >= 0:
+                t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
+                                                work.r_prev[k], rb)
+                if t_ext >= 0.0:
+                    tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, ta, t_ext, ga, g_ext, cfg.xtol)
+            work.g_prev[k] = gb
+            work.r_prev[k] = rb
+            if tk >= 0.0:
+                found |= 1 << k
+                if tk < best_t:
+                    best_w, best_t = w, tk
+    return best_w, best_t
+
+
+@jitable
+def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
+    """A step that starts exactly on a watched surface (value 0) and ends strictly on its
+    leaving side has left mode m at its start: the transition's row, or -1."""
+    tab = prob.tables
+    for w in range(tab.watch_start[m], tab.watch_start[m + 1]):
+        s = tab.surface[w]
+        if value(prob, m, s, t0, y0, y1) == 0.0 and tab.direction[w] * value(prob, m, s, t1, n0, n1) > 0.0:
+            return w
+    return -1
+
+
+@jitable
+def zero_at_start(prob, m, work):
+    """Whether a watched value was exactly 0 at the step's start (a start on its surface)."""
+    tab = prob.tables
+    for k in range(tab.watch_start[m + 1] - tab.watch_start[m]):
+        if work.g_prev[k] == 0.0:
+            return True
+    return False
+
+
+# --- switching ------------------------------------------------------------------------------
+@jitable
+def across(prob, m, w, t, a, ad):
+    """Whether the state is across transition w's surface (or on it), in its direction."""
+    tab = prob.tables
+    return tab.direction[w] * value(prob, m, tab.surface[w], t, a, ad) >= 0.0
+
+
+@jitable
+def switch(prob, w, t, a, ad, cfg, buf):
+    """The mode after transition w fires at (t, a, ad), and the state after its reset."""
+    tab = prob.tables
+    m_new = target(prob, w, t, a, ad, cfg.look_ahead)
+    j = tab.reset[w]
+    if j >= 0:
+        prob.kernels.reset(j, t, a, ad, prob.p, buf)
+        return m_new, buf[0], buf[1]
+    return m_new, a, ad
+
+
+@jitable
+def chattering(times, n, window, count):
+    """More than ``count`` switches within ``window`` (relative) of the latest, switches at
+    times[:n]: no progress."""
+    if n <= count:
+        return False
+    t = times[n - 1]
+    return t - times[n - 1 - count] < window * max(1.0, abs(t))

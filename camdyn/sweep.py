@@ -4,194 +4,300 @@
 of a grid -- the outer product of named 1-D value lists: ``speed_rpm`` and/or any rig
 parameter (``k_s``, ``e``, ``zeta_D``...) -- applies a *measure* to each Result, and
 returns an ``xarray.Dataset`` with one dimension per grid name, in the grid's order, plus
-whatever dimensions the measure adds.  The same call runs serially (``executor=None``),
-on local processes (``ProcessPoolExecutor``) or on a dask cluster
-(``distributed.Client(...).get_executor()``); points are grouped into chunks, each chunk is
-one task, and results are placed by index, so the order (and every value) is the same
-whichever executor ran them and in whatever order the tasks finished.  A progress bar
-(tqdm) counts points.  The Dataset is NetCDF3-compatible: ``ds.to_netcdf(path)`` saves it.
+whatever dimensions the measure adds, and two variables of its own: ``outcome`` (a code per
+point: the engine's ``camdyn.Outcome``, or INVALID, ERROR, NOT_RUN; the codes are in the
+variable's ``flag_values``/``flag_meanings``) and ``message`` (why a point did not succeed).
 
-A measure is a picklable callable ``measure(result) -> dict``: each value a number or an
-``(dims, array)`` pair, as in ``xarray.Dataset`` (see :class:`Summary`, :class:`PoincareSection`).
+Sweeps at scale lose nothing:
+
+* every point is checked before any work (:mod:`camdyn.sweep_check`): by default a grid
+  with invalid points is refused with all of them listed (:class:`InvalidGridError`);
+  ``invalid="skip"`` records them as INVALID (NaN values, the reason in ``message``) and
+  runs the rest;
+* a point whose simulation or measure raises is recorded as ERROR with its message; a run
+  that stops early is recorded with its engine outcome; neither stops the sweep;
+* with ``out="map.nc"`` the finished chunks stream to ``map.nc.parts/`` as they complete
+  (:mod:`camdyn.sweep_store`); after Ctrl-C, a crash or a killed process, :func:`resume`
+  runs only the missing points, and the result equals an uninterrupted sweep's;
+* a worker that dies costs a retry of its chunk (:mod:`camdyn.sweep_run`); a chunk that
+  cannot run is recorded as NOT_RUN and the sweep says so (a warning on ``camdyn.sweep``);
+* the Dataset is the same serially (``executor=None``), on local processes
+  (``ProcessPoolExecutor``) or on a dask cluster (``distributed.Client(...).get_executor()``),
+  for any chunk size and worker count: each point's values depend only on the point;
+* memory is O(points): each Result is measured in the worker and dropped.
+
+A measure is a picklable callable ``measure(result) -> dict``: each value a number or a
+``(dim, 1-D array)`` pair (see :class:`Summary`, :class:`PoincareSection`); numbers are
+stored as floats.  Its optional ``variables`` (name -> (long_name, units)) label the file.
 :func:`bifurcation` (Poincare section of alpha once per revolution against speed) and
 :func:`contact_loss_map` (k_s against cam speed, as in the paper's Fig. 9) are sweeps.
 """
 from __future__ import annotations
 
-import itertools
+import logging
 import math
-from concurrent.futures import Executor, as_completed
+import pickle
+from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass
-from typing import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Callable, ClassVar, Mapping, Sequence
 
 import numpy as np
 
-from . import __version__
 from .analysis import contact_loss_speed, residual_stats
 from .cam import ConstantSpeed
-from .errors import ParameterError
-from .outcome import Outcome
+from .errors import CamdynError, ParameterError
 from .result import Result
 from .rig import Rig
 from .scene import Scene
-from .simulation import simulate
+from .simulation import BACKENDS
+from .sweep_check import InvalidGridError, check_by_running, check_grid, check_settings
+from .sweep_run import Dispatch, chunks_of, run_serial, worker_count
+from .sweep_spec import ALL_CODES, ERROR, INVALID, NOT_RUN, OUTCOME_CODES, SweepSpec, chunk_of, grid_axes
+from .sweep_store import FolderStore, MemoryStore, StoreError, assemble, done_mask, parts_folder, rig_of, scene_of
 
-#: grid names that are not rig parameters
-CAM_NAMES = ("speed_rpm",)
-OUTCOME_CODES = {o.name: i for i, o in enumerate(Outcome)}
+log = logging.getLogger("camdyn.sweep")
 
 
 @dataclass(frozen=True)
 class Summary:
-    """Impacts per revolution, residual response (rms, peak-to-peak of alpha_r) and the outcome
-    code (position in camdyn.Outcome), after ``transient_revolutions``."""
+    """Impacts per revolution and the residual response (rms, peak-to-peak of alpha_r), after
+    ``transient_revolutions``; NaN for a run that did not succeed."""
 
     transient_revolutions: float = 0.0
+    variables: ClassVar[dict] = {
+        "impacts_per_rev": ("impacts per cam revolution after the transient", "1"),
+        "alpha_r_rms": ("rms of the residual response alpha_r after the transient", "rad"),
+        "alpha_r_ptp": ("peak-to-peak of the residual response alpha_r after the transient", "rad")}
 
     def __call__(self, result: Result) -> dict:
-        outcome = OUTCOME_CODES[result.outcome.name]
         if not result.ok or result.t.size < 2:
-            return {"impacts_per_rev": math.nan, "alpha_r_rms": math.nan, "alpha_r_ptp": math.nan,
-                    "outcome": outcome}
+            return {"impacts_per_rev": math.nan, "alpha_r_rms": math.nan, "alpha_r_ptp": math.nan}
         t0 = result.t[0] + self.transient_revolutions * result.period
         steady = result.after(t0)
         revs = (result.t[-1] - t0) / result.period
         stats = residual_stats(steady)
         return {"impacts_per_rev": steady.impacts().size / revs if revs > 0 else math.nan,
-                "alpha_r_rms": stats.rms, "alpha_r_ptp": stats.peak_to_peak, "outcome": outcome}
+                "alpha_r_rms": stats.rms, "alpha_r_ptp": stats.peak_to_peak}
 
 
 @dataclass(frozen=True)
 class PoincareSection:
     """alpha once per revolution (the samples at t = k T), after ``transient_revolutions``;
-    run with ``samples_per_revolution=1``.  Also the impacts per revolution and the outcome."""
+    run with ``samples_per_revolution=1``.  Also the impacts per revolution."""
 
     transient_revolutions: int = 0
+    variables: ClassVar[dict] = {
+        "alpha_section": ("follower angle alpha once per cam revolution (Poincare section)", "rad"),
+        "impacts_per_rev": Summary.variables["impacts_per_rev"]}
 
     def __call__(self, result: Result) -> dict:
         per_rev = max(1, int(round(result.period * _sample_rate(result))))
         section = result.alpha[::per_rev][self.transient_revolutions:]
         summary = Summary(self.transient_revolutions)(result)
-        return {"alpha_section": (("revolution",), section), "impacts_per_rev": summary["impacts_per_rev"],
-                "outcome": summary["outcome"]}
+        return {"alpha_section": (("revolution",), section), "impacts_per_rev": summary["impacts_per_rev"]}
 
 
 def _sample_rate(result: Result) -> float:
     return 1.0 / (result.t[1] - result.t[0]) if result.t.size > 1 else math.nan
 
 
-def _grid(rig: Rig, grid: Mapping[str, Sequence[float]]) -> dict[str, np.ndarray]:
-    if not isinstance(grid, Mapping) or not grid:
-        raise ParameterError("grid", grid, "a non-empty mapping of names to 1-D value lists")
-    out = {}
-    known = set(rig.to_dict())
-    for name, values in grid.items():
-        if name not in CAM_NAMES and name not in known:
-            raise ParameterError("grid", name, f"speed_rpm or a rig parameter ({', '.join(sorted(known))})")
-        arr = np.asarray(values, dtype=float)
-        if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
-            raise ParameterError(name, values, "a non-empty 1-D list of finite numbers (a grid axis)")
-        out[name] = arr
-    return out
+@dataclass(frozen=True)
+class _RunOptions:
+    """How to run the chunks (none of it changes the result)."""
+
+    executor: Executor | None = None
+    progress: bool = True
+    chunksize: int | None = None
+    retries: int = 2
+
+    def __post_init__(self):
+        if self.chunksize is not None and not _whole(self.chunksize, 1):
+            raise ParameterError("chunksize", self.chunksize, "an integer >= 1 (points per task), or None")
+        if not _whole(self.retries, 0):
+            raise ParameterError("retries", self.retries, "an integer >= 0")
 
 
-def _run_chunk(rig: Rig, scene: Scene, names: tuple, points: list, measure: Callable,
-               kwargs: dict) -> list[dict]:
-    """One task: simulate and measure each point of the chunk (module level: picklable)."""
-    results = []
-    for point in points:
-        values = dict(zip(names, point))
-        speed = values.pop("speed_rpm", None)
-        point_rig = rig.replace(**values) if values else rig
-        kw = dict(kwargs)
-        if speed is not None:
-            kw["cam"] = ConstantSpeed(speed)
-        per_rev = kw.pop("samples_per_revolution", None)
-        if per_rev is not None:
-            kw["sample_rate_Hz"] = per_rev / kw["cam"].period
-        results.append(measure(simulate(point_rig, scene, **kw)))
-    return results
-
-
-def _chunks(n: int, size: int) -> list[range]:
-    return [range(i, min(n, i + size)) for i in range(0, n, size)]
+def _whole(value, least: int) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= least
 
 
 def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: Callable = Summary(), *,
           executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
-          samples_per_revolution: int | None = None, **simulate_kwargs):
-    """Simulate every point of ``grid`` and measure it; an ``xarray.Dataset`` (see the module doc).
+          samples_per_revolution: int | None = None, out=None, invalid: str = "raise", retries: int = 2,
+          **simulate_kwargs):
+    """Simulate every point of ``grid`` and measure it (see the module doc).
 
-    ``simulate_kwargs`` go to :func:`camdyn.simulate` (``revolutions``, ``rtol``...;
-    ``backend`` defaults to ``"compiled"``).  ``samples_per_revolution`` sets each point's
-    sample rate from its own cam period (1: one sample per revolution, a Poincare section).
-    ``chunksize``: points per task (default: about four tasks per worker).
+    Parameters
+    ----------
+    rig, scene : camdyn.Rig, camdyn.Scene
+        The base rig (each point replaces the grid's rig parameters) and the physics.
+    grid : mapping of str to 1-D sequence of float
+        ``speed_rpm`` and/or rig parameters (SI), each with its values; the points are the
+        outer product, and the Dataset's dimensions follow this order.
+    measure : callable, optional
+        ``measure(result) -> dict`` (picklable); default :class:`Summary`.
+    executor : concurrent.futures.Executor, optional
+        Where the chunks run: None (serially, here), a ``ProcessPoolExecutor``, or dask's
+        ``Client.get_executor()``.  The result does not depend on it.
+    progress : bool
+        Show a progress bar (tqdm) counting points.
+    chunksize : int, optional
+        Points per task (default: about 16 tasks per worker).  The result does not depend on it.
+    samples_per_revolution : int, optional
+        Each point's sample rate from its own cam period (1: a Poincare section).
+    out : str or os.PathLike, optional
+        A netCDF file to write.  The finished chunks stream to the folder ``<out>.parts``
+        while the sweep runs; an interrupted sweep is continued by :func:`resume`.
+    invalid : {"raise", "skip"}
+        A grid with points that cannot run: "raise" refuses to start and lists every one
+        (:class:`InvalidGridError`); "skip" records them as INVALID and runs the others.
+    retries : int
+        Times a chunk whose worker died (or whose task failed) is submitted again.
+    **simulate_kwargs
+        Given to :func:`camdyn.simulate` at every point (``revolutions``, ``rtol``,
+        ``backend`` -- "compiled" unless given -- ``cam`` or ``speed_rpm`` when the speed is
+        not a grid axis, ...).
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per grid name, the measured variables, ``outcome`` and ``message``.
     """
-    import xarray as xr
-    from tqdm.auto import tqdm
+    spec = _spec(rig, scene, grid, measure, samples_per_revolution, simulate_kwargs)
+    return _start(spec, out, invalid, _RunOptions(executor, progress, chunksize, retries))
 
-    axes = _grid(rig, grid)
-    names = tuple(axes)
-    if "speed_rpm" not in axes and "cam" not in simulate_kwargs and "speed_rpm" not in simulate_kwargs:
+
+def resume(out, *, executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
+           retries: int = 2):
+    """Continue the sweep that was writing ``out``: run only the points missing from
+    ``<out>.parts`` and write ``out``; the result equals an uninterrupted sweep's.
+
+    The grid, rig, scene, measure and settings come from the folder; ``executor``,
+    ``progress``, ``chunksize`` and ``retries`` are as in :func:`sweep` and may differ from
+    the first run's.  A sweep that already finished returns its file's Dataset.
+    """
+    options = _RunOptions(executor, progress, chunksize, retries)
+    if not parts_folder(out).exists() and Path(out).is_file():
+        import xarray as xr
+
+        log.info("%s is complete: nothing to resume", out)
+        return xr.load_dataset(out, engine="scipy")
+    store = FolderStore.open(out)
+    return _run(store.spec(), store, options)
+
+
+def load_partial(out):
+    """The Dataset of an unfinished sweep writing ``out``, as far as it got: the points not
+    run yet are NOT_RUN (NaN values).  Nothing runs."""
+    store = FolderStore.open(out)
+    return assemble(store.spec(), store.chunks())
+
+
+def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finish=None) -> SweepSpec:
+    axes = grid_axes(rig, grid)
+    kwargs = dict(kwargs)
+    if not callable(measure):
+        raise ParameterError("measure", measure, "a callable measure(result) -> dict")
+    if samples_per_revolution is not None and not _whole(samples_per_revolution, 1):
+        raise ParameterError("samples_per_revolution", samples_per_revolution, "an integer >= 1")
+    if "speed_rpm" in kwargs:
+        if "speed_rpm" in axes or "cam" in kwargs:
+            raise ParameterError("speed_rpm", kwargs["speed_rpm"], "not given with a speed_rpm axis or cam=")
+        kwargs["cam"] = ConstantSpeed(kwargs.pop("speed_rpm"))
+    if "speed_rpm" in axes and "cam" in kwargs:
+        raise ParameterError("cam", kwargs["cam"], "not given with a speed_rpm axis")
+    if "speed_rpm" not in axes and "cam" not in kwargs:
         raise ParameterError("speed_rpm", None, "a grid axis 'speed_rpm', or cam=/speed_rpm= for every point")
-    if samples_per_revolution is not None:
-        if isinstance(samples_per_revolution, bool) or not isinstance(samples_per_revolution, int) \
-                or samples_per_revolution < 1:
-            raise ParameterError("samples_per_revolution", samples_per_revolution, "an integer >= 1")
-        simulate_kwargs["samples_per_revolution"] = samples_per_revolution
-    if "speed_rpm" in simulate_kwargs:
-        simulate_kwargs["cam"] = ConstantSpeed(simulate_kwargs.pop("speed_rpm"))
-    simulate_kwargs.setdefault("backend", "compiled")
-    points = list(itertools.product(*(a.tolist() for a in axes.values())))
-    workers = getattr(executor, "_max_workers", None) or 2
-    size = chunksize or max(1, math.ceil(len(points) / (4 * workers)))
-    chunks = _chunks(len(points), size)
-    rows: list = [None] * len(points)
-    bar = tqdm(total=len(points), disable=not progress, desc=f"sweep {scene.slug}", unit="pt")
-    args = (rig, scene, names)
-    if executor is None:
-        for chunk in chunks:
-            rows[chunk.start:chunk.stop] = _run_chunk(*args, [points[i] for i in chunk], measure, simulate_kwargs)
-            bar.update(len(chunk))
-    else:
-        futures = {executor.submit(_run_chunk, *args, [points[i] for i in chunk], measure, simulate_kwargs): chunk
-                   for chunk in chunks}
-        for future in as_completed(futures):
-            chunk = futures[future]
-            rows[chunk.start:chunk.stop] = future.result()
-            bar.update(len(chunk))
-    bar.close()
-    return _dataset(xr, axes, rows, rig, scene, simulate_kwargs)
+    if "speed_rpm" in axes and scene.motion != "constant":
+        raise ParameterError("grid", "speed_rpm", f"no speed_rpm axis with the scene's {scene.motion!r} motion")
+    if "backend" not in kwargs and "compiled" in BACKENDS:
+        kwargs["backend"] = "compiled"
+    return SweepSpec(rig, scene, axes, measure, kwargs, samples_per_revolution, finish)
 
 
-def _dataset(xr, axes: dict, rows: list, rig: Rig, scene: Scene, kwargs: dict):
-    shape = tuple(a.size for a in axes.values())
-    dims = tuple(axes)
-    data = {}
-    for name, first in rows[0].items():
-        if isinstance(first, tuple):
-            extra_dims, _ = first
-            length = max(len(np.atleast_1d(r[name][1])) for r in rows)
-            block = np.full((len(rows), length), np.nan)
-            for i, r in enumerate(rows):
-                v = np.asarray(r[name][1], dtype=float)
-                block[i, :v.size] = v
-            data[name] = (dims + tuple(extra_dims), block.reshape(shape + (length,)))
+def _start(spec: SweepSpec, out, invalid: str, options: _RunOptions):
+    """Check every point, then run the sweep into memory or into ``out``'s folder."""
+    if invalid not in ("raise", "skip"):
+        raise ParameterError("invalid", invalid, "'raise' or 'skip'")
+    check_settings(spec)
+    bad, lines = check_grid(spec)
+    if bad and invalid == "raise":
+        raise InvalidGridError(spec.size, bad, lines)
+    first = next((i for i in range(spec.size) if i not in bad), None)
+    if first is not None:
+        check_by_running(spec, first)
+    if out is not None or isinstance(options.executor, ProcessPoolExecutor):
+        try:
+            pickle.dumps(spec)
+        except Exception as exc:
+            raise TypeError(f"the sweep's measure and settings must be picklable to run in other processes "
+                            f"or to be resumed ({type(exc).__name__}: {exc})") from None
+    store = FolderStore.create(out, spec) if out is not None else MemoryStore()
+    if bad:
+        indices = sorted(bad)
+        store.put(chunk_of(indices, [(INVALID, bad[i], {}) for i in indices]))
+    return _run(spec, store, options)
+
+
+def _run(spec: SweepSpec, store, options: _RunOptions):
+    """Run the points missing from the store; assemble (and, with a folder, write) the Dataset."""
+    todo = np.flatnonzero(~done_mask(spec, store.chunks()))
+    workers = worker_count(options.executor)
+    size = options.chunksize or max(1, math.ceil(todo.size / (16 * workers)))
+    chunks = chunks_of(todo, size)
+    bar = _Progress(spec, todo.size, options.progress)
+    try:
+        if options.executor is None:
+            not_run = run_serial(spec, chunks, store, bar)
         else:
-            values = np.array([r[name] for r in rows])
-            values = values.astype(np.int32) if np.issubdtype(values.dtype, np.integer) else values.astype(float)
-            data[name] = (dims, values.reshape(shape))
-    attrs = {"scene": scene.slug, "rig": str(rig.name), "camdyn_version": __version__,
-             "simulate": ", ".join(f"{k}={v!r}" for k, v in sorted(kwargs.items())),
-             "outcome_codes": ", ".join(f"{i}={name}" for name, i in OUTCOME_CODES.items())}
-    coords = {name: (name, a) for name, a in axes.items()}
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+            not_run = Dispatch(spec, chunks, store, bar, options.executor, options.retries).run()
+    finally:
+        bar.close()
+    ds = assemble(spec, store.chunks(), not_run)
+    if isinstance(store, FolderStore):
+        store.finish(ds, complete=not not_run)
+    _report(ds, store)
+    return ds
+
+
+class _Progress:
+    """A tqdm bar counting points, with the number that did not succeed."""
+
+    def __init__(self, spec: SweepSpec, total: int, enabled: bool):
+        from tqdm.auto import tqdm
+
+        self.bar = tqdm(total=spec.size, initial=spec.size - total, disable=not enabled,
+                        desc=f"sweep {spec.scene.slug}", unit="pt")
+        self.failed = 0
+
+    def done(self, chunk) -> None:
+        self.bar.update(len(chunk))
+        failed = int(np.sum(chunk.outcome != OUTCOME_CODES["SUCCESS"]))
+        if failed:
+            self.failed += failed
+            self.bar.set_postfix_str(f"{self.failed} not SUCCESS", refresh=False)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def _report(ds, store) -> None:
+    codes = ds["outcome"].values
+    errors, not_run = int(np.sum(codes == ERROR)), int(np.sum(codes == NOT_RUN))
+    if errors:
+        log.warning("%d of %d points raised: recorded as ERROR (the message variable says why)", errors, codes.size)
+    if not_run:
+        where = (f"camdyn.sweep.resume({str(store.out)!r}) runs them" if isinstance(store, FolderStore)
+                 else "run the sweep with out= to be able to resume it")
+        log.warning("%d of %d points could not run: recorded as NOT_RUN; %s", not_run, codes.size, where)
 
 
 def bifurcation(rig: Rig, scene: Scene, speeds_rpm: Sequence[float], *, revolutions: int = 200,
                 transient_revolutions: int = 50, **kwargs):
     """Poincare section of alpha once per revolution against cam speed: ``alpha_section``
-    (speed_rpm, revolution) for the revolutions after the transient."""
+    (speed_rpm, revolution) for the revolutions after the transient.  ``kwargs`` go to
+    :func:`sweep` (``executor``, ``out``, ``rtol``...)."""
     if isinstance(revolutions, bool) or not isinstance(revolutions, int) or revolutions < 1:
         raise ParameterError("revolutions", revolutions, "an integer >= 1")
     if not 0 <= transient_revolutions < revolutions:
@@ -202,16 +308,36 @@ def bifurcation(rig: Rig, scene: Scene, speeds_rpm: Sequence[float], *, revoluti
 
 def contact_loss_map(rig: Rig, scene: Scene, k_s: Sequence[float], speeds_rpm: Sequence[float], *,
                      revolutions: float = 6, transient_revolutions: float = 3, samples_per_revolution: int = 64,
-                     **kwargs):
+                     executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
+                     out=None, invalid: str = "raise", retries: int = 2, **simulate_kwargs):
     """Where the follower leaves the cam: ``impacts_per_rev`` over (k_s, speed_rpm) from simulation,
-    ``contact_lost`` (impacts after the transient), and ``loss_speed_predicted`` (k_s), the
-    inverse-kinematics contact-loss speed (Section 6) -- the curve of the paper's Fig. 9."""
-    ds = sweep(rig, scene, {"k_s": k_s, "speed_rpm": speeds_rpm}, Summary(transient_revolutions),
-               revolutions=revolutions, samples_per_revolution=samples_per_revolution, **kwargs)
-    ds["contact_lost"] = (ds["impacts_per_rev"] > 0).astype(np.int32)
-    ds["loss_speed_predicted"] = ("k_s", np.array([contact_loss_speed(rig.replace(k_s=float(k)))
-                                                   for k in ds["k_s"].values]))
+    ``contact_lost`` (1 with impacts after the transient, 0 without, NaN where the run did not
+    succeed), and ``loss_speed_predicted`` (k_s), the inverse-kinematics contact-loss speed
+    (Section 6) -- the curve of the paper's Fig. 9.  Other keywords as in :func:`sweep`."""
+    spec = _spec(rig, scene, {"k_s": k_s, "speed_rpm": speeds_rpm}, Summary(transient_revolutions),
+                 samples_per_revolution, {"revolutions": revolutions, **simulate_kwargs}, finish=add_contact_loss)
+    return _start(spec, out, invalid, _RunOptions(executor, progress, chunksize, retries))
+
+
+def add_contact_loss(ds, spec: SweepSpec):
+    """The derived variables of :func:`contact_loss_map` (its ``finish``: run on resume too)."""
+    import xarray as xr
+
+    impacts = ds["impacts_per_rev"]
+    ds["contact_lost"] = xr.where(impacts.isnull(), np.nan, (impacts > 0).astype(float))
+    ds["contact_lost"].attrs = {"units": "1", "long_name": "1: impacts after the transient, 0: none, NaN: no run"}
+    ds["loss_speed_predicted"] = ("k_s", np.array([_loss_speed(spec.rig, float(k)) for k in ds["k_s"].values]),
+                                  {"units": "rev/min", "long_name": "contact-loss speed by inverse kinematics "
+                                                                    "(Section 6)"})
     return ds
 
 
-__all__ = ["sweep", "Summary", "PoincareSection", "bifurcation", "contact_loss_map"]
+def _loss_speed(rig: Rig, k_s: float) -> float:
+    try:
+        return contact_loss_speed(rig.replace(k_s=k_s))
+    except CamdynError:
+        return math.nan
+
+
+__all__ = ["sweep", "resume", "load_partial", "Summary", "PoincareSection", "bifurcation", "contact_loss_map",
+           "InvalidGridError", "StoreError", "ALL_CODES", "rig_of", "scene_of"]

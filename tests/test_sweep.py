@@ -1,6 +1,9 @@
-"""Sweeps: any Executor, deterministic order and values, labelled result, NetCDF round trip."""
+"""Sweeps: any Executor, deterministic order and values, labelled result, NetCDF round trip;
+every point checked first, a failing point recorded, results streamed to a self-describing file.
+(Workers that die, interrupts and resume: test_sweep_faults.py.)"""
 from __future__ import annotations
 
+import math
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import numpy as np
@@ -10,6 +13,7 @@ import camdyn
 from camdyn import sweep as S
 from camdyn.errors import ParameterError
 from registry import RIG
+from sweep_faults import Faulty
 
 xr = pytest.importorskip("xarray")
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -51,11 +55,15 @@ def test_process_pool_gives_the_same_dataset(serial):
     xr.testing.assert_identical(ds, serial)
 
 
-def test_dask_local_cluster_gives_the_same_dataset(serial):
-    distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=client.get_executor(), chunksize=2, **KW)
+@pytest.mark.parametrize("threads, chunksize", [(None, 1), (None, 4), (1, 5), (2, 1), (3, 2)])
+def test_any_executor_and_chunk_size_gives_the_same_dataset(serial, threads, chunksize):
+    """Serial or threads, any chunk size: the same Dataset (process pools and dask: below and in
+    test_sweep_faults.py)."""
+    if threads is None:
+        ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), chunksize=chunksize, **KW)
+    else:
+        with ThreadPoolExecutor(threads) as pool:
+            ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=pool, chunksize=chunksize, **KW)
     xr.testing.assert_identical(ds, serial)
 
 
@@ -64,6 +72,41 @@ def test_netcdf_round_trip(serial, tmp_path):
     serial.to_netcdf(path)
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), serial)
+
+
+def test_streamed_sweep_writes_the_same_dataset_self_described(serial, tmp_path):
+    out = tmp_path / "map.nc"
+    ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), out=out, chunksize=2, **KW)
+    xr.testing.assert_identical(ds, serial)
+    assert not (tmp_path / "map.nc.parts").exists()  # every point ran: the folder is gone
+    with xr.open_dataset(out, engine="scipy") as back:
+        back = back.load()
+    xr.testing.assert_identical(back, serial)
+    a = back.attrs
+    assert a["camdyn_version"] == camdyn.__version__ and a["grid"] == "k_s speed_rpm"
+    assert a["scene"] == SCENE.slug and a["scene_damping"] == "D" and a["scene_friction"] == "coulomb"
+    for name, value in RIG.to_dict().items():  # every parameter of the base rig
+        if value is not None and name not in ("name", "description"):
+            assert a[f"rig_{name}"] == value, name
+    assert a["simulate_rtol"] == 1e-8 and a["simulate_revolutions"] == 2 and a["samples_per_revolution"] == 32
+    assert a["measure"] == "Summary(transient_revolutions=1)" and a["measure_transient_revolutions"] == 1
+    assert back["speed_rpm"].attrs["units"] == "rev/min" and back["k_s"].attrs["units"] == "N/m"
+    assert back["alpha_r_rms"].attrs["units"] == "rad" and "long_name" in back["impacts_per_rev"].attrs
+    flags = dict(zip(back["outcome"].attrs["flag_meanings"].split(), back["outcome"].attrs["flag_values"]))
+    assert flags["SUCCESS"] == 0 and flags["ERROR"] == S.ALL_CODES["ERROR"]
+    # the file alone gives back the rig and the scene it was swept on
+    assert S.rig_of(a) == RIG and S.scene_of(a) == SCENE
+
+
+def test_a_folder_in_progress_is_never_overwritten(tmp_path):
+    out = tmp_path / "map.nc"
+    (tmp_path / "map.nc.parts").mkdir()
+    with pytest.raises(S.StoreError, match="resume"):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), out=out, **KW)
+    with pytest.raises(S.StoreError, match="no sweep to resume"):
+        S.resume(tmp_path / "other.nc")
+    with pytest.raises(S.StoreError, match="does not exist"):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), out=tmp_path / "no" / "map.nc", **KW)
 
 
 def test_progress_bar_counts_points(capsys):
@@ -91,6 +134,82 @@ def test_bifurcation_and_contact_loss_map():
                 assert lost[i, j] == int(v > loss)
 
 
+# --- every point checked before any work ---------------------------------------------------------
+def test_an_invalid_point_refuses_the_sweep_and_names_the_valid_one_untouched(tmp_path):
+    """The issue's two examples: the valid point is not lost, nothing runs, one clear error."""
+    bad_e = 1.5 * RIG.r_c
+    with pytest.raises(S.InvalidGridError) as info:
+        S.sweep(RIG, SCENE, {"speed_rpm": [300.0], "e": [0.001, bad_e]}, revolutions=1, progress=False,
+                out=tmp_path / "e.nc")
+    assert info.value.invalid == {1: info.value.invalid[1]} and "1 of 2 grid points" in str(info.value)
+    assert "e=0.0375" in str(info.value) and "< r_c" in str(info.value)
+    assert not list(tmp_path.iterdir())  # refused before any work: no folder, no file
+    with pytest.raises(S.InvalidGridError, match=r"speed_rpm=1e\+06: speed_rpm = 1000000.0 is out of range"):
+        S.sweep(RIG, SCENE, {"speed_rpm": [300.0, 1e6]}, revolutions=1, progress=False)
+
+
+def test_every_invalid_point_is_listed_with_its_reason():
+    grid = {"speed_rpm": [300.0, 1e6, 0.0], "e": [0.001, 1.5 * RIG.r_c]}
+    with pytest.raises(S.InvalidGridError) as info:
+        S.sweep(RIG, SCENE, grid, revolutions=1, progress=False)
+    err = info.value
+    assert sorted(err.invalid) == [1, 2, 3, 4, 5]  # flat C order over (speed_rpm, e): only (300, 0.001) runs
+    assert err.lines[0].startswith("e=0.0375 (every speed_rpm): e = ")
+    assert err.lines[1].startswith("speed_rpm=1e+06 (every e): speed_rpm = 1000000.0 is out of range")
+    assert err.lines[2].startswith("speed_rpm=0, e=0.001: revolutions") and "no period" in err.lines[2]
+    assert len(err.lines) == 3 and "5 of 6 grid points are invalid" in str(err)
+
+
+def test_skip_records_invalid_points_and_runs_the_rest():
+    grid = {"speed_rpm": [900.0, 1e6], "k_s": [2000.0, -1.0]}
+    ds = S.sweep(RIG, SCENE, grid, S.Summary(1), invalid="skip", revolutions=2, samples_per_revolution=32,
+                 rtol=1e-8, progress=False)
+    codes = ds["outcome"].values
+    assert codes[0, 0] == 0 and np.all(codes.ravel()[1:] == S.ALL_CODES["INVALID"])
+    assert "k_s = -1.0 is out of range" in ds["message"].values[0, 1]
+    assert "speed_rpm = 1000000.0" in ds["message"].values[1, 0]
+    assert np.all(np.isnan(ds["alpha_r_rms"].values.ravel()[1:]))
+    assert ds["alpha_r_rms"].values[0, 0] == _point(2000.0, 900.0)["alpha_r_rms"]  # the valid point, as if alone
+
+
+def test_a_point_beyond_the_run_limits_is_invalid():
+    """simulate's limits that join a rig to a speed (here the samples of a run) are checked per point."""
+    with pytest.raises(S.InvalidGridError, match="speed_rpm=1: sample_rate_Hz .* at most 50000000 samples"):
+        S.sweep(RIG, SCENE, {"speed_rpm": [1.0, 1000.0]}, revolutions=60, sample_rate_Hz=1e6, progress=False)
+
+
+@pytest.mark.parametrize("settings, error, match", [
+    (dict(revolutions=2, rtol=1.0), ParameterError, "rtol"),
+    (dict(revolution=3), TypeError, "not a keyword of camdyn.simulate"),
+    (dict(revolutions=2, t_end=1.0), ParameterError, "t_end"), (dict(revolutions=-1), ParameterError, "revolutions"),
+    (dict(revolutions=2, backend="gpu"), ParameterError, "backend"),
+    (dict(revolutions=2, y0=[1.0]), ParameterError, "y0")])
+def test_settings_shared_by_every_point_are_checked_at_once(settings, error, match):
+    with pytest.raises(error, match=match):
+        S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, progress=False, **settings)
+
+
+def test_a_point_that_raises_in_a_worker_is_recorded_and_the_sweep_completes(serial, caplog):
+    with ProcessPoolExecutor(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "raise"), executor=pool, chunksize=2, **KW)
+    failed = ds["speed_rpm"] == 1100.0
+    assert np.all(ds["outcome"].where(failed, drop=True) == S.ALL_CODES["ERROR"])
+    assert np.all(ds["message"].where(failed, drop=True) == "ValueError: this measure fails at 1100.0 rev/min")
+    xr.testing.assert_equal(ds.where(~failed, drop=True), serial.where(~failed, drop=True))  # the others as ever
+    assert np.all(np.isnan(ds["alpha_r_rms"].where(failed, drop=True)))
+    assert "2 of 6 points raised" in caplog.text
+
+
+def test_a_run_that_stops_early_is_recorded_with_its_outcome():
+    """An engine outcome that is not SUCCESS: its code and message, and the measure's NaN."""
+    from camdyn.engine import EventSettings
+
+    ds = S.sweep(RIG.replace(k_s=2000.0), SCENE, {"speed_rpm": [1300.0]}, S.Summary(0), revolutions=2,
+                 samples_per_revolution=32, events=EventSettings(max_events=1), progress=False)
+    assert ds["outcome"].item() == S.ALL_CODES["MAX_EVENTS"]
+    assert ds["message"].item() == camdyn.Outcome.MAX_EVENTS.message and math.isnan(ds["alpha_r_rms"].item())
+
+
 @pytest.mark.parametrize("grid, name", [({"k_z": [1.0]}, "grid"), ({"speed_rpm": []}, "speed_rpm"),
                                         ({"k_s": [1.0, np.nan], "speed_rpm": [1.0]}, "k_s"), ({}, "grid")])
 def test_bad_grid_names_the_parameter(grid, name):
@@ -101,3 +220,23 @@ def test_bad_grid_names_the_parameter(grid, name):
 def test_missing_speed_is_an_error():
     with pytest.raises(ParameterError, match="speed_rpm"):
         S.sweep(RIG, SCENE, {"k_s": [2000.0]}, revolutions=1, progress=False)
+
+
+def test_an_interrupt_inside_a_point_stops_the_sweep():
+    """Ctrl-C inside compiled code reaches Python as a SystemError caused by the KeyboardInterrupt
+    (numba's dispatcher): it must stop the sweep, not be recorded as the point's error."""
+    def measure(result):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise SystemError("CPUDispatcher(...) returned a result with an exception set") from exc
+
+    with pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, measure, revolutions=1, samples_per_revolution=8, progress=False)
+
+
+def test_a_method_the_engine_does_not_have_refuses_the_sweep():
+    """The engine runs explicit Runge-Kutta pairs only: found once, before any work (not as an
+    ERROR at every point)."""
+    with pytest.raises(ParameterError, match="method"):
+        S.sweep(RIG, SCENE, {"speed_rpm": [900.0, 1000.0]}, revolutions=1, method="Radau", progress=False)

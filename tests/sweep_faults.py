@@ -1,0 +1,36 @@
+"""Measures that misbehave at one cam speed, for the sweep's fault tests.
+
+They live in a module of their own (not a test file) so that worker processes, forked or
+spawned (dask), can import them by name.  Away from the chosen speed each is ``Summary(1)``,
+so a sweep that recovers gives the values of a plain ``Summary(1)`` sweep.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from camdyn.sweep import Summary
+
+
+@dataclass(frozen=True)
+class Faulty:
+    """At ``speed_rpm``: ``"raise"`` a ValueError; ``"exit"`` kill the worker process
+    (os._exit) every time; ``"exit_once"`` kill it only the first time (it writes the marker
+    file); ``"exit_unless"`` kill it every time until someone writes the marker file."""
+
+    speed_rpm: float
+    action: str
+    marker: str = ""
+    inner: Summary = field(default_factory=lambda: Summary(1))
+
+    def __call__(self, result):
+        if result.meta["cam"].speed_rpm == self.speed_rpm:
+            if self.action == "raise":
+                raise ValueError(f"this measure fails at {self.speed_rpm} rev/min")
+            fixed = bool(self.marker) and Path(self.marker).exists()
+            if self.action == "exit" or (self.action in ("exit_once", "exit_unless") and not fixed):
+                if self.action == "exit_once":
+                    Path(self.marker).write_text(str(os.getpid()))
+                os._exit(17)
+        return self.inner(result)

@@ -1,0 +1,179 @@
+"""Sweeps that lose nothing: workers that die (process pool, dask), Ctrl-C, a killed process,
+then resume; the result equals an uninterrupted sweep's, whatever the executor and chunk size."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import camdyn
+from camdyn import sweep as S
+from camdyn.cli import main
+from registry import RIG
+from sweep_faults import Faulty
+
+xr = pytest.importorskip("xarray")
+SCENE = camdyn.Scene(damping="D", friction="coulomb")
+GRID = {"k_s": [2000.0, 3000.0], "speed_rpm": [900.0, 1000.0, 1100.0, 1200.0, 1300.0, 1400.0]}
+KW = dict(revolutions=2, samples_per_revolution=32, rtol=1e-8, progress=False)
+NOT_RUN = S.ALL_CODES["NOT_RUN"]
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return S.sweep(RIG, SCENE, GRID, S.Summary(1), **KW)
+
+
+# --- workers that die -----------------------------------------------------------------------------
+def test_process_pool_worker_killed_mid_sweep_costs_a_retry(serial, tmp_path):
+    marker = tmp_path / "killed"
+    with ProcessPoolExecutor(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "exit_once", str(marker)), executor=pool, chunksize=1, **KW)
+    assert marker.exists()  # a worker did die: its pool broke, a new one ran the chunks in flight again
+    xr.testing.assert_equal(ds, serial)  # values (the measure's repr differs: attrs are not compared)
+
+
+def test_process_pool_point_that_always_kills_its_worker_is_recorded(serial, caplog):
+    with ProcessPoolExecutor(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "exit"), executor=pool, chunksize=1, retries=1, **KW)
+    lost = ds["speed_rpm"] == 1100.0
+    assert np.all(ds["outcome"].where(lost, drop=True) == NOT_RUN)
+    assert all("BrokenProcessPool" in m for m in ds["message"].where(lost, drop=True).values.ravel())
+    # only the culprit is blamed: every other point ran, with its usual values
+    xr.testing.assert_equal(ds.where(~lost, drop=True), serial.where(~lost, drop=True))
+    assert "2 of 12 points could not run: recorded as NOT_RUN" in caplog.text
+
+
+def test_dask_worker_killed_mid_sweep(serial, tmp_path):
+    """On a LocalCluster of processes a worker that dies costs its task a rerun (by the scheduler);
+    the sweep completes with the same values, also for another chunk size."""
+    distributed = pytest.importorskip("distributed")
+    marker = tmp_path / "killed"
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    with cluster, distributed.Client(cluster) as client:
+        ds = S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "exit_once", str(marker)), executor=client.get_executor(),
+                     chunksize=2, **KW)
+        assert marker.exists()
+        xr.testing.assert_equal(ds, serial)
+        plain = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=client.get_executor(), chunksize=5, **KW)
+    xr.testing.assert_identical(plain, serial)  # determinism on dask, attributes included
+
+
+# --- interrupted, then resumed ----------------------------------------------------------------------
+class InterruptAfter(ThreadPoolExecutor):
+    """One worker thread; Ctrl-C lands in the sweep's loop when it submits task number ``n + 1``."""
+
+    def __init__(self, n: int):
+        super().__init__(1)
+        self.n = n
+
+    def submit(self, *args, **kwargs):
+        if self.n == 0:
+            raise KeyboardInterrupt
+        self.n -= 1
+        return super().submit(*args, **kwargs)
+
+
+def test_interrupt_after_half_the_chunks_then_resume_equals_the_uninterrupted_sweep(serial, tmp_path):
+    out = tmp_path / "map.nc"
+    chunks = tmp_path / "map.nc.parts" / "chunks"
+    with InterruptAfter(7) as executor, pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, chunksize=1, out=out, **KW)
+    finished = len(list(chunks.glob("*.nc")))
+    assert 5 <= finished <= 7  # about half of the 12 chunks are kept; nothing else was written
+    assert not out.exists()
+    partial = S.load_partial(out)
+    assert int((partial["outcome"] == 0).sum()) == finished
+    assert int((partial["outcome"] == NOT_RUN).sum()) == 12 - finished
+    next(iter(chunks.glob("*.nc"))).write_bytes(b"half a file")  # a damaged chunk: its points run again
+    # resume on another executor with another chunk size: bit for bit the uninterrupted result
+    with ProcessPoolExecutor(2) as pool:
+        ds = S.resume(out, executor=pool, chunksize=2, progress=False)
+    xr.testing.assert_identical(ds, serial)
+    with xr.open_dataset(out, engine="scipy") as back:
+        xr.testing.assert_identical(back.load(), serial)
+    assert not chunks.parent.exists()
+    xr.testing.assert_identical(S.resume(out), serial)  # a finished sweep: its file
+
+
+def test_lost_points_are_run_by_resume(serial, tmp_path):
+    """A sweep that could not run some points writes what it has and keeps its folder; resume
+    runs them (here the point that killed its worker no longer does)."""
+    out, marker = tmp_path / "map.nc", tmp_path / "fixed"
+    with ProcessPoolExecutor(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "exit_unless", str(marker)), executor=pool, chunksize=3,
+                     retries=0, out=out, **KW)
+    # the chunks holding 1100 rev/min (3 points each, one per k_s) could not run
+    assert int((ds["outcome"] == NOT_RUN).sum()) == 6 and (tmp_path / "map.nc.parts").is_dir() and out.exists()
+    marker.write_text("fixed")
+    resumed = S.resume(out, progress=False)
+    xr.testing.assert_equal(resumed, serial)
+    assert not (tmp_path / "map.nc.parts").exists()
+
+
+# --- the command line: a killed sweep, then Ctrl-C, then resumed ------------------------------------
+CLI = ["--no-progress", "sweep", "--speeds", "600:900:12", "--revolutions", "60", "--transient-revolutions", "20"]
+CHILD = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+         "from camdyn.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def _start(args: list[str]) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-c", CHILD, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+
+
+def _when_chunks(chunks: Path, n: int, proc: subprocess.Popen, timeout: float = 120.0) -> None:
+    start = time.monotonic()
+    while len(list(chunks.glob("*.nc"))) < n:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - start < timeout, "the sweep made no progress"
+        time.sleep(0.01)
+
+
+def test_cli_sweep_killed_then_interrupted_then_resumed_equals_the_uninterrupted_one(tmp_path, capsys):
+    out = tmp_path / "bif.nc"
+    chunks = tmp_path / "bif.nc.parts" / "chunks"
+    proc = _start(CLI + ["--out", str(out)])
+    _when_chunks(chunks, 4, proc)
+    proc.send_signal(signal.SIGKILL)  # a crash: no chance to clean up
+    proc.communicate()
+    crashed = len(list(chunks.glob("*.nc")))
+    assert 4 <= crashed < 12 and not out.exists()
+    proc = _start(["--no-progress", "sweep", "--resume", str(out)])
+    _when_chunks(chunks, crashed + 2, proc)
+    proc.send_signal(signal.SIGINT)  # Ctrl-C
+    _, err = proc.communicate()
+    assert proc.returncode == 130 and f"'camdyn sweep --resume {out}' runs the rest" in err
+    assert crashed + 2 <= len(list(chunks.glob("*.nc"))) < 12
+    assert main(["--no-progress", "sweep", "--resume", str(out)]) == 0
+    reference = S.bifurcation(RIG, camdyn.Scene(), np.linspace(600, 900, 12), revolutions=60, transient_revolutions=20,
+                              method="DOP853", rtol=1e-8, atol=1e-12, progress=False)
+    with xr.open_dataset(out, engine="scipy") as back:
+        xr.testing.assert_identical(back.load(), reference)
+    assert not chunks.parent.exists()
+    capsys.readouterr()
+    assert main(["--no-progress", "sweep", "--resume", str(out)]) == 0  # again: nothing left to run
+    assert "was complete: nothing to run" in capsys.readouterr().out
+
+
+def test_cli_lists_invalid_points_or_skips_them(tmp_path, capsys):
+    args = ["sweep", "--speeds", "900,1e6", "--param", "e", "--values", f"0.001,{1.5 * RIG.r_c}", "--revolutions", "2",
+            "--transient-revolutions", "1", "--samples-per-revolution", "16"]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "speed_rpm=1e+06 (every e): speed_rpm = 1000000.0 is out of range" in err and "e=0.0375 (every" in err
+    assert "3 of 4 grid points are invalid (listed above); --skip-invalid runs the others" in err
+    assert not list(tmp_path.iterdir())
+    assert main(args + ["--skip-invalid", "--out", str(tmp_path / "e.nc")]) == 3  # some points did not succeed
+    assert "3 INVALID" in capsys.readouterr().out
+    with xr.open_dataset(tmp_path / "e.nc", engine="scipy") as ds:
+        assert int((ds["outcome"] == 0).sum()) == 1
+    assert main(["sweep", "--resume", str(tmp_path / "e.nc"), "--speeds", "1"]) == 2
+    assert os.listdir(tmp_path) == ["e.nc"]

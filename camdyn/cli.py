@@ -28,11 +28,13 @@ import inspect
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 from .errors import CamdynError
 
@@ -117,9 +119,30 @@ def _parse_values(text: str, name: str) -> list[float]:
 
 
 def _rig(args):
-    from .presets import load_rig
+    """The rig of --rig: a shipped preset's name or a .toml file."""
+    from .errors import ParameterError
+    from .presets import available, load_rig
 
-    return load_rig(args.rig)
+    try:
+        return load_rig(args.rig)
+    except ParameterError as exc:  # not a preset and not a .toml path
+        if exc.name != "name":
+            raise
+        import difflib
+
+        close = difflib.get_close_matches(args.rig, available(), n=1)
+        raise UsageError(f"--rig {args.rig}: no shipped rig of that name"
+                         + (f" (did you mean {close[0]!r}?)" if close else "")
+                         + f"; shipped rigs: {', '.join(available())}, or a rig file ending in .toml") from None
+
+
+def _rig_source(name: str) -> str:
+    """Where the rig of --rig came from, for the saved run's attributes."""
+    from .presets import available
+
+    if name in available():
+        return f"camdyn preset {name!r} (camdyn {_version()})"
+    return str(Path(name).resolve())
 
 
 def _cam(args):
@@ -140,27 +163,64 @@ def _scene(args, motion: str = "constant"):
     return Scene(contact=getattr(args, "contact", "line"), damping=args.damping, friction=args.friction,
                  motion=motion, model=getattr(args, "model", "nonlinear"),
                  sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
-                 damping_sign=getattr(args, "damping_sign", "dissipative"))
+                 damping_sign=getattr(args, "damping_sign", "dissipative"),
+                 damping_switch=getattr(args, "damping_switch", "episode"))
+
+
+# --- solvers: the one place the command learns the engine's backend and method names -----------
+def _solvers() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(backends, methods) of the engine: every backend runs every method (one loop)."""
+    from .engine.config import BACKENDS, METHODS
+
+    return BACKENDS, METHODS
+
+
+def _default_backend() -> str | None:
+    """The backend simulate() uses when not told (its keyword's default)."""
+    from .simulation import simulate
+
+    param = inspect.signature(simulate).parameters.get("backend")
+    return None if param is None or param.default is inspect.Parameter.empty else param.default
+
+
+class _Lazy:
+    """A sequence (argparse choices) or text (help) computed on first use: the engine's names need
+    the engine's import, which a command that does not simulate should not pay for."""
+
+    def __init__(self, load):
+        self._load, self._value = load, None
+
+    def _get(self):
+        if self._value is None:
+            self._value = self._load()
+        return self._value
+
+    def __contains__(self, item):
+        return item in self._get()
+
+    def __iter__(self):
+        return iter(self._get())
+
+    def __str__(self):
+        return str(self._get())
 
 
 def _backend_kwargs(args) -> dict:
-    """``backend=`` for simulate() when asked for and supported by this camdyn."""
+    """``backend=`` for simulate() when asked for on the command line."""
     backend = getattr(args, "backend", None)
-    if backend is None:
-        return {}
-    from .simulation import simulate
-
-    params = inspect.signature(simulate).parameters
-    if "backend" not in params and not any(p.kind is p.VAR_KEYWORD for p in params.values()):
-        if backend == "scipy":
-            return {}
-        raise MissingPart(f"backend {backend!r} is not available in this version of camdyn "
-                          "(only the SciPy backend is)")
-    return {"backend": backend}
+    return {} if backend is None else {"backend": backend}
 
 
-def _simulate(args):
-    """One run from the command-line options (cam, scene, run length, solver)."""
+class _Run(NamedTuple):
+    result: object
+    rig: object
+    settings: dict
+
+
+def _simulate(args) -> _Run:
+    """One run from the command-line options (cam, scene, run length, solver), with the rig and
+    the settings that made it (for the saved run's attributes)."""
+    from .metadata import describe_cam, describe_scene
     from .simulation import simulate
 
     cam = _cam(args)
@@ -169,11 +229,16 @@ def _simulate(args):
                   **_backend_kwargs(args))
     if args.t_end is not None:
         kwargs["t_end"] = args.t_end
+    elif not math.isfinite(cam.period):
+        raise UsageError(f"--speed-rpm {args.speed_rpm:g} holds the cam still: with no cam period, the run "
+                         "length cannot be counted in --revolutions; give it in seconds with --t-end SECONDS")
     else:
         kwargs["revolutions"] = args.revolutions
     rig = _rig(args)
-    with _busy(f"simulating {scene.slug}", args):
-        return simulate(rig, scene, cam, **kwargs)
+    with _busy(f"simulating {describe_scene(scene)}, {describe_cam(cam)}", args):
+        result = simulate(rig, scene, cam, **kwargs)
+    settings = {"backend": _default_backend(), **kwargs}
+    return _Run(result, rig, settings)
 
 
 def _plot_modules():
@@ -196,6 +261,63 @@ def _save_figure(fig, path: str) -> None:
     print(f"  wrote {path}")
 
 
+# --- file options: their kind is checked while the command line is read, before any work -------
+_KINDS = {"csv": "a CSV file", "netcdf": "a NetCDF file", "plot": "a figure", "run": "a saved run"}
+
+
+def _plot_formats() -> dict[str, str]:
+    _plot_modules()
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return FigureCanvasBase.get_supported_filetypes()
+
+
+def _file_of_kind(kind: str, flag: str, value: str) -> str:
+    """``value`` checked for ``kind`` (csv, netcdf, plot, run): the path to use (a missing ending
+    gets the default one), or UsageError naming ``flag``."""
+    from .files import SUFFIXES, FileFormatError, check_suffix
+
+    if kind == "plot":
+        formats = _plot_formats()
+        suffix = Path(value).suffix.lower()
+        if not suffix:
+            return value + ".png"
+        if suffix[1:] not in formats:
+            raise UsageError(f"{flag} {value}: matplotlib cannot write {suffix} figures; use one of "
+                             f"{', '.join('.' + f for f in sorted(formats))}")
+        return value
+    if kind == "run":
+        suffix = Path(value).suffix.lower()
+        if suffix not in SUFFIXES["csv"] + SUFFIXES["netcdf"]:
+            raise UsageError(f"{flag} {value}: a saved run is a .csv or .nc file written by 'camdyn simulate'")
+        return value
+    try:
+        return check_suffix(value, kind)
+    except FileFormatError as exc:
+        raise UsageError(f"{flag} {exc}") from None
+
+
+class _FileOption(argparse.Action):
+    """An option naming a file of one kind; checks the kind and records which flag gave it
+    (``args.flags[dest]``), so that later messages name the flag the user typed."""
+
+    def __init__(self, option_strings, dest, kind: str, deprecated_for: str | None = None, **kwargs):
+        self.kind, self.deprecated_for = kind, deprecated_for
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, value, option_string=None):
+        if self.deprecated_for:
+            print(f"camdyn: {option_string} is deprecated here; use {self.deprecated_for}", file=sys.stderr)
+        setattr(namespace, self.dest, _file_of_kind(self.kind, option_string, value))
+        flags = dict(getattr(namespace, "flags", None) or {})
+        flags[self.dest] = option_string
+        namespace.flags = flags
+
+
+def _flag(args, name: str) -> str:
+    return (getattr(args, "flags", None) or {}).get(name, "--" + name.replace("_", "-"))
+
+
 def _check_outputs(args, *names: str) -> None:
     """Fail before a long run, not after it: output folders must exist, plots need matplotlib."""
     for name in names:
@@ -204,55 +326,11 @@ def _check_outputs(args, *names: str) -> None:
             continue
         folder = Path(path).resolve().parent
         if not folder.is_dir():
-            raise UsageError(f"--{name.replace('_', '-')} {path}: folder {folder} does not exist")
+            raise UsageError(f"{_flag(args, name)} {path}: folder {folder} does not exist")
         if not os.access(folder, os.W_OK):
-            raise UsageError(f"--{name.replace('_', '-')} {path}: folder {folder} is not writable")
+            raise UsageError(f"{_flag(args, name)} {path}: folder {folder} is not writable")
     if getattr(args, "plot", None):
         _plot_modules()
-
-
-def _columns(result) -> list[str]:
-    return ["t", "alpha", "alpha_dot", "Theta", "alpha_r"] + list(result.outputs)
-
-
-def write_csv(result, path: str) -> None:
-    """Time histories as CSV: one column per quantity (SI units) and the regime name."""
-    columns = _columns(result)
-    data = [getattr(result, c) for c in columns]
-    with open(path, "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(columns + ["regime"])
-        for i in range(result.t.size):
-            writer.writerow([repr(float(col[i])) for col in data] + [result.regime[i]])
-
-
-def _units():
-    from .plots import QUANTITIES
-
-    return {name: unit for name, (_, unit) in QUANTITIES.items()}
-
-
-def write_netcdf(result, path: str, attrs: dict | None = None) -> None:
-    """Time histories as NetCDF (netCDF3 through SciPy), with units, the regime as
-    integer codes (``flag_values``/``flag_meanings``) and the impact times."""
-    import numpy as np
-    import xarray as xr
-
-    units = _units()
-    regimes = sorted(set(result.regime.tolist()))
-    codes = np.array([regimes.index(r) for r in result.regime], dtype=np.int8)
-    data = {c: ("t", np.asarray(getattr(result, c), dtype=float), {"units": units.get(c, "")})
-            for c in _columns(result) if c != "t"}
-    data["regime"] = ("t", codes, {"flag_values": np.arange(len(regimes), dtype=np.int8),
-                                   "flag_meanings": " ".join(regimes)})
-    data["impact_t"] = ("impact", np.asarray(result.impacts(), dtype=float), {"units": "s"})
-    cam = result.meta.get("cam")
-    meta = {"scene": result.scene, "rig": str(result.meta.get("rig")), "outcome": result.outcome.name,
-            "period_s": float(result.period) if math.isfinite(result.period) else -1.0,
-            "alpha_star_rad": float(result.alpha_star), "cam": repr(cam),
-            "source": "camdyn " + _version(), **(attrs or {})}
-    ds = xr.Dataset(data, coords={"t": ("t", np.asarray(result.t, dtype=float), {"units": "s"})}, attrs=meta)
-    ds.to_netcdf(path, engine="scipy")
 
 
 def _version() -> str:
@@ -264,9 +342,11 @@ def _version() -> str:
 # --------------------------------------------------------------------------- commands
 def cmd_simulate(args) -> int:
     from .analysis import residual_stats
+    from .files import write_csv, write_netcdf
 
     _check_outputs(args, "csv", "netcdf", "plot")
-    result = _simulate(args)
+    run = _simulate(args)
+    result = run.result
     print(result.summary())
     if result.t.size > 1 and math.isfinite(result.period):
         transient = min(args.transient_revolutions, max(0.0, (result.t[-1] - result.t[0]) / result.period - 1e-9))
@@ -277,7 +357,8 @@ def cmd_simulate(args) -> int:
         write_csv(result, args.csv)
         print(f"  wrote {args.csv}")
     if args.netcdf:
-        write_netcdf(result, args.netcdf, {"command": " ".join(["camdyn"] + (args.argv or []))})
+        write_netcdf(result, args.netcdf, run.rig, rig_source=_rig_source(args.rig), settings=run.settings,
+                     attrs={"command": " ".join(["camdyn"] + (args.argv or []))})
         print(f"  wrote {args.netcdf}")
     if args.plot:
         plots = _plot_modules()
@@ -286,40 +367,6 @@ def cmd_simulate(args) -> int:
         print(f"camdyn: the run stopped early: {result.outcome.message}", file=sys.stderr)
         return EXIT_INCOMPLETE
     return EXIT_OK
-
-
-def _read_series(path: str, quantity: str):
-    """(t, values, period) from a file written by ``camdyn simulate --csv/--netcdf``."""
-    import numpy as np
-
-    p = Path(path)
-    if not p.exists():
-        raise UsageError(f"{path}: no such file")
-    if p.suffix in (".nc", ".netcdf", ".cdf"):
-        import xarray as xr
-
-        with xr.open_dataset(p, engine="scipy") as ds:
-            if quantity not in ds and quantity != "t":
-                raise UsageError(f"{path}: no variable {quantity!r} (has {', '.join(map(str, ds.data_vars))})")
-            t, x = ds["t"].values.astype(float), ds[quantity].values.astype(float)
-            period = float(ds.attrs.get("period_s", -1.0))
-            theta = ds["Theta"].values.astype(float) if "Theta" in ds else None
-    else:
-        with open(p, newline="") as fh:
-            header = next(csv.reader(fh), None)
-        if not header or "t" not in header or quantity not in header:
-            raise UsageError(f"{path}: a CSV from 'camdyn simulate --csv' with columns t and {quantity} is needed")
-        table = np.genfromtxt(p, delimiter=",", skip_header=1, usecols=[header.index(c) for c in
-                                                                          ("t", quantity, "Theta")
-                                                                          if c in header])
-        t, x = table[:, 0], table[:, 1]
-        theta = table[:, 2] if table.shape[1] > 2 else None
-        period = -1.0
-    if not period > 0 and theta is not None and t.size > 1:  # constant speed: Theta is linear in t
-        rate = (theta[-1] - theta[0]) / (t[-1] - t[0])
-        if rate != 0 and np.allclose(theta, theta[0] + rate * (t - t[0]), rtol=0, atol=1e-9 * max(1, abs(theta).max())):
-            period = abs(2 * math.pi / rate)
-    return t, x, (period if period > 0 else math.inf)
 
 
 class _Series:
@@ -345,15 +392,18 @@ def cmd_spectrum(args) -> int:
     import numpy as np
 
     from . import signal
+    from .metadata import units
 
     _check_outputs(args, "csv", "plot")
     natural = None
     status = EXIT_OK
     if args.input:
-        t, x, period = _read_series(args.input, args.quantity)
+        from .files import read_series
+
+        t, x, period = read_series(args.input, args.quantity)
         source = _Series(t, period, **{args.quantity: x})
     else:
-        result = _simulate(args)
+        result = _simulate(args).result
         print(result.summary())
         if not result.ok:
             print(f"camdyn: the run stopped early: {result.outcome.message}", file=sys.stderr)
@@ -367,23 +417,20 @@ def cmd_spectrum(args) -> int:
                 natural = natural_frequency(_rig(args), _scene(args), ConstantSpeed(args.speed_rpm)).Hz
             except CamdynError:
                 natural = None
-    transient = args.transient_revolutions
+    transient = args.transient_revolutions if math.isfinite(period) else 0.0
     t = np.asarray(source.t, dtype=float)
-    if transient and math.isfinite(period):
-        if transient * period >= t[-1] - t[0]:
-            raise UsageError(f"--transient-revolutions {transient:g} drops the whole run "
-                             f"({(t[-1] - t[0]) / period:.3g} revolutions)")
-        source = source.after(t[0] + transient * period)
-    from .plots import whole_period_samples
-
-    keep = whole_period_samples(source.t, period)  # harmonics of the cam on frequency bins
+    if transient and transient * period >= t[-1] - t[0]:
+        raise UsageError(f"--transient-revolutions {transient:g} drops the whole run "
+                         f"({(t[-1] - t[0]) / period:.3g} revolutions)")
+    keep = signal.whole_periods(t, period, transient)  # after the transient; cam harmonics on bins
     values = np.asarray(getattr(source, args.quantity), dtype=float)[keep]
-    times = np.asarray(source.t, dtype=float)[keep]
+    times = t[keep]
+    source = source.after(times[0])  # the plot takes the same whole periods from here
     f, amp = signal.spectrum(times, values)
     periods = values.size * (times[1] - times[0]) / period if math.isfinite(period) else math.nan
     f0 = 1 / period if math.isfinite(period) else math.nan
     print(f"spectrum of {args.quantity}: {values.size} samples"
-          + (f" ({periods:.4g} cam periods)" if math.isfinite(periods) else "")
+          + (f" ({round(periods)} cam periods, to the nearest sample)" if math.isfinite(periods) else "")
           + f", resolution {f[1] - f[0]:.4g} Hz, "
           f"up to {f[-1]:.6g} Hz" + (f"; cam frequency Omega_c = {f0:.6g} Hz" if math.isfinite(f0) else ""))
     if natural:
@@ -393,7 +440,7 @@ def cmd_spectrum(args) -> int:
     peaks = np.flatnonzero((amp[1:-1] > amp[:-2]) & (amp[1:-1] >= amp[2:])) + 1
     peaks = peaks[band[peaks]]
     peaks = peaks[np.argsort(amp[peaks])[::-1][:args.peaks]]
-    unit = _units().get(args.quantity, "")
+    unit = units(args.quantity)
     for k in sorted(peaks, key=lambda i: f[i]):
         fk = signal.peak_frequency(f, amp, fmin=f[k], fmax=f[k])  # bin k, refined with its neighbours
         order = f"  = {fk / f0:.3f} x Omega_c" if math.isfinite(f0) else ""
@@ -401,7 +448,7 @@ def cmd_spectrum(args) -> int:
     if args.csv:
         with open(args.csv, "w", newline="") as fh:
             writer = csv.writer(fh)
-            writer.writerow(["f_Hz", f"amplitude_{args.quantity}_{unit}".rstrip("_")])
+            writer.writerow(["f (Hz)", f"amplitude of {args.quantity}" + (f" ({unit})" if unit else "")])
             for fi, ai in zip(f, amp):
                 writer.writerow([repr(float(fi)), repr(float(ai))])
         print(f"  wrote {args.csv}")
@@ -436,7 +483,7 @@ def cmd_contact_loss(args) -> int:
     if args.k_s:
         values = _parse_values(args.k_s, "--k-s")
         rows = [(k, contact_loss_speed(rig.replace(k_s=k))) for k in values]
-        print("k_s_N_per_m,contact_loss_rpm")
+        print("k_s (N/m),contact_loss_speed (rev/min)")
         for k, v in rows:
             print(f"{k:.6g},{v:.6g}")
     else:
@@ -480,8 +527,11 @@ def _outcome_names(ds) -> dict[int, str]:
 
 
 def cmd_sweep(args) -> int:
-    import numpy as np
-
+    sweeps = _sweep_module()
+    if args.resume:
+        return _resume_sweep(sweeps, args)
+    if not args.speeds:
+        raise UsageError("give --speeds (a new sweep) or --resume FILE (continue one)")
     rig, scene = _rig(args), _scene(args)
     speeds = _parse_values(args.speeds, "--speeds")
     param = args.param
@@ -501,60 +551,114 @@ def cmd_sweep(args) -> int:
     if args.samples_per_revolution < 1:
         raise UsageError("--samples-per-revolution must be at least 1")
     _check_outputs(args, "out", "plot")
-    sweeps = _sweep_module()
     solver = dict(method=args.method, rtol=args.rtol, atol=args.atol)
     if args.backend:
         solver["backend"] = args.backend
-    progress = not args.no_progress and sys.stderr.isatty()
-    with _executor(args) as executor:
-        common = dict(executor=executor, progress=progress, **solver)
-        if not param:
-            revolutions, transient = args.revolutions, args.transient_revolutions
-            if revolutions != int(revolutions) or transient != int(transient):
-                raise UsageError("a bifurcation sweep needs whole --revolutions and --transient-revolutions")
-            ds = sweeps.bifurcation(rig, scene, speeds, revolutions=int(revolutions),
-                                    transient_revolutions=int(transient), **common)
-        elif param == "k_s":
-            ds = sweeps.contact_loss_map(rig, scene, values, speeds, revolutions=args.revolutions,
-                                         transient_revolutions=args.transient_revolutions,
-                                         samples_per_revolution=args.samples_per_revolution, **common)
-        else:
-            ds = sweeps.sweep(rig, scene, {param: values, "speed_rpm": speeds},
-                              sweeps.Summary(args.transient_revolutions), revolutions=args.revolutions,
-                              samples_per_revolution=args.samples_per_revolution, **common)
+    with _executor(args) as executor, _sweep_interrupted(args.out):
+        common = dict(executor=executor, progress=_sweep_progress(args), out=args.out,
+                      invalid="skip" if args.skip_invalid else "raise", **solver)
+        try:
+            ds = _new_sweep(sweeps, args, rig, scene, speeds, values, common)
+        except sweeps.InvalidGridError as exc:
+            print(str(exc).split("\n", 1)[1], file=sys.stderr)  # every invalid point, one a line
+            raise UsageError(f"{len(exc.invalid)} of {exc.size} grid points are invalid (listed above); "
+                             "--skip-invalid runs the others") from None
+    if args.out:
+        print(f"  wrote {args.out}")
+    return _sweep_report(ds, args, sweeps)
+
+
+def _resume_sweep(sweeps, args) -> int:
+    if args.speeds or args.param or args.values or args.out:
+        raise UsageError("--resume FILE takes the grid, rig, scene and settings from FILE's sweep; "
+                         "give only --jobs, --dask, --plot")
+    _check_outputs(args, "plot")
+    running = Path(args.resume + ".parts").exists()
+    with _executor(args) as executor, _sweep_interrupted(args.resume):
+        ds = sweeps.resume(args.resume, executor=executor, progress=_sweep_progress(args))
+    print(f"  wrote {args.resume}" if running else f"  {args.resume} was complete: nothing to run")
+    return _sweep_report(ds, args, sweeps)
+
+
+def _new_sweep(sweeps, args, rig, scene, speeds, values, common):
+    """The sweep the options ask for: bifurcation (--speeds only), contact map (--param k_s), or
+    the same map over another rig parameter."""
+    param = args.param
+    if not param:
+        revolutions, transient = args.revolutions, args.transient_revolutions
+        if revolutions != int(revolutions) or transient != int(transient):
+            raise UsageError("a bifurcation sweep needs whole --revolutions and --transient-revolutions")
+        return sweeps.bifurcation(rig, scene, speeds, revolutions=int(revolutions),
+                                  transient_revolutions=int(transient), **common)
+    if param == "k_s":
+        return sweeps.contact_loss_map(rig, scene, values, speeds, revolutions=args.revolutions,
+                                       transient_revolutions=args.transient_revolutions,
+                                       samples_per_revolution=args.samples_per_revolution, **common)
+    return sweeps.sweep(rig, scene, {param: values, "speed_rpm": speeds}, sweeps.Summary(args.transient_revolutions),
+                        revolutions=args.revolutions, samples_per_revolution=args.samples_per_revolution, **common)
+
+
+def _sweep_progress(args) -> bool:
+    return not args.no_progress and sys.stderr.isatty()
+
+
+@contextlib.contextmanager
+def _sweep_interrupted(out):
+    """On Ctrl-C, say where the finished points are and how to go on."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        if out:
+            print(f"camdyn: the finished points are kept in {out}.parts; 'camdyn sweep --resume {out}' runs the rest",
+                  file=sys.stderr)
+        raise
+
+
+def _sweep_report(ds, args, sweeps) -> int:
+    """Print what the sweep found, plot it; exit 3 if any point did not succeed."""
+    import numpy as np
+
+    rig, scene = sweeps.rig_of(ds.attrs), sweeps.scene_of(ds.attrs)
     names = _outcome_names(ds)
     success = next((c for c, n in names.items() if n == "SUCCESS"), 0)
     ok = ds["outcome"].values == success
-    impacting = np.nan_to_num(ds["impacts_per_rev"].values) > 0
+    impacts = ds["impacts_per_rev"].values if "impacts_per_rev" in ds else np.zeros(ok.shape)  # an API sweep's measure
+    impacting = np.nan_to_num(impacts) > 0
     regimes = np.where(ok, impacting.astype(int), 2)
     failed = int(np.sum(~ok))
     print(f"sweep of {scene.slug} on rig {rig.name!r}: {regimes.size} runs, "
           f"{int(np.sum(regimes == 0))} without impacts after the transient, {int(np.sum(regimes == 1))} impacting, "
-          f"{failed} stopped early")
+          f"{failed} did not succeed")
     for code in sorted(set(ds["outcome"].values.ravel().tolist()) - {success}):
-        print(f"  {int(np.sum(ds['outcome'].values == code))} stopped with {names.get(int(code), code)}")
-    if args.out:
-        ds.to_netcdf(args.out, engine="scipy")
-        print(f"  wrote {args.out}")
+        print(f"  {int(np.sum(ds['outcome'].values == code))} {names.get(int(code), code)}")
     if args.plot:
-        plots = _plot_modules()
-        title = f"{scene.slug}, rig {rig.name}"
-        if param:
-            regimes_2d = regimes.reshape(len(values), len(speeds))
-            loss = None
-            if "loss_speed_predicted" in ds:
-                loss = (ds["loss_speed_predicted"].values, ds["k_s"].values)
-            fig = plots.contact_map(speeds, values, regimes_2d, loss_curve=loss, log_k=param == "k_s", title=title)
-            if param != "k_s":
-                fig.axes[0].set_ylabel(param)
-        else:
-            from .analysis import static_equilibrium
-
-            alpha_star = static_equilibrium(rig, scene.contact).alpha
-            fig = plots.bifurcation(speeds, ds["alpha_section"].values, relative_to=alpha_star,
-                                    title=f"{title}: revolutions {args.transient_revolutions:g}-{args.revolutions:g}")
-        _save_figure(fig, args.plot)
+        if "alpha_section" not in ds and (ds["outcome"].ndim != 2 or "speed_rpm" not in ds.dims):
+            raise UsageError("--plot draws a bifurcation sweep or a (parameter, speed_rpm) map, not this sweep")
+        _save_figure(_sweep_plot(ds, rig, scene, regimes), args.plot)
     return EXIT_INCOMPLETE if failed else EXIT_OK
+
+
+def _sweep_plot(ds, rig, scene, regimes):
+    from .metadata import describe_scene
+
+    plots = _plot_modules()
+    title = f"{describe_scene(scene)}, rig {rig.name}"
+    speeds = ds["speed_rpm"].values
+    if "alpha_section" not in ds:
+        param = next(name for name in ds.attrs["grid"].split() if name != "speed_rpm")
+        values = ds[param].values
+        loss = (ds["loss_speed_predicted"].values, ds["k_s"].values) if "loss_speed_predicted" in ds else None
+        fig = plots.contact_map(speeds, values, regimes.reshape(len(values), len(speeds)), loss_curve=loss,
+                                log_k=param == "k_s", title=title)
+        if param != "k_s":
+            fig.axes[0].set_ylabel(param)
+        return fig
+    from .analysis import contact_loss_speed, static_equilibrium
+
+    alpha_star = static_equilibrium(rig, scene.contact).alpha
+    span = f"{ds.attrs.get('measure_transient_revolutions', 0):g}-{ds.attrs.get('simulate_revolutions', 0):g}"
+    return plots.bifurcation(speeds, ds["alpha_section"].values, relative_to=alpha_star,
+                             contact_loss_rpm=contact_loss_speed(rig), title=f"{title}: revolutions {span}")
 
 
 # --- regenerate ----------------------------------------------------------------------
@@ -693,9 +797,9 @@ def cmd_scenes(args) -> int:
 
     if args.json:
         print(json.dumps({"scenes": sorted(generated.SCENES), "rigs": presets.available(),
-                          "options": {k: list(v) for k, v in generated.OPTIONS.items()}}, indent=2))
+                          "options": {k: list(v) for k, v in _options().items()}}, indent=2))
         return EXIT_OK
-    print("generated scenes (contact_damping_friction_motion_model[_vrprinted][_printedsign]):")
+    print("generated scenes (contact_damping_friction_motion_model[_vrprinted][_printedsign][_memoryless]):")
     for slug in sorted(generated.SCENES):
         print(f"  {slug}")
     print("shipped rigs: " + ", ".join(presets.available()) + "  (or a path to a .toml rig file)")
@@ -704,19 +808,94 @@ def cmd_scenes(args) -> int:
 
 # --------------------------------------------------------------------------- parser
 class _Parser(argparse.ArgumentParser):
-    """argparse that raises UsageError (one line, exit 2) instead of printing usage and exiting."""
+    """argparse that raises UsageError (one line, exit 2) instead of printing usage and exiting;
+    misspelled options and values get a suggestion, and the help pointed at is the command's."""
+
+    commands: dict | None = None  # command name -> its parser (set on the top-level parser)
 
     def error(self, message):
-        raise UsageError(f"{message} (see '{self.prog} --help')")
+        raise UsageError(f"{message}{_suggest_choice(message)} (see '{self.prog} --help')")
+
+    def parse_args(self, args=None, namespace=None):
+        args = _values_with_a_minus(list(sys.argv[1:] if args is None else args), self)
+        namespace, extras = self.parse_known_args(args, namespace)
+        if extras:
+            parser = (self.commands or {}).get(getattr(namespace, "command", None), self)
+            raise UsageError(f"{_unrecognized(extras, parser)} (see '{parser.prog} --help')")
+        return namespace
 
 
-_FORMATTER = argparse.RawDescriptionHelpFormatter
+def _option_strings(parser, single_value: bool = False) -> list[str]:
+    """The option strings of a parser (with single_value: only those taking exactly one value)."""
+    return [o for a in parser._actions for o in a.option_strings if not single_value or a.nargs is None]
+
+
+def _unrecognized(extras: list[str], parser) -> str:
+    """'unrecognized option --x (did you mean --y?)' for the first stray word of the command line."""
+    import difflib
+
+    word = extras[0]
+    if not word.startswith("-"):
+        return f"unexpected argument {word!r}"
+    name = word.split("=", 1)[0]
+    close = difflib.get_close_matches(name, _option_strings(parser), n=1, cutoff=0.6)
+    return f"unrecognized option {name}" + (f" (did you mean {close[0]}?)" if close else "")
+
+
+def _suggest_choice(message: str) -> str:
+    """' (did you mean 'D'?)' for argparse's "invalid choice: 'd' (choose from ...)"."""
+    import difflib
+    import re
+
+    m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+    if not m:
+        return ""
+    choices = re.findall(r"'([^']*)'", m.group(2))
+    close = [c for c in choices if c.lower() == m.group(1).lower()] or difflib.get_close_matches(m.group(1), choices, n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+_MINUS_VALUE = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+
+
+def _values_with_a_minus(argv: list[str], parser) -> list[str]:
+    """``--k-s -500:8000:5`` as ``--k-s=-500:8000:5``: argparse takes a word starting with '-'
+    for an option unless it is a plain number; here a value that starts with a minus sign and a
+    digit (a range, -inf) follows an option that takes one value, so it is that value."""
+    options = set(_option_strings(parser, single_value=True))
+    for sub in (parser.commands or {}).values():
+        options.update(_option_strings(sub, single_value=True))
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        word = argv[i]
+        if word in options and i + 1 < len(argv) and _MINUS_VALUE.match(argv[i + 1]):
+            out.append(f"{word}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(word)
+        i += 1
+    return out
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help text with the engine's default backend filled in only when help is shown
+    (``{default_backend}``)."""
+
+    def _get_help_string(self, action):
+        text = super()._get_help_string(action)
+        if "{default_backend}" in text:
+            text = text.replace("{default_backend}", str(_default_backend()))
+        return text
+
+
+_FORMATTER = _Formatter
 
 
 def _options():
-    from . import generated
+    from .derive.vocabulary import OPTIONS
 
-    return generated.OPTIONS
+    return OPTIONS
 
 
 def _add_physics(p, contact: bool = True, full: bool = True):
@@ -736,6 +915,9 @@ def _add_physics(p, contact: bool = True, full: bool = True):
                        dest="sliding_velocity", help="v_r: derived, or as printed (misprint 8) (default: kinematic)")
         g.add_argument("--damping-sign", default="dissipative", choices=opts["damping_sign"], dest="damping_sign",
                        help="B/D coefficient: dissipative, or as printed (misprint 2) (default: dissipative)")
+        g.add_argument("--damping-switch", default="episode", choices=opts["damping_switch"], dest="damping_switch",
+                       help="D/E: the impact law once per contact, until maximum compression (episode, Sec. 3.4), "
+                            "or whenever the gap closes (memoryless) (default: episode)")
 
 
 def _add_cam(p, required_speed: bool = False):
@@ -758,15 +940,19 @@ def _add_run(p, revolutions: float = 3.0, sample_rate: float = 20_000.0):
     _add_solver(g)
 
 
-def _add_solver(g):
-    from .integrate import METHODS
-
-    g.add_argument("--method", default="DOP853", choices=sorted(METHODS),
-                   help="SciPy integration method (default: DOP853)")
+def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s (default: {default_backend}; "
+                                      "python: the same loop in Python, slow, for checking)"):
+    g.add_argument("--method", default="DOP853", metavar="METHOD", choices=_Lazy(lambda: _solvers()[1]),
+                   help="Runge-Kutta pair with dense output: %(choices)s (default: DOP853)")
     g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (default: 1e-8)")
     g.add_argument("--atol", type=float, default=1e-12, help="absolute tolerance (default: 1e-12)")
-    g.add_argument("--backend", choices=["scipy", "compiled"], default=None,
-                   help="integration backend (default: camdyn's default); 'compiled' where available")
+    g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
+                   help=backend_help)
+
+
+def _add_file(g, flag: str, kind: str, help_: str, *aliases: str, dest: str | None = None, **kw):
+    """An option naming a file of one kind (checked when read: see _FileOption)."""
+    g.add_argument(flag, *aliases, action=_FileOption, kind=kind, metavar="FILE", dest=dest, help=help_, **kw)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -780,6 +966,7 @@ def _parser() -> argparse.ArgumentParser:
                         help="never show progress bars (they show only on a terminal anyway)")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
     sub.required = True
+    parser.commands = sub.choices
 
     def command(name, help_, epilog, func, **kw):
         p = sub.add_parser(name, help=help_, description=help_[0].upper() + help_[1:] + ".",
@@ -799,9 +986,11 @@ def _parser() -> argparse.ArgumentParser:
     _add_cam(p)
     _add_run(p)
     g = p.add_argument_group("outputs")
-    g.add_argument("--csv", metavar="FILE", help="write the time histories to this CSV file")
-    g.add_argument("--netcdf", metavar="FILE", help="write the time histories to this NetCDF file (.nc)")
-    g.add_argument("--plot", metavar="FILE", help="save an overview figure (PNG, PDF or SVG by extension)")
+    _add_file(g, "--csv", "csv", "write the time histories to this CSV file (.csv; units in the headers)")
+    _add_file(g, "--netcdf", "netcdf", "write the time histories to this NetCDF file (.nc), with units and "
+                                       "everything needed to re-run it")
+    _add_file(g, "--plot", "plot", "save an overview figure (.png, .pdf, .svg...: by the file's ending; "
+                                   "none: .png)")
     g.add_argument("--transient-revolutions", type=float, default=0.0, dest="transient_revolutions",
                    metavar="N", help="revolutions left out of the alpha_r statistics (default: 0)")
 
@@ -816,7 +1005,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_cam(p)
     _add_run(p, revolutions=10.0, sample_rate=10_000.0)
     g = p.add_argument_group("spectrum")
-    g.add_argument("--input", metavar="FILE", help="a .csv or .nc written by 'camdyn simulate' (no simulation)")
+    _add_file(g, "--input", "run", "a .csv or .nc written by 'camdyn simulate' (no simulation)")
     g.add_argument("--quantity", default="alpha", help="time history to analyse (default: alpha; e.g. alpha_r, F_n)")
     g.add_argument("--transient-revolutions", type=float, default=1.0, dest="transient_revolutions", metavar="N",
                    help="revolutions dropped before the transform (default: 1)")
@@ -824,8 +1013,8 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--fmax", type=float, metavar="HZ", help="highest frequency listed and plotted")
     g.add_argument("--band", type=float, nargs=2, action="append", metavar=("LO", "HI"),
                    help="plot this band (Hz) in its own panel; repeat for more panels")
-    g.add_argument("--csv", metavar="FILE", help="write f_Hz and amplitude to this CSV file")
-    g.add_argument("--plot", metavar="FILE", help="save the spectrum figure")
+    _add_file(g, "--csv", "csv", "write the frequency (Hz) and amplitude to this CSV file")
+    _add_file(g, "--plot", "plot", "save the spectrum figure (.png, .pdf, .svg...)")
 
     p = command("equilibrium", "static equilibrium and linearized natural frequency (Eqs. 16-23), as JSON",
                 "example:\n  camdyn equilibrium --contact point --speed-rpm 300\n\n"
@@ -848,16 +1037,21 @@ def _parser() -> argparse.ArgumentParser:
                 "examples:\n"
                 "  camdyn sweep --speeds 600:1500:91 --revolutions 200 --transient-revolutions 50 --plot bif.png\n"
                 "  camdyn sweep --speeds 200:1600:29 --param k_s --values 200:20000:21:log --plot map.png\n"
-                "  camdyn sweep --speeds 900:1300:5 --param zeta_D --values 0.01,0.1 --out zeta.nc\n\n"
+                "  camdyn sweep --speeds 900:1300:5 --param zeta_D --values 0.01,0.1 --netcdf zeta.nc\n"
+                "  camdyn sweep --resume zeta.nc --jobs 2       # after Ctrl-C or a crash: only the missing points\n"
+                "  camdyn sweep --speeds -1500:-600:10 --revolutions 60 --plot clockwise.png\n\n"
                 "One run per point from the static equilibrium (camdyn.sweep; the compiled backend by\n"
                 "default). With --speeds only: the Poincare section of alpha (once per revolution, after\n"
                 "the transient) against speed. With --param k_s: the map of runs with and without impacts\n"
                 "over (speed, k_s) with the inverse-kinematics contact-loss curve (Fig. 9); any other rig\n"
-                "parameter gives the same map over that parameter. --out saves the labelled results as\n"
-                "NetCDF; --jobs or --dask run the points in parallel.", cmd_sweep)
+                "parameter gives the same map over that parameter. --netcdf saves the labelled results,\n"
+                "streaming the finished points to FILE.parts/ while it runs (--out: the same, deprecated);\n"
+                "--jobs or --dask run the points in parallel. Every point is checked first: invalid points\n"
+                "are listed and nothing runs, unless --skip-invalid. A point that fails is recorded\n"
+                "(outcome, message).", cmd_sweep)
     _add_physics(p)
     g = p.add_argument_group("sweep")
-    g.add_argument("--speeds", required=True, metavar="VALUES",
+    g.add_argument("--speeds", metavar="VALUES",
                    help="cam speeds in rev/min: 'start:stop:count[:log]' or 'v1,v2,...'")
     g.add_argument("--param", metavar="NAME", help="a rig parameter to vary as well (e.g. k_s, e, zeta_D)")
     g.add_argument("--values", metavar="VALUES", help="its values (SI), same syntax as --speeds")
@@ -869,8 +1063,12 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--jobs", type=int, default=1, help="local worker processes (default: 1)")
     g.add_argument("--dask", metavar="ADDRESS", help="run on this dask scheduler (tcp://host:port)")
     _add_solver(g)
-    g.add_argument("--out", metavar="FILE", help="save the sweep as NetCDF (.nc)")
-    g.add_argument("--plot", metavar="FILE", help="save the bifurcation diagram or contact map")
+    _add_file(g, "--netcdf", "netcdf", "save the sweep as NetCDF (.nc), streaming to FILE.parts/ meanwhile", dest="out")
+    _add_file(g, "--out", "netcdf", argparse.SUPPRESS, deprecated_for="--netcdf")
+    _add_file(g, "--resume", "netcdf", "continue the interrupted sweep whose --netcdf was FILE")
+    g.add_argument("--skip-invalid", action="store_true", dest="skip_invalid",
+                   help="record invalid grid points (outcome INVALID) and run the others")
+    _add_file(g, "--plot", "plot", "save the bifurcation diagram or contact map (.png, .pdf, .svg...)")
 
     p = command("regenerate", "regenerate the model code from derive/ (needs camdyn[derive])",
                 "examples:\n"
@@ -891,16 +1089,20 @@ def _parser() -> argparse.ArgumentParser:
                 "  camdyn reproduce numbers --json\n\n"
                 "Writes the study's figure (<out>/img/repro_<study>.png) and its section of\n"
                 "<out>/reproduction.md, the paper's statement beside camdyn's result (camdyn.studies;\n"
-                "the same as 'python -m camdyn.studies <study>'). <out> is the checkout's docs/ by default.",
+                "the same as 'python -m camdyn.studies <study>'). <out> is the checkout's docs/ when camdyn\n"
+                "runs from a source checkout (pip install -e .), else ./camdyn-reproduction in the current\n"
+                "folder; nothing is ever written inside the installed package.",
                 cmd_reproduce)
     p.add_argument("study", nargs="?", help="the study (see --list), or 'all'")
     p.add_argument("--list", action="store_true", help="list the studies")
     p.add_argument("--fast", action="store_true", help="reduced speeds and revolutions (also: CAMDYN_FAST=1)")
-    p.add_argument("--out", metavar="DIR", help="folder of reproduction.md and img/ (default: docs/)")
+    p.add_argument("--out", metavar="DIR", help="folder of reproduction.md and img/ (default: the checkout's "
+                                                "docs/, or ./camdyn-reproduction outside a checkout)")
     p.add_argument("--json", action="store_true", help="print the study's numbers as JSON on stdout")
     p.add_argument("--no-docs", action="store_true", dest="no_docs", help="do not update the report")
     p.add_argument("--data-dir", metavar="DIR", dest="data_dir",
-                   help="where 'reference-rig' writes the rig presets (default: camdyn/data)")
+                   help="where 'reference-rig' writes the rig presets (default: the checkout's camdyn/data, "
+                        "or <out>/rigs outside a checkout)")
 
     p = command("scenes", "list the generated scenes and the shipped rigs",
                 "example:\n  camdyn scenes --json", cmd_scenes)

@@ -23,8 +23,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["PAPER_STYLE", "QUANTITIES", "style", "time_history", "overview", "spectrum", "poincare_section",
-           "poincare", "bifurcation", "contact_map", "work_precision"]
+from .metadata import describe_cam, describe_scene
+from .metadata import units as _units
+
+__all__ = ["PAPER_STYLE", "QUANTITIES", "MIN_FONT_PT", "REGIME_CODES", "style", "run_title", "time_history",
+           "overview", "spectrum", "whole_period_samples", "poincare_section", "poincare", "bifurcation",
+           "contact_map", "work_precision"]
 
 #: rcParams of the paper-like look: thin lines, inward ticks on all sides, no frame on legends.
 PAPER_STYLE = {
@@ -44,30 +48,21 @@ PAPER_STYLE = {
     "xtick.top": True,
     "ytick.right": True,
     "legend.frameon": False,
-    "legend.fontsize": 8.5,
+    "legend.fontsize": 9,
 }
 
-#: Display name (matplotlib mathtext) and SI unit of each time history of a Result.
-QUANTITIES = {
-    "alpha": (r"\alpha", "rad"),
-    "alpha_dot": (r"\dot\alpha", "rad/s"),
-    "alpha_r": (r"\alpha_r", "rad"),
-    "alpha_i": (r"\alpha_i", "rad"),
-    "Theta": (r"\Theta", "rad"),
-    "psi_i": (r"\psi_i", "m"),
-    "psi_j": (r"\psi_j", "m"),
-    "psi_i_dot": (r"\dot\psi_i", "m/s"),
-    "F_s": (r"F_s", "N"),
-    "F_n": (r"F_n", "N"),
-    "F_f": (r"F_f", "N"),
-    "v_r": (r"v_r", "m/s"),
-    "N_x": (r"N_x", "N"),
-    "energy": (r"E", "J"),
-    "P_in": (r"P_{in}", "W"),
-    "D_c": (r"D_c", "W"),
-    "D_f": (r"D_f", "W"),
+_SYMBOLS = {
+    "alpha": r"\alpha", "alpha_dot": r"\dot\alpha", "alpha_r": r"\alpha_r", "alpha_i": r"\alpha_i",
+    "Theta": r"\Theta", "psi_i": r"\psi_i", "psi_j": r"\psi_j", "psi_i_dot": r"\dot\psi_i", "F_s": r"F_s",
+    "F_n": r"F_n", "F_f": r"F_f", "v_r": r"v_r", "N_x": r"N_x", "energy": r"E", "P_in": r"P_{in}",
+    "D_c": r"D_c", "D_f": r"D_f",
 }
+#: Display name (matplotlib mathtext) and SI unit (from :data:`camdyn.metadata.VARIABLES`) of
+#: each time history of a Result.
+QUANTITIES = {name: (symbol, _units(name)) for name, symbol in _SYMBOLS.items()}
 
+#: the smallest font (pt) of any text in a figure: legends and labels stay readable when saved
+MIN_FONT_PT = 8.5
 _PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
 _SCALABLE = {"rad", "m", "m/s", "N", "J", "W"}
 #: regime codes of contact_map, with their colours
@@ -88,7 +83,9 @@ def _pyplot():
 
 
 def style():
-    """A context manager with the paper-like look, for figures you build yourself::
+    """A context manager with the paper-like look, for figures you build yourself.
+
+    Example::
 
         with camdyn.plots.style():
             fig, axes = plt.subplots(1, 2)
@@ -215,16 +212,26 @@ def overview(result, *, quantities: Sequence[str] | None = None, title: str | No
             time_history(result, q, ax=ax, shade_free=True)
             if ax is not axes[-1]:
                 ax.set_xlabel("")
-        summary = f"{result.scene}, rig {result.meta.get('rig', '?')}"
-        cam = result.meta.get("cam")
-        if getattr(cam, "speed_rpm", None) is not None:
-            summary += f", {cam.speed_rpm:g} rev/min"
+        summary = run_title(result)
         axes[0].set_title(title or summary + ("" if result.ok else f" ({result.outcome.name})"))
         if _free_intervals(result):
             from matplotlib.patches import Patch
             fig.legend(handles=[Patch(color=_FREE_SHADE, label="free flight (no contact)")], loc="outside lower right",
-                       fontsize=7.5)
+                       fontsize=MIN_FONT_PT)
     return fig
+
+
+def run_title(result) -> str:
+    """The physics of a run in words, for a title: ``line contact, damping D, Coulomb friction,
+    1100 rev/min, rig example`` (empty for a series with no scene)."""
+    if not getattr(result, "scene", None):
+        return ""
+    meta = getattr(result, "meta", {}) or {}
+    words = [describe_scene(result.scene), describe_cam(meta.get("cam"))]
+    rig = meta.get("rig")
+    if rig is not None:
+        words.append(f"rig {getattr(rig, 'name', rig)}")
+    return ", ".join(w for w in words if w)
 
 
 def _fundamental_Hz(result) -> float:
@@ -235,42 +242,32 @@ def _fundamental_Hz(result) -> float:
 def spectrum(results, quantity: str = "alpha", *, bands: Sequence[tuple[float, float]] | None = None,
              fmax: float | None = None, harmonics: int | bool = True, mark_Hz: Mapping[str, float] | None = None,
              transient_revolutions: float = 0.0, whole_periods: bool = True, log: bool = True,
-             window: str = "hann", ax=None, title: str | None = None):
+             window: str = "hann", noise_floor: bool = True, ax=None, title: str | None = None):
     """One-sided amplitude spectrum of ``quantity`` with the harmonics of Omega_c marked (Figs. 10, 16).
 
     ``bands=[(f0, f1), ...]`` draws one panel per frequency band (Fig. 10: (a) the low
-    harmonics, (b) around the natural frequency); else one panel up to ``fmax``.
+    harmonics, (b) around the natural frequency); else one panel up to ``fmax``.  All panels
+    share one unit, chosen for the largest amplitude shown.
     ``harmonics``: mark k Omega_c (True: all in view, labelled while there is room; an int:
     the first n; False: none).  ``mark_Hz={"vartheta": 2182.0}`` marks other frequencies.
     ``transient_revolutions`` are dropped first; with ``whole_periods`` the record is then cut
     to a whole number of cam periods, so that the harmonics fall on frequency bins.  The
-    signal's mean is removed.
+    signal's mean is removed.  ``noise_floor`` draws the spectrum's median level
+    (:func:`camdyn.signal.noise_floor`): amplitudes near it are not lines.  The title
+    defaults to the run's physics (one run).
     """
     _pyplot()
-    from matplotlib.lines import Line2D
-
-    from . import signal
-
-    pairs = _labelled(results)
-    spectra = []
-    for label, r in pairs:
-        if transient_revolutions:
-            r = r.after(r.t[0] + transient_revolutions * r.period)
-        t, x = np.asarray(r.t, dtype=float), _values(r, quantity)
-        if whole_periods:
-            keep = whole_period_samples(t, r.period)
-            t, x = t[keep], x[keep]
-        f, amp = signal.spectrum(t, x, window=window)
-        spectra.append((label, f, amp, _fundamental_Hz(r)))
+    spectra = _spectra(_labelled(results), quantity, transient_revolutions, whole_periods, window)
     if bands is None:
         top = fmax if fmax is not None else max(f[-1] for _, f, _, _ in spectra)
         bands = [(0.0, top)]
     unit = QUANTITIES[quantity][1]
+    shown = [a[(f >= lo) & (f <= hi)] for lo, hi in bands for _, f, a, _ in spectra]
+    scale, unit_label = _prefix([max(float(np.max(a, initial=0.0)) for a in shown)], unit)
+    floor = _noise_floor(spectra[0][2]) if noise_floor else None
     with _style():
         fig, axes = _figure(ax, nrows=len(bands), figsize=(6.4, 2.6 * len(bands) + 0.3))
         for ax_, (lo, hi) in zip(axes, bands):
-            peak = max(float(np.max(a[(f >= lo) & (f <= hi)], initial=0.0)) for _, f, a, _ in spectra)
-            scale, unit_label = _prefix([peak], unit)
             for label, f, amp, _ in spectra:
                 keep = (f >= lo) & (f <= hi)
                 ax_.plot(f[keep], amp[keep] / scale, label=label)
@@ -278,48 +275,77 @@ def spectrum(results, quantity: str = "alpha", *, bands: Sequence[tuple[float, f
                 ax_.set_yscale("log")
             ax_.set_xlim(lo, hi)
             ax_.set(xlabel="frequency (Hz)", ylabel=f"|${QUANTITIES[quantity][0]}$| ({unit_label})")
-            f0 = spectra[0][3]
             handles = [h for h in ax_.get_lines() if not h.get_label().startswith("_")]
-            if harmonics and math.isfinite(f0):
-                ks = np.arange(max(1, math.ceil(lo / f0)), math.floor(hi / f0) + 1)
-                if harmonics is not True:
-                    ks = ks[ks <= int(harmonics)]
-                if 0 < ks.size <= _MAX_HARMONIC_LINES:
-                    for k in ks:
-                        ax_.axvline(k * f0, color="0.55", lw=0.6, ls=":", zorder=0)
-                        if ks.size <= 15:
-                            ax_.text(k * f0, 0.985, f"{k}", transform=ax_.get_xaxis_transform(), ha="center",
-                                     va="top", fontsize=6.5, color="0.35",
-                                     bbox=dict(fc="white", ec="none", pad=0.3, alpha=0.8))
-                    handles.append(Line2D([], [], color="0.55", lw=0.6, ls=":",
-                                          label=rf"$k\,\Omega_c$, $\Omega_c$ = {f0:.4g} Hz"
-                                          + (" (k on top)" if ks.size <= 15 else "")))
-                elif ks.size:
-                    handles.append(Line2D([], [], color="none",
-                                          label=rf"harmonics of $\Omega_c$ = {f0:.4g} Hz: too dense to mark here"))
+            handles += _mark_harmonics(ax_, spectra[0][3], lo, hi, harmonics)
             for name, fm in (mark_Hz or {}).items():
                 if lo <= fm <= hi:
                     handles.append(ax_.axvline(fm, color="#c0392b", lw=0.8, ls="--", zorder=0,
                                                label=f"{name} = {fm:.5g} Hz"))
+            if floor:
+                handles.append(ax_.axhline(floor / scale, color="0.45", lw=0.8, ls="-.", zorder=0,
+                                           label=f"noise floor (median level) = {floor / scale:.2g} {unit_label}"))
             if handles:
                 ax_.legend(handles=handles, loc="best")
-        if title:
-            axes[0].set_title(title)
+        heading = title if title is not None else (run_title(_labelled(results)[0][1]) if len(spectra) == 1 else "")
+        if heading:
+            axes[0].set_title(heading)
     return fig
 
 
+def _spectra(pairs, quantity: str, transient_revolutions: float, whole_periods: bool, window: str):
+    """(label, f, amplitude, fundamental) of each run, after the transient (whole periods)."""
+    from . import signal
+
+    out = []
+    for label, r in pairs:
+        t, x = np.asarray(r.t, dtype=float), _values(r, quantity)
+        if whole_periods:
+            keep = signal.whole_periods(t, r.period, transient_revolutions)
+        else:
+            dt = (t[-1] - t[0]) / max(t.size - 1, 1)
+            keep = t >= t[0] + transient_revolutions * r.period - dt / 2
+        f, amp = signal.spectrum(t[keep], x[keep], window=window)
+        out.append((label, f, amp, _fundamental_Hz(r)))
+    return out
+
+
+def _noise_floor(amplitude) -> float | None:
+    from . import signal
+
+    level = signal.noise_floor(amplitude)
+    return level if level > 0 else None
+
+
+def _mark_harmonics(ax, f0: float, lo: float, hi: float, harmonics) -> list:
+    """Dotted lines at k f0 in [lo, hi], numbered while there is room; their legend handle."""
+    from matplotlib.lines import Line2D
+
+    if not harmonics or not math.isfinite(f0):
+        return []
+    ks = np.arange(max(1, math.ceil(lo / f0)), math.floor(hi / f0) + 1)
+    if harmonics is not True:
+        ks = ks[ks <= int(harmonics)]
+    if ks.size > _MAX_HARMONIC_LINES:
+        return [Line2D([], [], color="none", label=rf"harmonics of $\Omega_c$ = {f0:.4g} Hz: too dense to mark here")]
+    if ks.size == 0:
+        return []
+    numbered = ks.size <= 15
+    for k in ks:
+        ax.axvline(k * f0, color="0.55", lw=0.6, ls=":", zorder=0)
+        if numbered:
+            ax.text(k * f0, 0.985, f"{k}", transform=ax.get_xaxis_transform(), ha="center", va="top",
+                    fontsize=MIN_FONT_PT, color="0.3", bbox=dict(fc="white", ec="none", pad=0.3, alpha=0.8))
+    return [Line2D([], [], color="0.55", lw=0.6, ls=":",
+                   label=rf"$k\,\Omega_c$, $\Omega_c$ = {f0:.4g} Hz" + (" (k on top)" if numbered else ""))]
+
+
 def whole_period_samples(t, period: float) -> np.ndarray:
-    """Boolean mask of the first samples of ``t`` covering a whole number of periods
-    ([t0, t0 + k T), k as large as fits); all samples if the period is not finite or
-    longer than the record."""
-    t = np.asarray(t, dtype=float)
-    if t.size < 2 or not (math.isfinite(period) and period > 0):
-        return np.ones(t.size, dtype=bool)
-    k = math.floor((t[-1] - t[0]) / period + 1e-9)
-    if k < 1:
-        return np.ones(t.size, dtype=bool)
-    dt = (t[-1] - t[0]) / (t.size - 1)
-    return t < t[0] + k * period - dt / 2
+    """Boolean mask of the first samples of ``t`` covering a whole number of periods (as many
+    as fit, N samples spanning N dt); all samples if the period is not finite or longer than
+    the record.  See :func:`camdyn.signal.whole_periods`."""
+    from .signal import whole_periods
+
+    return whole_periods(t, period)
 
 
 def poincare_section(result, quantities: Sequence[str] = ("alpha", "alpha_dot"), *,
@@ -357,13 +383,15 @@ def poincare(result, *, transient_revolutions: float = 0.0, phase: float = 0.0, 
     return fig
 
 
-def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: float | None = None, ax=None,
-                title: str | None = None):
+def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: float | None = None,
+                contact_loss_rpm: float | None = None, ax=None, title: str | None = None):
     """Poincare section against cam speed: one column of points per speed.
 
     ``points``: a list of arrays (one per speed), a 2-D array (speed x revolution; NaN for
     missing points), or an xarray DataArray with the speed as its first dimension.
     ``relative_to`` is subtracted (e.g. alpha*), to show the deviation.
+    ``contact_loss_rpm`` (e.g. :func:`camdyn.analysis.contact_loss_speed`) is marked with a
+    dashed line where it falls in the range of speeds, and named in the legend.
     """
     speeds = np.asarray(speed_rpm, dtype=float)
     if hasattr(points, "values") and not isinstance(points, np.ndarray):
@@ -385,6 +413,10 @@ def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: floa
         if relative_to is not None:
             symbol += r" - " + symbol + "^*"
         ax.set(xlabel=r"cam speed $\Omega_c$ (rev/min)", ylabel=f"${symbol}$ once per revolution ({unit_label})")
+        if contact_loss_rpm is not None and speeds.size and speeds.min() <= contact_loss_rpm <= speeds.max():
+            ax.axvline(contact_loss_rpm, color="#c0392b", lw=1.0, ls="--",
+                       label=f"contact loss (inverse kinematics): {contact_loss_rpm:.4g} rev/min")
+            ax.legend(loc="best", frameon=True, framealpha=0.9)
         if title:
             ax.set_title(title)
     return fig
@@ -451,7 +483,7 @@ def work_precision(records, *, ax=None, title: str | None = None, error_label: s
             for r, x, y in zip(recs, err, sec):
                 if r.get("rtol") is not None:
                     ax.annotate(f"{r['rtol']:.0e}", (x, y), textcoords="offset points", xytext=(3, 3),
-                                fontsize=6.5, color=line.get_color())
+                                fontsize=MIN_FONT_PT, color=line.get_color())
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set(xlabel=error_label, ylabel="run time (s)")

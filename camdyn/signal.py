@@ -16,6 +16,8 @@ __all__ = [
     "spectrum",
     "peak_frequency",
     "harmonics",
+    "whole_periods",
+    "noise_floor",
 ]
 
 _EPS = float(np.finfo(float).eps)
@@ -167,3 +169,37 @@ def harmonics(fundamental_Hz: float, fmax_Hz: float) -> np.ndarray:
         raise ValueError(f"fmax_Hz must be finite and >= 0, got {fmax_Hz!r}")
     count = int(np.floor(fmax_Hz / fundamental_Hz * (1 + 1e-12)))
     return fundamental_Hz * np.arange(1, count + 1)
+
+
+def whole_periods(t, period: float, skip_periods: float = 0.0) -> np.ndarray:
+    """Boolean mask of the samples of ``t`` after the first ``skip_periods`` periods that
+    cover the largest whole number of periods, so that the harmonics of ``1/period`` fall on
+    frequency bins.
+
+    Each sample stands for one step ``dt``: N samples span ``N dt``.  When the period is not
+    a whole number of steps, no record is exactly k periods long; one within a step of k
+    periods counts as k (the harmonics then lie within 1/N of a bin), so a run of 4
+    revolutions less a transient of 1 keeps 3 periods, not 2.  Times are compared with half a
+    step of slack (the period and the sample times carry rounding).  All samples after the
+    skip are kept if ``period`` is not finite or longer than them.
+    """
+    a = np.asarray(t, dtype=float)
+    if a.size < 2 or not (np.isfinite(period) and period > 0):
+        return np.ones(a.size, dtype=bool)
+    dt = (a[-1] - a[0]) / (a.size - 1)
+    after = a >= a[0] + skip_periods * period - dt / 2
+    if not after.any():
+        return after
+    first = a[after][0]
+    k = int(np.floor((a[-1] - first + 2 * dt) / period + 1e-9))  # N dt, plus the step of slack
+    if k < 1:
+        return after
+    return after & (a < first + k * period - dt / 2)
+
+
+def noise_floor(amplitude) -> float:
+    """The broadband level of an amplitude spectrum: the median amplitude of its bins (DC
+    left out).  Peaks far above it are signal; amplitudes near it are numerical noise or
+    broadband content, not lines."""
+    a = _vector(amplitude, "amplitude", min_len=2)
+    return float(np.median(a[1:]))

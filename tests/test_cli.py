@@ -29,7 +29,8 @@ def test_simulate_writes_csv(tmp_path, capsys):
     assert main(["simulate", "--speed-rpm", "300", "--revolutions", "0.2", "--sample-rate-Hz", "2000",
                  "--csv", str(out)]) == 0
     rows = list(csv.reader(out.open()))
-    assert rows[0][:3] == ["t", "alpha", "alpha_dot"] and rows[0][-1] == "regime"
+    assert rows[0][:3] == ["t (s)", "alpha (rad)", "alpha_dot (rad/s)"] and rows[0][-1] == "regime"
+    assert "F_n (N)" in rows[0] and "v_r (m/s)" in rows[0]  # every column says its unit
     assert len(rows) == 1 + 81  # 0.2 rev at 300 rev/min = 0.04 s at 2 kHz: 80 intervals, both ends
     assert "alpha_r: rms" in capsys.readouterr().out
 
@@ -64,7 +65,7 @@ def test_spectrum_of_a_saved_run_finds_the_cam_harmonics(tmp_path, capsys):
     ratio = float(out.split(" x Omega_c")[0].split("=")[-1])
     assert abs(ratio - 1) < 0.01  # the strongest peak of alpha is the fundamental
     rows = list(csv.reader(spec.open()))
-    assert rows[0] == ["f_Hz", "amplitude_alpha_rad"] and len(rows) > 100
+    assert rows[0] == ["f (Hz)", "amplitude of alpha (rad)"] and len(rows) > 100
 
 
 def test_spectrum_simulates_and_plots(tmp_path, capsys):
@@ -94,8 +95,8 @@ def test_contact_loss_single_and_over_k_s(capsys):
     assert main(["contact-loss"]) == 0
     single = float(capsys.readouterr().out)
     assert main(["contact-loss", "--k-s", "2000,8000"]) == 0
-    lines = capsys.readouterr().out.split()
-    assert lines[0] == "k_s_N_per_m,contact_loss_rpm"
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "k_s (N/m),contact_loss_speed (rev/min)"
     speeds = [float(line.split(",")[1]) for line in lines[1:]]
     assert math.isclose(speeds[0], single, rel_tol=1e-9)
     assert math.isclose(speeds[1], 2 * speeds[0], rel_tol=1e-5)  # Omega_loss ~ sqrt(k_s)
@@ -105,9 +106,9 @@ def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
     xr = pytest.importorskip("xarray")
     pytest.importorskip("matplotlib")
     nc, png = tmp_path / "bif.nc", tmp_path / "bif.png"
-    scipy = ["--backend", "scipy"]  # no compile step in the test
+    scipy = []  # the compiled loop is cached once per machine
     assert main(["sweep", "--speeds", "1200,1500", "--revolutions", "4", "--transient-revolutions", "2",
-                 "--out", str(nc), "--plot", str(png), *scipy]) == 0
+                 "--netcdf", str(nc), "--plot", str(png), *scipy]) == 0
     assert png.read_bytes()[:8] == PNG
     with xr.open_dataset(nc, engine="scipy") as ds:
         assert ds["alpha_section"].dims == ("speed_rpm", "revolution")
@@ -118,7 +119,8 @@ def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
     nc2, png2 = tmp_path / "map.nc", tmp_path / "map.png"
     assert main(["sweep", "--speeds", "1200,1500", "--param", "k_s", "--values", "200,400",
                  "--revolutions", "2", "--transient-revolutions", "1", "--samples-per-revolution", "20",
-                 "--out", str(nc2), "--plot", str(png2), *scipy]) == 0
+                 "--out", str(nc2), "--plot", str(png2), *scipy]) == 0  # --out: the deprecated name
+    assert "--out is deprecated here; use --netcdf" in capsys.readouterr().err
     assert png2.read_bytes()[:8] == PNG
     with xr.open_dataset(nc2, engine="scipy") as ds:
         assert ds["impacts_per_rev"].dims == ("k_s", "speed_rpm")
@@ -171,7 +173,8 @@ def test_errors_are_one_line_with_exit_code_2(tmp_path, capsys):
     (["simulate", "--speed-rpm", "fast"], "--speed-rpm"),
     (["simulate", "--speed-rpm", "300", "--oscillating-rpm", "40"], "not both"),
     (["simulate", "--speed-rpm", "300", "--rig", "missing.toml"], "missing.toml"),
-    (["simulate", "--speed-rpm", "300", "--model", "linear_paper", "--damping", "B"], "not generated"),
+    (["simulate", "--speed-rpm", "300", "--contact", "point", "--damping", "B"], "not generated"),
+    (["simulate", "--speed-rpm", "300", "--model", "linear_paper", "--damping", "B"], "constant damping coefficient"),
     (["simulate", "--speed-rpm", "300", "--csv", "/no/such/folder/run.csv"], "does not exist"),
     (["simulate", "--speed-rpm", "300", "--rtol", "1"], "rtol"),
     (["sweep", "--speeds", "1:2"], "start:stop:count"),
@@ -221,8 +224,6 @@ def test_reproduce_lists_and_checks_study_names(capsys):
 
 
 def test_backend_option_reaches_simulate(monkeypatch, capsys):
-    import inspect
-
     import camdyn.simulation
 
     real = camdyn.simulation.simulate
@@ -230,17 +231,11 @@ def test_backend_option_reaches_simulate(monkeypatch, capsys):
 
     def spy(*args, **kwargs):
         seen.append(kwargs.get("backend"))
-        kwargs.pop("backend", None)  # run on SciPy: no compile step in the test
         return real(*args, **kwargs)
 
     monkeypatch.setattr(camdyn.simulation, "simulate", spy)
-    if "backend" in inspect.signature(real).parameters:
-        assert main(["simulate", *QUICK, "--backend", "compiled"]) == 0
-        assert seen == ["compiled"]
-    else:  # a camdyn without the compiled engine says so
-        assert main(["simulate", *QUICK, "--backend", "compiled"]) == 4
-        assert "compiled" in one_error_line(capsys)
-
+    assert main(["simulate", *QUICK, "--backend", "python"]) == 0
+    assert seen == ["python"]
 
 def test_internal_errors_are_one_line_exit_5_and_traceback_on_request(monkeypatch, capsys):
     def broken(args):
@@ -284,3 +279,139 @@ def test_parse_values():
     for bad in ("", "1:2", "1:2:0", "a,b", "0:1:3:log", "1:2:3:lin"):
         with pytest.raises(cli.UsageError):
             cli._parse_values(bad, "x")
+
+
+# ------------------------------------------------------------------ issue 14: messages (D)
+@pytest.fixture
+def no_simulation(monkeypatch):
+    """simulate() fails the test if called: the command must stop before any work."""
+    import camdyn.simulation
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("simulate() was called: the error should come before any work")
+
+    monkeypatch.setattr(camdyn.simulation, "simulate", forbidden)
+
+
+def test_a_cam_at_rest_asks_for_t_end_not_revolutions(capsys, no_simulation):
+    assert main(["simulate", "--speed-rpm", "0"]) == 2
+    line = one_error_line(capsys)
+    assert "--speed-rpm 0 holds the cam still" in line and "--t-end" in line
+    assert "out of range" not in line  # was: "revolutions = 3.0 is out of range: must be t_end (s)..."
+
+
+def test_a_cam_at_rest_runs_for_t_end(capsys):
+    assert main(["simulate", "--speed-rpm", "0", "--t-end", "0.005", "--sample-rate-Hz", "2000"]) == 0
+    assert "11 samples" in capsys.readouterr().out  # 0.005 s at 2 kHz, both ends
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["simulate", "--speed-rpm", "300", "--rig", "exmaple"], ["--rig exmaple", "did you mean 'example'"]),
+    (["simulate", "--speed-rpm", "300", "--method", "Radau"],
+     ["invalid choice: 'Radau'", "'DOP853'", "'RK45'"]),
+    (["simulate", "--speed-rpm", "300", "--method", "RK54"], ["did you mean 'RK45'", "camdyn simulate --help"]),
+    (["simulate", "--speed-rpm", "300", "--backend", "scipy"], ["invalid choice: 'scipy'", "'compiled', 'python'"]),
+    (["simulate", "--speed-rpm", "300", "--damping", "d"], ["did you mean 'D'"]),
+    (["simulate", "--speed-rpmm", "300"], ["unrecognized option --speed-rpmm", "did you mean --speed-rpm?",
+                                           "see 'camdyn simulate --help'"]),
+    (["sweep", "--speeds", "1000", "--transient-revs", "3"], ["did you mean --transient-revolutions?",
+                                                              "see 'camdyn sweep --help'"]),
+])
+def test_messages_name_the_option_suggest_and_point_at_the_commands_help(argv, words, capsys, no_simulation):
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    for w in words:
+        assert w in line
+    assert "is not a real number" not in line  # a name is not a number
+
+
+def test_solver_names_come_from_the_engine():
+    """The CLI's backends and methods are the engine's (one helper), not a list of its own."""
+    from camdyn.engine.tableau import TABLEAUS
+    from camdyn.simulation import BACKENDS
+
+    backends, methods = cli._solvers()
+    assert tuple(backends) == tuple(BACKENDS) and set(methods) == set(TABLEAUS)
+    help_text = cli._parser().parse_args.__self__.commands["simulate"].format_help()
+    for name in (*backends, *methods):
+        assert name in help_text
+
+
+# ------------------------------------------------------------------ file formats, checked first (E)
+@pytest.mark.parametrize("flag, name, words", [
+    ("--plot", "run.jpgx", "matplotlib cannot write .jpgx figures"),
+    ("--netcdf", "run.csv", "a NetCDF file name ends in .nc"),
+    ("--csv", "run.nc", "a CSV file name ends in .csv"),
+])
+def test_output_formats_are_checked_before_the_run(flag, name, words, tmp_path, capsys, no_simulation):
+    pytest.importorskip("matplotlib")
+    assert main(["simulate", *QUICK, flag, str(tmp_path / name)]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"camdyn: error: {flag} ") and words in line
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_plot_with_no_ending_is_a_png_and_says_so(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    assert main(["simulate", "--speed-rpm", "300", "--revolutions", "0.05", "--sample-rate-Hz", "2000",
+                 "--plot", str(tmp_path / "runnoext")]) == 0
+    written = tmp_path / "runnoext.png"
+    assert written.read_bytes()[:8] == PNG
+    assert f"wrote {written}" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name, words", [
+    ("image.png", "a saved run is a .csv or .nc file"),
+    ("image.csv", "not a text file"),
+    ("image.nc", "not a NetCDF file"),
+])
+def test_spectrum_input_must_be_a_saved_run(name, words, tmp_path, capsys):
+    path = tmp_path / name
+    path.write_bytes(PNG + bytes(range(256)))  # a PNG, whatever its name
+    assert main(["spectrum", "--input", str(path)]) == 2
+    line = one_error_line(capsys)
+    assert words in line and "codec" not in line
+
+
+# ------------------------------------------------------------------ values with a minus sign (F)
+def test_ranges_may_start_with_a_minus_sign(capsys):
+    args = cli._parser().parse_args(["sweep", "--speeds", "-1500:-1200:2"])
+    assert cli._parse_values(args.speeds, "--speeds") == [-1500.0, -1200.0]
+    assert main(["contact-loss", "--k-s", "-500:8000:5:log"]) == 2
+    assert "a log range needs positive ends" in one_error_line(capsys)  # read, then refused with the reason
+    assert main(["contact-loss", "--k-s", "-500,8000"]) == 2
+    assert "k_s = -500.0 is out of range" in one_error_line(capsys)
+
+
+# ------------------------------------------------------------------ whole periods after the transient (G)
+def test_spectrum_keeps_every_whole_period_after_the_transient(capsys):
+    """1100 rev/min at 5 kHz is 272.7 samples per revolution: 4 revolutions less 1 are 3 periods
+    to within a sample, which used to be rounded down to 2."""
+    assert main(["spectrum", "--speed-rpm", "1100", "--revolutions", "4", "--transient-revolutions", "1",
+                 "--sample-rate-Hz", "5000", "--peaks", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "(3 cam periods" in out
+    samples = int(out.split("spectrum of alpha: ")[1].split(" samples")[0])
+    assert abs(samples - 3 * 5000 * 60 / 1100) <= 1
+
+
+# ------------------------------------------------------------------ one name, honest help (H)
+def test_simulate_and_sweep_save_netcdf_with_the_same_option():
+    for argv in (["simulate", "--speed-rpm", "1", "--netcdf", "a.nc"], ["sweep", "--speeds", "1", "--netcdf", "a.nc"]):
+        args = cli._parser().parse_args(argv)
+        assert (args.netcdf if argv[0] == "simulate" else args.out) == "a.nc"
+
+
+def _help(command, capsys):
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_backend_and_method_help_state_the_real_defaults_and_names(capsys):
+    text = _help("simulate", capsys)
+    backends, methods = cli._solvers()
+    for command in ("simulate", "sweep"):
+        text = " ".join(_help(command, capsys).split())
+        assert f"(default: {cli._default_backend()};" in text and "{default_backend}" not in text
+        assert f"{', '.join(backends)} (default" in text and f"{', '.join(methods)} (default: DOP853)" in text

@@ -64,7 +64,8 @@ def test_overview_has_alpha_r_force_and_sliding_velocity(impacting, tmp_path):
     fig = plots.overview(impacting)
     labels = [a.get_ylabel() for a in fig.axes]
     assert len(labels) == 3 and "alpha_r" in labels[0] and "F_n" in labels[1] and "v_r" in labels[2]
-    assert "1100 rev/min" in fig.axes[0].get_title()
+    # the physics in words, not the generated module's slug (line_d_coulomb_constant_nonlinear)
+    assert fig.axes[0].get_title() == "line contact, damping D, Coulomb friction, 1100 rev/min, rig example"
     saves(fig, tmp_path)
 
 
@@ -153,3 +154,44 @@ def test_import_does_not_need_matplotlib_and_calls_say_how_to_install():
             "try:\n    p.time_history(None)\nexcept ImportError as e:\n    print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert 'pip install "camdyn[plot]"' in out
+
+
+# ------------------------------------------------------------------ issue 14 (K)
+def test_spectrum_panels_share_one_unit_and_mark_the_noise_floor(impacting):
+    """The band around the contact mode holds only noise: it is drawn in the unit of the whole
+    figure (not prad) with the median level marked, so it does not read as a signal."""
+    fig = plots.spectrum(impacting, "alpha", bands=[(0, 200), (1800, 2600)], transient_revolutions=1)
+    low, high = fig.axes
+    assert low.get_ylabel() == high.get_ylabel() and "(mrad)" in low.get_ylabel()
+    for ax in (low, high):
+        floors = [t.get_text() for t in ax.get_legend().get_texts() if t.get_text().startswith("noise floor")]
+        assert len(floors) == 1 and "mrad" in floors[0]
+    assert "1100 rev/min" in low.get_title() and "_" not in low.get_title()
+
+
+def test_bifurcation_marks_the_contact_loss_speed():
+    speeds = [800.0, 1000.0, 1200.0]
+    fig = plots.bifurcation(speeds, np.zeros((3, 2)), contact_loss_rpm=997.9)
+    ax = fig.axes[0]
+    assert [line.get_xdata()[0] for line in ax.lines if line.get_linestyle() == "--"] == [997.9]
+    assert "contact loss" in ax.get_legend().get_texts()[0].get_text()
+    fig = plots.bifurcation(speeds, np.zeros((3, 2)), contact_loss_rpm=2000.0)  # out of range: not drawn
+    assert fig.axes[0].get_legend() is None
+
+
+def test_no_text_in_any_figure_is_smaller_than_the_minimum(impacting):
+    """Legends, harmonic numbers, annotations: every text at least MIN_FONT_PT (8.5 pt: at the
+    saved 150 dpi about 18 px, readable in a report), which the 6.5-7.5 pt labels were not."""
+    from matplotlib.text import Text
+
+    records = [{"label": "DOP853", "error": 1e-6, "seconds": 1.0, "rtol": 1e-6},
+               {"label": "DOP853", "error": 1e-9, "seconds": 2.0, "rtol": 1e-9}]
+    figures = [plots.overview(impacting), plots.time_history(impacting, mark_impacts=True),
+               plots.spectrum(impacting, "alpha", bands=[(0, 200)], transient_revolutions=1),
+               plots.poincare(impacting), plots.bifurcation([1, 2], np.ones((2, 2)), contact_loss_rpm=1.5),
+               plots.contact_map([1.0, 2.0], [1.0, 10.0], np.array([[0, 1], [1, 2]]), loss_curve=([1, 2], [1, 10])),
+               plots.work_precision(records)]
+    for fig in figures:
+        fig.canvas.draw()
+        sizes = [t.get_fontsize() for t in fig.findobj(Text) if t.get_text().strip() and t.get_visible()]
+        assert sizes and min(sizes) >= plots.MIN_FONT_PT, fig

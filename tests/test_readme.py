@@ -19,3 +19,53 @@ def test_readme_has_the_two_fresh_machine_commands():
     ci = (Path(__file__).resolve().parent.parent / ".ci" / "run").read_text().strip().splitlines()[-1]
     assert ci in README
     assert "examples/quickstart.py" in README
+
+
+#: what each command the README tells users to run needs installed (a distribution name), or
+#: None when camdyn's own dependencies are enough; a README command not listed here fails the test
+#: below until it is added, with what it needs
+COMMAND_NEEDS = {
+    "python examples/quickstart.py": "matplotlib",
+    "python -m pytest": "pytest",
+    "jupyter lab": "jupyterlab",
+    "python -m sphinx": "sphinx",
+}
+
+
+def _extras() -> dict[str, set[str]]:
+    """Each extra of pyproject.toml -> the distribution names it installs (camdyn[...] expanded)."""
+    try:
+        import tomllib
+    except ImportError:  # Python 3.10
+        import tomli as tomllib
+
+    table = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())
+    raw = table["project"]["optional-dependencies"]
+
+    def names(extra, seen=()):
+        out = set()
+        for requirement in raw[extra]:
+            m = re.match(r"([A-Za-z0-9_.-]+)(?:\[([^\]]+)\])?", requirement)
+            if m.group(1) == "camdyn":
+                for inner in m.group(2).split(","):
+                    if inner not in seen:
+                        out |= names(inner.strip(), seen + (extra,))
+            else:
+                out.add(m.group(1).lower())
+        return out
+
+    return {extra: names(extra) for extra in raw}
+
+
+def test_every_install_and_run_line_of_the_readme_installs_what_it_runs():
+    """`pip install -e ".[dev]" && jupyter lab notebooks/` failed with 'jupyter-lab not found'
+    (issue 14, C): each `pip install ".[extras]" && command` installs what the command needs."""
+    extras = _extras()
+    chains = re.findall(r'pip install (?:-e )?"\.\[([a-z,]+)\]"((?:\s*&&\s*[^`\n&]+)+)', README)
+    assert len(chains) >= 4, chains
+    for names, commands in chains:
+        installed = set().union(*(extras[n.strip()] for n in names.split(",")))
+        for command in (c.strip() for c in commands.split("&&") if c.strip()):
+            need = [v for k, v in COMMAND_NEEDS.items() if command.startswith(k)]
+            assert need, f"README runs {command!r}: add what it needs to COMMAND_NEEDS"
+            assert need[0] in installed, f'pip install ".[{names}]" does not install {need[0]} for {command!r}'

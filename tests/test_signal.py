@@ -13,6 +13,8 @@ from camdyn.signal import (
     rms,
     sample_rate,
     spectrum,
+    whole_periods,
+    noise_floor,
 )
 
 FS = 1000.0  # Hz
@@ -184,3 +186,30 @@ def test_harmonics():
     assert harmonics(10.0, 5.0).size == 0
     with pytest.raises(ValueError, match="fundamental_Hz"):
         harmonics(0.0, 5.0)
+
+
+# --------------------------------------------------------------------------- whole periods
+@pytest.mark.parametrize("samples_per_period", [80.0, 272.7272727, 545.4545454])
+def test_whole_periods_after_a_transient_keeps_every_period(samples_per_period):
+    """4 periods sampled, 1 skipped: 3 periods are kept (to within one sample when a period is not
+    a whole number of samples), not 2 (issue 14, G)."""
+    fs, period = 5000.0, samples_per_period / 5000.0
+    t = np.arange(int(np.floor(4 * period * fs + 1e-9)) + 1) / fs
+    keep = whole_periods(t, period, 1)
+    kept = keep.sum() / fs / period
+    assert abs(kept - 3) <= 1 / samples_per_period + 1e-9
+    assert t[keep][0] == pytest.approx(period, abs=1 / fs)
+    assert whole_periods(t, period).sum() / fs / period == pytest.approx(4, abs=1 / samples_per_period + 1e-9)
+
+
+def test_whole_periods_without_a_period_keeps_what_follows_the_skip():
+    t = np.arange(100) / 100.0
+    assert whole_periods(t, math.inf).all()
+    assert whole_periods(t, 5.0, 0).all()  # longer than the record
+
+
+def test_noise_floor_is_the_median_level():
+    f, amp = spectrum(T, _sine(1.0, 100 * DF) + 1e-9 * np.random.default_rng(1).standard_normal(N))
+    level = noise_floor(amp)
+    assert 1e-12 < level < 1e-9  # the noise, far below the line at 1
+    assert amp.max() > 1e8 * level

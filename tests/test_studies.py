@@ -6,6 +6,7 @@ import json
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -198,3 +199,50 @@ def test_chaos_scan_writes_its_section_to_both_documents(tmp_path):
     studies.run("reference-rig", **quiet)
     again = (tmp_path / "reference-rig.md").read_text()
     assert again.count("## Chaos onsets: geometry scan") == 1 and "Not run yet" not in again
+
+
+# ---------------------------------------------------------------- where the studies write (issue 14, I)
+
+def test_checkout_is_told_from_an_installed_copy(tmp_path):
+    checkout = tmp_path / "src"
+    (checkout / "camdyn").mkdir(parents=True)
+    (checkout / "docs").mkdir()
+    (checkout / "pyproject.toml").write_text('[project]\nname = "camdyn"\n')
+    assert common.checkout_root(checkout / "camdyn") == checkout
+    site = tmp_path / "lib" / "site-packages"
+    (site / "camdyn").mkdir(parents=True)
+    assert common.checkout_root(site / "camdyn") is None
+    other = tmp_path / "other"
+    (other / "camdyn").mkdir(parents=True)
+    (other / "docs").mkdir()
+    (other / "pyproject.toml").write_text('[project]\nname = "something-else"\n')
+    assert common.checkout_root(other / "camdyn") is None
+
+
+def _files_under(folder):
+    return {p: p.stat().st_mtime_ns for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+
+
+def test_an_installed_camdyn_writes_to_the_working_folder_never_into_the_package(tmp_path, monkeypatch, capsys):
+    from camdyn.cli import main
+
+    package = Path(camdyn.__file__).resolve().parent
+    before = _files_under(package)
+    monkeypatch.setattr(common, "checkout_root", lambda package_dir=None: None)  # as if pip-installed
+    monkeypatch.chdir(tmp_path)
+    assert main(["reproduce", "numbers", "--fast"]) == 0
+    report = tmp_path / common.DEFAULT_OUT / "reproduction.md"
+    assert report.exists()
+    err = capsys.readouterr().err
+    assert "not running from a source checkout" in err and str(tmp_path / common.DEFAULT_OUT) in err
+    assert common.default_data_dir(tmp_path / common.DEFAULT_OUT) == tmp_path / common.DEFAULT_OUT / "rigs"
+    assert _files_under(package) == before
+    assert not (tmp_path / "docs").exists()  # the old fallback made ./docs here
+
+
+def test_a_checkout_writes_its_docs_and_presets():
+    root = common.checkout_root()
+    if root is None:
+        pytest.skip("camdyn is not running from a source checkout")
+    assert common.default_out() == root / "docs"
+    assert common.default_data_dir(root / "docs") == root / "camdyn" / "data"

@@ -38,6 +38,7 @@ _EXPORTS = {
     "GeometryError": "camdyn.errors",
     "EquilibriumError": "camdyn.errors",
     "SceneError": "camdyn.errors",
+    "CompileNotice": "camdyn.errors",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

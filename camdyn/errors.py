@@ -110,3 +110,9 @@ class EquilibriumError(CamdynError, ValueError):
 
 class SceneError(CamdynError, ValueError):
     """A scene (simulation set-up) option is invalid or inconsistent with the rig."""
+
+
+class CompileNotice(UserWarning):
+    """Issued once when camdyn is about to compile its integration loop (a first run on this
+    machine, or after an upgrade): the run takes seconds longer, once.  Silence it with
+    ``warnings.filterwarnings("ignore", category=camdyn.CompileNotice)``."""

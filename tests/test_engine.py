@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn.engine import loop
+from camdyn.engine import cache, loop
 from camdyn.engine.config import SolverOptions, settings as loop_settings
 from camdyn.engine.loop import SUCCESS, Samples, Start, run_compiled, run_interpreted
 from camdyn.engine.tableau import DOP853, arrays
@@ -81,21 +81,23 @@ def test_tables_encode_the_generated_automaton(slug):
     surface, direction, candidates and conditions; the initial candidates follow the last row."""
     K = scene_from_slug(slug).kernels()
     tab = tables(K)
+    data = {name: tab.data[getattr(tab, name):] for name in tab._fields if name != "data" and not name.startswith("n_")}
     rows = []
     for m in range(len(K.MODES)):
-        for w in range(tab.watch_start[m], tab.watch_start[m + 1]):
-            targets = tuple((int(tab.target_mode[c]), tuple(
-                (int(tab.condition_surface[q]), int(tab.condition_sign[q]))
-                for q in range(tab.condition_start[c], tab.condition_start[c + 1])))
-                for c in range(tab.target_start[w], tab.target_start[w + 1]))
-            rows.append((m, int(tab.surface[w]), int(tab.direction[w]), targets))
-            assert tab.reset[w] == IDENTITY
+        for w in range(data["watch_start"][m], data["watch_start"][m + 1]):
+            targets = tuple((int(data["target_mode"][c]), tuple(
+                (int(data["condition_surface"][q]), int(data["condition_sign"][q]))
+                for q in range(data["condition_start"][c], data["condition_start"][c + 1])))
+                for c in range(data["target_start"][w], data["target_start"][w + 1]))
+            rows.append((m, int(data["surface"][w]), int(data["direction"][w]), targets))
+            assert data["reset"][w] == IDENTITY
     assert rows == [tr[:4] for tr in K.TRANSITIONS]
-    n = tab.surface.shape[0]
-    initial = [int(tab.target_mode[c]) for c in range(tab.target_start[n], tab.target_start[n + 1])]
+    n = tab.n_transitions
+    initial = [int(data["target_mode"][c]) for c in range(data["target_start"][n], data["target_start"][n + 1])]
     assert initial == [c[0] for c in K.INITIAL]
-    assert tab.mode_contact.tolist() == [int(c) for c in K.CONTACT_OF_MODE]
-    assert [K.OUTPUTS[i] for i in tab.flows] == ["P_in", "D_c", "D_f"]
+    assert data["mode_contact"][:tab.n_modes].tolist() == [int(c) for c in K.CONTACT_OF_MODE]
+    assert [K.OUTPUTS[i] for i in data["flows"][:3]] == ["P_in", "D_c", "D_f"]
+    assert tab.data.size == tab.flows + 3 and tab.n_surfaces == len(K.SURFACES)
 
 
 # --- trap 1: the gap as a difference of nearly equal angles --------------------------------
@@ -294,3 +296,21 @@ def test_settings_carry_the_rules_constants_by_name():
     assert (cfg.rtol, cfg.atol, cfg.contact_step) == (1e-7, 1e-11, 0.1 / 1e4)
     assert cfg._fields[:3] == ("rtol", "atol", "max_step")
     assert loop.OUTCOMES == tuple(o.name for o in camdyn.Outcome)
+
+
+def test_a_run_that_will_compile_the_loop_says_so_once(monkeypatch, tmp_path):
+    """Issue 14 (N): an empty cache and a loop not yet in memory give one CompileNotice, naming
+    how to silence it; a loaded loop gives none."""
+    import warnings
+
+    from camdyn.engine import driver
+
+    camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, t_end=1e-4)  # the loop is in memory now
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", camdyn.CompileNotice)
+        camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, t_end=1e-4)
+    monkeypatch.setenv("CAMDYN_CACHE_DIR", str(tmp_path))  # an empty cache ...
+    monkeypatch.setattr(driver, "loop_loaded", lambda: False)  # ... and a fresh process
+    assert not cache.loop_cached()
+    with pytest.warns(camdyn.CompileNotice, match="compiles its integration loop.*filterwarnings"):
+        camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, t_end=1e-4)

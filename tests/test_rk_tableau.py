@@ -44,12 +44,12 @@ def _problem(p) -> Problem:
 @numba.njit
 def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
     """Drive stepper.step like SciPy's solver loop; records the accepted times."""
-    K = np.empty((method.A.shape[0], 2))
+    K = np.empty((method.n_rows, 2))
     K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t0, y0, y1, prob.p)
-    h = stepper.initial_step(prob, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
+    h = stepper.initial_step(prob.kernels.rhs, prob.p, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
     t, n, nfev = t0, 0, 2
     while t < t_end:
-        status, t, y0, y1, h, f, _ = stepper.step(prob, 0, t, y0, y1, h, t_end, method, K, cfg)
+        status, t, y0, y1, h, f, _ = stepper.step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K, cfg)
         nfev += f
         times[n] = t
         n += 1
@@ -60,14 +60,14 @@ def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
 @numba.njit
 def _fixed(prob, method, h, n_steps, y0, y1, theta):
     """n_steps fixed steps of size h; returns the end state and the interpolant at theta of the last step."""
-    K = np.empty((method.A.shape[0], 2))
-    Q = np.empty((2, method.P.shape[1]))
+    K = np.empty((method.n_rows, 2))
+    Q = np.empty((2, method.degree))
     t = 0.0
     d0 = d1 = 0.0
     for _ in range(n_steps):
         K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t, y0, y1, prob.p)
-        n0, n1 = stepper.step_impl(prob, 0, t, y0, y1, h, method, K)
-        stepper.dense_coefficients(prob, 0, t, y0, y1, h, method, K, Q)
+        n0, n1 = stepper.step_impl(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, method, K)
+        stepper.dense_coefficients(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, method, K, Q)
         d0, d1 = stepper.dense_eval(t + theta * h, t, h, y0, y1, Q)
         t, y0, y1 = t + h, n0, n1
     return y0, y1, d0, d1
@@ -166,3 +166,10 @@ def test_measured_order_of_convergence(name, order, dense_order):
         local.append(abs(d - math.cos(2 * 2 * h)))
     assert math.log2(glob[0] / glob[1]) == pytest.approx(order, abs=0.35)
     assert math.log2(local[0] / local[1]) >= dense_order + 1 - 0.35
+
+
+@pytest.mark.parametrize("t", [0.0, 1.0, -1.0, 2.0, -2.0, 0.5, -0.5, 3.0, -4.0, 1e-310, -1e-310, 5e-324, 1e300,
+                               -1e300, 0.1, -0.1, 123.456])
+def test_spacing_is_numpys_distance_to_the_next_float(t):
+    """The step-size floor's unit (stepper.spacing, from frexp) is np.nextafter(t, inf) - t exactly."""
+    assert stepper.spacing(t) == np.nextafter(t, np.inf) - t

@@ -145,3 +145,9 @@ def install() -> bool:
     if not any(getattr(c, "__name__", "") == locator.__name__ for c in classes):
         classes.insert(0, locator)
     return True
+
+
+def loop_cached() -> bool:
+    """Whether the compiled loop of this camdyn and engine is in the cache (numba's index file
+    of ``camdyn.engine.loop``'s compiled entry point)."""
+    return any((cache_dir() / "numba").rglob("loop._run_compiled-*.nbi"))

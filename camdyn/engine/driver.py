@@ -7,15 +7,17 @@ interpreted, and names what comes back: sample times and states, the mode at eac
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import CompileNotice, ParameterError
 from ..outcome import Outcome
+from . import cache
 from .config import BACKENDS, SolverOptions, settings
 from .kernels import compiled_kernels, python_kernels
-from .loop import OUTCOMES, Samples, Start, run_compiled, run_interpreted
+from .loop import OUTCOMES, Samples, Start, loop_loaded, run_compiled, run_interpreted
 from .problem import Problem
 from .tableau import TABLEAUS, arrays
 from .tables import tables, transition_rows
@@ -83,9 +85,20 @@ def integrate(model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
                       np.zeros(t_eval.size, dtype=np.int64))
     y0 = np.asarray(y0, dtype=float)
     start = Start(t0, t_end, float(y0[0]), float(y0[1]), -1 if mode is None else int(mode))
+    if backend == "compiled":
+        _notice_compile()
     loop = run_compiled if backend == "compiled" else run_interpreted
     r = loop(prob, method, cfg, start, samples)
     return _trajectory(model, r, samples, backend)
+
+
+def _notice_compile() -> None:
+    """Say once, before it happens, that the loop is about to be compiled (a first run here)."""
+    if loop_loaded() or cache.loop_cached():
+        return
+    warnings.warn(f"camdyn compiles its integration loop on this first run (typically 10-20 s, once; later runs "
+                  f"load it from {cache.cache_dir()}). Silence this with warnings.filterwarnings('ignore', "
+                  "category=camdyn.CompileNotice).", CompileNotice, stacklevel=5)
 
 
 def _trajectory(model, r, samples: Samples, backend: str) -> Trajectory:

@@ -30,10 +30,10 @@ def accumulate(prob, m, t, h, y0, y1, Q, ta, tb, buf, work):
     length = tb - ta
     if length <= 0.0:
         return
-    flows = prob.tables.flows
+    tab = prob.tables
     for q in range(NODES.shape[0]):
         tq = ta + NODES[q] * length
         a, ad = dense_eval(tq, t, h, y0, y1, Q)
         prob.kernels.outputs(m, tq, a, ad, prob.p, buf)
         for i in range(N_FLOWS):
-            work[i] += WEIGHTS[q] * length * buf[flows[i]]
+            work[i] += WEIGHTS[q] * length * buf[tab.data[tab.flows + i]]

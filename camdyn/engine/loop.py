@@ -75,7 +75,8 @@ def _record(sw, n, t, w, before, after, a, ad):
     """Append a switch, doubling the buffer when full; returns the buffer."""
     if n == sw.shape[0]:
         bigger = np.empty(2 * n, dtype=SWITCH)
-        bigger[:n] = sw[:n]
+        for k in range(n):  # element by element: a slice assignment compiles numba's shape-error
+            bigger[k] = sw[k]  # message formatting, seconds of the cold start
         sw = bigger
     sw["t"][n], sw["transition"][n], sw["before"][n], sw["after"][n] = t, w, before, after
     sw["alpha"][n], sw["alpha_dot"][n] = a, ad
@@ -92,9 +93,11 @@ def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tm
         ts = samples.t[i]
         samples.y[0, i], samples.y[1, i] = dense_eval(ts, t, h, y0, y1, Q)
         if ledger:
-            ledger_tmp[:] = ledger_work
+            for k in range(N_FLOWS):  # element by element, as in _record
+                ledger_tmp[k] = ledger_work[k]
             accumulate(prob, m, t, h, y0, y1, Q, t, ts, buf, ledger_tmp)
-            samples.y[2:2 + N_FLOWS, i] = ledger_tmp
+            for k in range(N_FLOWS):
+                samples.y[2 + k, i] = ledger_tmp[k]
         samples.mode[i] = m
         i += 1
     return i
@@ -106,7 +109,7 @@ def _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K):
     last step's size (capped at contact_step when contact just started).  (h, evaluations)."""
     K[0, 0], K[0, 1] = y1, prob.kernels.rhs(m, t, y0, y1, prob.p)
     if h_last < 0.0:
-        return initial_step(prob, m, t, y0, y1, K[0, 1], t_end, method, cfg), 2
+        return initial_step(prob.kernels.rhs, prob.p, m, t, y0, y1, K[0, 1], t_end, method, cfg), 2
     h_abs = min(h_last, t_end - t)
     if capped and cfg.contact_step > 0.0:
         h_abs = min(h_abs, cfg.contact_step)
@@ -122,7 +125,7 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
     """The state at a crossing inside the step from (t, y): one step of the method to t_cross,
     and whether it is ACROSS transition w's surface, NOT_YET (K[n] then holds f there, the next
     step's first stage) or UNUSABLE (not finite).  K[0] must hold f(t, y)."""
-    c0, c1 = step_impl(prob, m, t, y0, y1, t_cross - t, method, K)
+    c0, c1 = step_impl(prob.kernels.rhs, prob.p, m, t, y0, y1, t_cross - t, method, K)
     if not (math.isfinite(c0) and math.isfinite(c1)):
         return c0, c1, UNUSABLE
     g_ok = across(prob, m, w, t_cross, c0, c1)
@@ -133,12 +136,14 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
 def run(prob, method, cfg, start, samples):
     """Integrate the hybrid model from ``start`` (see the module docstring); a :class:`Run`."""
     tab = prob.tables
+    rhs, p = prob.kernels.rhs, prob.p  # taken out once: a call passing prob pays a count per array it holds
     n = method.n_stages
-    K = np.empty((method.A.shape[0], 2))
-    Q = np.empty((2, method.P.shape[1]))
-    n_watch = max(1, tab.surface.shape[0])
-    n_surf = max(1, tab.surface_rate.shape[0])
+    K = np.empty((method.n_rows, 2))
+    Q = np.empty((2, method.degree))
+    n_watch = max(1, tab.n_transitions)
+    n_surf = max(1, tab.n_surfaces)
     work = Scratch(np.zeros(n_watch), np.zeros(n_watch), np.zeros(n_surf), np.zeros(n_surf, dtype=np.bool_))
+    g_prev = work.g_prev
     buf = np.empty(max(tab.n_outputs, 2))
     ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
     ledger = samples.y.shape[0] > 2
@@ -150,10 +155,11 @@ def run(prob, method, cfg, start, samples):
     while t < t_end and outcome == SUCCESS:
         h_abs, f = _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K)
         nfev += f
-        watched = tab.watch_start[m + 1] > tab.watch_start[m]
+        n_watched = tab.data[tab.watch_start + m + 1] - tab.data[tab.watch_start + m]
+        watched = n_watched > 0
         have_start = False
         while t < t_end:
-            status, t_new, n0, n1, h_next, f, rej = step(prob, m, t, y0, y1, h_abs, t_end, method, K, cfg)
+            status, t_new, n0, n1, h_next, f, rej = step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg)
             nfev += f
             rejected += rej
             if status != ACCEPTED:
@@ -165,10 +171,10 @@ def run(prob, method, cfg, start, samples):
                 break
             h = t_new - t
             if watched or ledger or (i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_new):
-                nfev += dense_coefficients(prob, m, t, y0, y1, h, method, K, Q)
+                nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
             w, t_cross = -1, t_new
             if watched:
-                on_surface = not have_start or zero_at_start(prob, m, work)
+                on_surface = not have_start or zero_at_start(g_prev, n_watched)
                 w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
                 if w == NONFINITE:
                     outcome = NONFINITE_STATE
@@ -201,7 +207,7 @@ def run(prob, method, cfg, start, samples):
                         c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
                 retries = 0
                 m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
-                capped = tab.mode_contact[m] == 0 and tab.mode_contact[m_new] == 1
+                capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
                 sw = _record(sw, n_sw, t_cross, w, m, m_new, c0, c1)
                 n_sw += 1
                 t, y0, y1, m = t_cross, c0, c1, m_new
@@ -226,6 +232,11 @@ def _run_compiled(prob, method, cfg, start, samples):
     # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
     # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
     return (r.outcome, r.n_samples, r.switches, r.nfev, r.steps, r.rejected, r.mode, r.t, r.alpha, r.alpha_dot)
+
+
+def loop_loaded() -> bool:
+    """Whether the compiled loop is in memory (compiled or loaded from the cache already)."""
+    return bool(_run_compiled.signatures)
 
 
 def run_compiled(prob, method, cfg, start, samples) -> Run:

@@ -96,23 +96,24 @@ def side(prob, m, s, t, a, ad, look_ahead):
 def target(prob, row, t, a, ad, look_ahead):
     """The first candidate of target row ``row`` whose conditions hold at the state."""
     tab = prob.tables
-    first, last = tab.target_start[row], tab.target_start[row + 1]
+    first, last = tab.data[tab.target_start + row], tab.data[tab.target_start + row + 1]
     for c in range(first, last):
-        m = tab.target_mode[c]
+        m = tab.data[tab.target_mode + c]
         holds = True
-        for q in range(tab.condition_start[c], tab.condition_start[c + 1]):
-            if tab.condition_sign[q] * side(prob, m, tab.condition_surface[q], t, a, ad, look_ahead) < 0.0:
+        for q in range(tab.data[tab.condition_start + c], tab.data[tab.condition_start + c + 1]):
+            s = tab.data[tab.condition_surface + q]
+            if tab.data[tab.condition_sign + q] * side(prob, m, s, t, a, ad, look_ahead) < 0.0:
                 holds = False
                 break
         if holds:
             return m
-    return tab.target_mode[last - 1]
+    return tab.data[tab.target_mode + last - 1]
 
 
 @jitable
 def initial_mode(prob, t, a, ad, look_ahead):
     """The mode a run starts in: the initial candidates (the row after the transitions)."""
-    return target(prob, prob.tables.surface.shape[0], t, a, ad, look_ahead)
+    return target(prob, prob.tables.n_transitions, t, a, ad, look_ahead)
 
 
 # --- location on the interpolant ------------------------------------------------------------
@@ -189,12 +190,11 @@ def hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, r
 
     Both ends are on the watched side; if the rate turns from approaching zero to leaving it,
     the extremum is located and the value read there.  A rate exactly 0 at an end is no turn."""
-    up = direction >= 0 and ga < 0.0 and ra > 0.0 > rb
-    down = direction <= 0 and ga > 0.0 and ra < 0.0 < rb
-    if not (up or down):
+    if not _turns(direction, ga, ra, rb):
         return -1.0, 0.0
+    up = ga < 0.0
     t_ext, g_ext = extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb)
-    if (up and g_ext >= 0.0) or (down and g_ext <= 0.0):
+    if (up and g_ext >= 0.0) or (not up and g_ext <= 0.0):
         return t_ext, g_ext
     return -1.0, 0.0
 
@@ -216,24 +216,35 @@ def turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb
 
 
 @jitable
-def _sample(prob, m, s, t, a, ad, work):
-    """Surface s's value at the current sample, computed once per sample."""
-    if not work.known[s]:
-        work.values[s] = value(prob, m, s, t, a, ad)
-        work.known[s] = True
-    return work.values[s]
+def _values_at(prob, m, w0, w1, t, a, ad, values, known):
+    """values[s] for the surfaces transitions w0..w1 watch, and their rates, at (t, a, ad),
+    each surface once (known[s] marks those computed).
+
+    Compiled, a call that passes the Problem and Scratch tuples costs a reference count per
+    array they hold (about 0.2 us: measured); the loop's hot path, first_crossing, calls it once
+    per sample with the two arrays it writes."""
+    tab = prob.tables
+    surface_of = tab.data[tab.surface:tab.surface + tab.n_transitions]
+    rate_of = tab.data[tab.surface_rate:tab.surface_rate + tab.n_surfaces]
+    kernel, p = prob.kernels.surface, prob.p
+    for s in range(known.shape[0]):
+        known[s] = False
+    for w in range(w0, w1):
+        s = surface_of[w]
+        r = rate_of[s]
+        if not known[s]:
+            values[s] = kernel(m, s, t, a, ad, p)
+            known[s] = True
+        if r >= 0 and not known[r]:
+            values[r] = kernel(m, r, t, a, ad, p)
+            known[r] = True
 
 
 @jitable
-def _start_values(prob, m, w0, w1, t0, y0, y1, work):
-    """The watched values (and rates) at the step's start, into g_prev and r_prev."""
-    tab = prob.tables
-    work.known[:] = False
-    for w in range(w0, w1):
-        s = tab.surface[w]
-        work.g_prev[w - w0] = _sample(prob, m, s, t0, y0, y1, work)
-        if tab.surface_rate[s] >= 0:
-            work.r_prev[w - w0] = _sample(prob, m, tab.surface_rate[s], t0, y0, y1, work)
+def _turns(direction, ga, ra, rb):
+    """Whether a surface on the watched side at both ends (value ga) has a rate that turns from
+    approaching zero (ra) to leaving it (rb): the only way it can cross and come back."""
+    return (direction >= 0 and ga < 0.0 and ra > 0.0 > rb) or (direction <= 0 and ga > 0.0 and ra < 0.0 < rb)
 
 
 @jitable
@@ -243,14 +254,22 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     Returns (w, t): the transition's row and the located far-side time; w = -1 when nothing
     crosses, NONFINITE when a value is not finite.  ``have_start``: work.g_prev and
     work.r_prev already hold the values at t0 (the previous step's end); with no crossing,
-    they hold the values at t1 on return.
+    they hold the values at t1 on return.  (Runs once per step: the arrays it reads are taken
+    out of their tuples once, and the rare locating calls only are calls.)
     """
     tab = prob.tables
-    w0, w1 = tab.watch_start[m], tab.watch_start[m + 1]
+    surface_of = tab.data[tab.surface:tab.surface + tab.n_transitions]
+    direction_of = tab.data[tab.direction:tab.direction + tab.n_transitions]
+    rate_of = tab.data[tab.surface_rate:tab.surface_rate + tab.n_surfaces]
+    g_prev, r_prev, values, known = work.g_prev, work.r_prev, work.values, work.known
+    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
     h = t1 - t0
     n_int = cfg.interior_points
     if not have_start:
-        _start_values(prob, m, w0, w1, t0, y0, y1, work)
+        _values_at(prob, m, w0, w1, t0, y0, y1, values, known)
+        for w in range(w0, w1):
+            g_prev[w - w0] = values[surface_of[w]]
+            r_prev[w - w0] = values[rate_of[surface_of[w]]] if rate_of[surface_of[w]] >= 0 else 0.0
     best_w, best_t = -1, math.inf
     found = 0
     for i in range(1, n_int + 2):
@@ -263,31 +282,32 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
             a, ad = n0, n1
         else:
             a, ad = dense_eval(tb, t0, h, y0, y1, Q)
-        work.known[:] = False
+        _values_at(prob, m, w0, w1, tb, a, ad, values, known)
         for w in range(w0, w1):
             k = w - w0
             if (found >> k) & 1:
                 continue
-            s, direction, rate = tab.surface[w], tab.direction[w], tab.surface_rate[tab.surface[w]]
-            ga, gb = work.g_prev[k], _sample(prob, m, s, tb, a, ad, work)
+            s, direction = surface_of[w], direction_of[w]
+            rate = rate_of[s]
+            ga, gb = g_prev[k], values[s]
             if not (math.isfinite(ga) and math.isfinite(gb)):
                 return NONFINITE, tb
-            rb = _sample(prob, m, rate, tb, a, ad, work) if rate >= 0 else 0.0
+            rb = values[rate] if rate >= 0 else 0.0
             tk = -1.0
             if crossed(ga, gb, direction):
                 lo, glo, genuine = ta, ga, True
                 if rate >= 0:
                     lo, glo, genuine = turned_back(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
-                                                   work.r_prev[k], rb)
+                                                   r_prev[k], rb)
                 if genuine:
                     tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, lo, tb, glo, gb, cfg.xtol)
-            elif rate >= 0:
+            elif rate >= 0 and _turns(direction, ga, r_prev[k], rb):
                 t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
-                                                work.r_prev[k], rb)
+                                                r_prev[k], rb)
                 if t_ext >= 0.0:
                     tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, ta, t_ext, ga, g_ext, cfg.xtol)
-            work.g_prev[k] = gb
-            work.r_prev[k] = rb
+            g_prev[k] = gb
+            r_prev[k] = rb
             if tk >= 0.0:
                 found |= 1 << k
                 if tk < best_t:
@@ -300,19 +320,20 @@ def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
     """A step that starts exactly on a watched surface (value 0) and ends strictly on its
     leaving side has left mode m at its start: the transition's row, or -1."""
     tab = prob.tables
-    for w in range(tab.watch_start[m], tab.watch_start[m + 1]):
-        s = tab.surface[w]
-        if value(prob, m, s, t0, y0, y1) == 0.0 and tab.direction[w] * value(prob, m, s, t1, n0, n1) > 0.0:
+    for w in range(tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]):
+        s = tab.data[tab.surface + w]
+        leaving = tab.data[tab.direction + w] * value(prob, m, s, t1, n0, n1) > 0.0
+        if leaving and value(prob, m, s, t0, y0, y1) == 0.0:
             return w
     return -1
 
 
 @jitable
-def zero_at_start(prob, m, work):
-    """Whether a watched value was exactly 0 at the step's start (a start on its surface)."""
-    tab = prob.tables
-    for k in range(tab.watch_start[m + 1] - tab.watch_start[m]):
-        if work.g_prev[k] == 0.0:
+def zero_at_start(g_prev, n_watched):
+    """Whether a watched value was exactly 0 at the step's start (a start on its surface):
+    g_prev[:n_watched] are the values first_crossing kept."""
+    for k in range(n_watched):
+        if g_prev[k] == 0.0:
             return True
     return False
 
@@ -322,7 +343,7 @@ def zero_at_start(prob, m, work):
 def across(prob, m, w, t, a, ad):
     """Whether the state is across transition w's surface (or on it), in its direction."""
     tab = prob.tables
-    return tab.direction[w] * value(prob, m, tab.surface[w], t, a, ad) >= 0.0
+    return tab.data[tab.direction + w] * value(prob, m, tab.data[tab.surface + w], t, a, ad) >= 0.0
 
 
 @jitable
@@ -330,7 +351,7 @@ def switch(prob, w, t, a, ad, cfg, buf):
     """The mode after transition w fires at (t, a, ad), and the state after its reset."""
     tab = prob.tables
     m_new = target(prob, w, t, a, ad, cfg.look_ahead)
-    j = tab.reset[w]
+    j = tab.data[tab.reset + w]
     if j >= 0:
         prob.kernels.reset(j, t, a, ad, prob.p, buf)
         return m_new, buf[0], buf[1]

@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .jit import jitable
 
 SAFETY = 0.9
@@ -37,56 +35,68 @@ def _norm(x0, x1):
 
 
 @jitable
-def stages(prob, m, t, y0, y1, h, method, K, first, last):
-    """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y))."""
-    A, C, rhs, p = method.A, method.C, prob.kernels.rhs, prob.p
+def spacing(t):
+    """np.nextafter(t, inf) - t, SciPy's unit of the smallest step, from frexp (a NumPy ufunc
+    costs a second of the compiled loop's first compile)."""
+    if t == 0.0:
+        return 5e-324
+    m, e = math.frexp(t)
+    if m == -0.5:  # t < 0 a power of two: the next float towards +inf is half as far
+        e -= 1
+    return max(math.ldexp(1.0, e - 53), 5e-324)
+
+
+@jitable
+def stages(rhs, p, m, t, y0, y1, h, coef, c_row, K, first, last):
+    """Fill K[first:last] with the stages f(t + c_s h, y + h sum_j a_sj K_j) (K[0] = f(t, y));
+    a_sj = coef[s, j], c_s = coef[c_row, s] (a :class:`~camdyn.engine.tableau.Method`'s)."""
     for s in range(first, last):
         d0 = 0.0
         d1 = 0.0
         for j in range(s):
-            a = A[s, j]
+            a = coef[s, j]
             d0 += K[j, 0] * a
             d1 += K[j, 1] * a
         z1 = y1 + d1 * h
         K[s, 0] = z1
-        K[s, 1] = rhs(m, t + C[s] * h, y0 + d0 * h, z1, p)
+        K[s, 1] = rhs(m, t + coef[c_row, s] * h, y0 + d0 * h, z1, p)
 
 
 @jitable
-def step_impl(prob, m, t, y0, y1, h, method, K):
+def step_impl(rhs, p, m, t, y0, y1, h, method, K):
     """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
-    B, n = method.B, method.n_stages
-    stages(prob, m, t, y0, y1, h, method, K, 1, n)
+    coef, b, n = method.coef, method.b_row, method.n_stages
+    stages(rhs, p, m, t, y0, y1, h, coef, method.c_row, K, 1, n)
     d0 = 0.0
     d1 = 0.0
     for j in range(n):
-        d0 += K[j, 0] * B[j]
-        d1 += K[j, 1] * B[j]
+        d0 += K[j, 0] * coef[b, j]
+        d1 += K[j, 1] * coef[b, j]
     n0 = y0 + h * d0
     n1 = y1 + h * d1
     K[n, 0] = n1
-    K[n, 1] = prob.kernels.rhs(m, t + h, n0, n1, prob.p)
+    K[n, 1] = rhs(m, t + h, n0, n1, p)
     return n0, n1
 
 
 @jitable
 def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
     """SciPy's error norm of the attempt (RK45: embedded difference; DOP853: 5th/3rd blend)."""
-    E, E3, n = method.E, method.E3, method.n_stages
+    coef, e, e3, n = method.coef, method.e_row, method.e3_row, method.n_stages
     s0 = atol + max(abs(y0), abs(n0)) * rtol
     s1 = atol + max(abs(y1), abs(n1)) * rtol
     e0 = 0.0
     e1 = 0.0
     for j in range(n + 1):
-        e0 += K[j, 0] * E[j]
-        e1 += K[j, 1] * E[j]
+        e0 += K[j, 0] * coef[e, j]
+        e1 += K[j, 1] * coef[e, j]
     if method.error_kind == 0:
         return _norm(e0 * h / s0, e1 * h / s1)
     f0 = 0.0
     f1 = 0.0
     for j in range(n + 1):
-        f0 += K[j, 0] * E3[j]
-        f1 += K[j, 1] * E3[j]
+        f0 += K[j, 0] * coef[e3, j]
+        f1 += K[j, 1] * coef[e3, j]
     e5 = (e0 / s0) ** 2 + (e1 / s1) ** 2
     e3 = (f0 / s0) ** 2 + (f1 / s1) ** 2
     if e5 == 0.0 and e3 == 0.0:
@@ -95,14 +105,14 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
 
 
 @jitable
-def step(prob, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
+def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
 
     Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections);
     K then holds the accepted attempt's stages with f(t_new, y_new) in row n_stages.
     """
     exponent = method.exponent
-    min_step = 10.0 * abs(np.nextafter(t, math.inf) - t)
+    min_step = 10.0 * spacing(t)
     if h_abs > cfg.max_step:
         h_abs = cfg.max_step
     elif h_abs < min_step:
@@ -117,7 +127,7 @@ def step(prob, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
             t_new = t_bound
         h = t_new - t
         h_abs = abs(h)
-        n0, n1 = step_impl(prob, m, t, y0, y1, h, method, K)
+        n0, n1 = step_impl(rhs, p, m, t, y0, y1, h, method, K)
         nfev += method.n_stages
         err = error_norm(K, h, y0, y1, n0, n1, cfg.rtol, cfg.atol, method)
         if err < 1.0:
@@ -133,7 +143,7 @@ def step(prob, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
 
 
 @jitable
-def initial_step(prob, m, t, y0, y1, f1, t_bound, method, cfg):
+def initial_step(rhs, p, m, t, y0, y1, f1, t_bound, method, cfg):
     """SciPy's ``select_initial_step`` (Hairer, Norsett & Wanner II.4), one RHS evaluation."""
     length = abs(t_bound - t)
     if length == 0.0:
@@ -152,7 +162,7 @@ def initial_step(prob, m, t, y0, y1, f1, t_bound, method, cfg):
     h0 = min(h0, length)
     z0 = y0 + h0 * y1
     z1 = y1 + h0 * f1
-    g1 = prob.kernels.rhs(m, t + h0, z0, z1, prob.p)
+    g1 = rhs(m, t + h0, z0, z1, p)
     d2 = _norm((z1 - y1) / s0, (g1 - f1) / s1) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -162,20 +172,19 @@ def initial_step(prob, m, t, y0, y1, f1, t_bound, method, cfg):
 
 
 @jitable
-def dense_coefficients(prob, m, t, y0, y1, h, method, K, Q):
+def dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q):
     """Q = K^T P after computing the extra stages (DOP853): y(t + theta h) = y + h theta (Q0 + Q1 theta + ...).
 
     Returns the number of RHS evaluations spent (the extra stages)."""
-    P, n, n_extra = method.P, method.n_stages, method.n_extra
+    coef, n, n_extra, p0 = method.coef, method.n_stages, method.n_extra, method.p_row
     if n_extra:
-        stages(prob, m, t, y0, y1, h, method, K, n + 1, n + 1 + n_extra)
-    rows, deg = P.shape
-    for k in range(deg):
+        stages(rhs, p, m, t, y0, y1, h, coef, method.c_row, K, n + 1, n + 1 + n_extra)
+    for k in range(method.degree):
         q0 = 0.0
         q1 = 0.0
-        for j in range(rows):
-            q0 += K[j, 0] * P[j, k]
-            q1 += K[j, 1] * P[j, k]
+        for j in range(method.n_rows):
+            q0 += K[j, 0] * coef[p0 + j, k]
+            q1 += K[j, 1] * coef[p0 + j, k]
         Q[0, k] = q0
         Q[1, k] = q1
     return n_extra

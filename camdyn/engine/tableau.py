@@ -179,20 +179,25 @@ TABLEAUS = {"RK45": DOPRI5, "DOP853": DOP853}
 
 
 class Method(NamedTuple):
-    """A tableau as the arrays the stepper reads (:mod:`camdyn.engine.stepper`).
+    """A tableau as the one coefficient array the stepper reads (:mod:`camdyn.engine.stepper`).
 
-    ``A`` and ``C`` hold the stages, then a row for the first-same-as-last stage (``A`` row = b,
-    ``C`` = 1), then the extra stages of the interpolant (DOP853); ``P`` is the dense output in
-    power form over all of them."""
+    ``coef`` rows ``0 .. n_rows - 1`` are the stage matrix A: the stages, then a row for the
+    first-same-as-last stage (its row is b), then the extra stages of the interpolant (DOP853);
+    rows ``c_row``, ``b_row``, ``e_row``, ``e3_row`` are c (1 for the FSAL stage), b, e and e3;
+    rows ``p_row ..`` are the dense output in power form, one row per stage, ``degree`` columns.
+    One array, not six: compiled code pays an atomic reference count per array for every call
+    that passes the method (a few per step)."""
 
-    A: np.ndarray
-    C: np.ndarray
-    B: np.ndarray
-    E: np.ndarray
-    E3: np.ndarray
-    P: np.ndarray
+    coef: np.ndarray
     n_stages: int
     n_extra: int
+    n_rows: int        # stages + FSAL + extra stages
+    c_row: int
+    b_row: int
+    e_row: int
+    e3_row: int
+    p_row: int
+    degree: int        # columns of the dense output
     error_kind: int    # position in ERROR_KINDS
     exponent: float    # step-size control exponent, -1 / (error_order + 1)
     order: int         # of the propagated solution
@@ -202,17 +207,23 @@ def arrays(tab: Tableau) -> Method:
     """The tableau as the :class:`Method` the stepper takes."""
     s, x = tab.n_stages, tab.n_extra
     total = s + 1 + x
-    A = np.zeros((total, total))
-    A[:s, :s] = tab.a
-    A[s, :s] = tab.b
+    dense = np.array(tab.dense, float)
+    degree = dense.shape[1]
+    c_row, b_row, e_row, e3_row, p_row = total, total + 1, total + 2, total + 3, total + 4
+    coef = np.zeros((p_row + dense.shape[0], max(total, degree)))
+    coef[:s, :s] = tab.a
+    coef[s, :s] = tab.b
     for i, row in enumerate(tab.a_extra):
-        A[s + 1 + i, :len(row)] = row
-    C = np.zeros(total)
-    C[:s], C[s] = tab.c, 1.0
-    C[s + 1:] = tab.c_extra
-    E3 = np.array(tab.e3 if tab.e3 else np.zeros(s + 1), float)
-    return Method(A, C, np.array(tab.b, float), np.array(tab.e, float), E3, np.array(tab.dense, float),
-                  s, x, ERROR_KINDS.index(tab.error_kind), -1.0 / (tab.error_order + 1), tab.order)
+        coef[s + 1 + i, :len(row)] = row
+    coef[c_row, :s], coef[c_row, s] = tab.c, 1.0
+    coef[c_row, s + 1:total] = tab.c_extra
+    coef[b_row, :s] = tab.b
+    coef[e_row, :len(tab.e)] = tab.e
+    if tab.e3:
+        coef[e3_row, :len(tab.e3)] = tab.e3
+    coef[p_row:, :degree] = dense
+    return Method(coef, s, x, total, c_row, b_row, e_row, e3_row, p_row, degree,
+                  ERROR_KINDS.index(tab.error_kind), -1.0 / (tab.error_order + 1), tab.order)
 
 
 def stages_per_step(tab: Tableau, dense: bool) -> int:

@@ -6,6 +6,11 @@ A generated module states its automaton as data (``MODES``, ``SURFACES``, ``INIT
 compressed rows, so that mode m's transitions are ``watch_start[m]:watch_start[m + 1]`` and a
 transition's candidate targets are ``target_start[w]:target_start[w + 1]``; the initial choice
 is the candidate row after the last transition.  Nothing is found by name at run time.
+
+All the tables are one integer array, ``data``, and each field of :class:`Tables` is where its
+table starts in it: table ``surface``'s entry w is ``tab.data[tab.surface + w]``.  One array,
+not twelve, because compiled code pays an atomic reference count per array for every call that
+passes the tables (measured on the sliding benchmark, benchmarks/floor.py: ~0.2 us per call).
 """
 from __future__ import annotations
 
@@ -21,28 +26,28 @@ IDENTITY = -1
 
 
 class Tables(NamedTuple):
-    mode_contact: np.ndarray       # per mode: 1 in contact, 0 in free flight
-    watch_start: np.ndarray        # per mode, and one past the end: its transitions (rows)
-    surface: np.ndarray            # per transition: the surface it watches
-    direction: np.ndarray          # per transition: +1 (upward crossing) or -1 (downward)
-    reset: np.ndarray              # per transition: the reset kernel's index, IDENTITY for none
-    target_start: np.ndarray       # per transition, then the initial choice, then the end: candidates
-    target_mode: np.ndarray        # per candidate: the mode entered
-    condition_start: np.ndarray    # per candidate, and the end: its conditions
-    condition_surface: np.ndarray  # per condition: the surface
-    condition_sign: np.ndarray     # per condition: holds where sign * value >= 0
-    surface_rate: np.ndarray       # per surface: the surface that is its time derivative, or -1
-    flows: np.ndarray              # the outputs integrated by the energy ledger (P_in, D_c, D_f)
+    data: np.ndarray               # every table below, one after the other (int64)
+    mode_contact: int              # per mode: 1 in contact, 0 in free flight
+    watch_start: int               # per mode, and one past the end: its transitions (rows)
+    surface: int                   # per transition: the surface it watches
+    direction: int                 # per transition: +1 (upward crossing) or -1 (downward)
+    reset: int                     # per transition: the reset kernel's index, IDENTITY for none
+    target_start: int              # per transition, then the initial choice, then the end: candidates
+    target_mode: int               # per candidate: the mode entered
+    condition_start: int           # per candidate, and the end: its conditions
+    condition_surface: int         # per condition: the surface
+    condition_sign: int            # per condition: holds where sign * value >= 0
+    surface_rate: int              # per surface: the surface that is its time derivative, or -1
+    flows: int                     # the outputs integrated by the energy ledger (P_in, D_c, D_f)
+    n_modes: int
+    n_transitions: int
+    n_surfaces: int
     n_outputs: int
-
-
-def _int(values) -> np.ndarray:
-    return np.ascontiguousarray(values, dtype=np.int64)
 
 
 def tables(K: ModuleType) -> Tables:
     """The tables of a generated scene module ``K``."""
-    transitions = sorted(K.TRANSITIONS, key=lambda tr: tr[0])  # grouped by source, order kept
+    transitions = transition_rows(K)
     n_modes = len(K.MODES)
     watch_start = np.searchsorted([tr[0] for tr in transitions], np.arange(n_modes + 1), side="left")
     target_start, target_mode, condition_start, condition_surface, condition_sign = [0], [], [0], [], []
@@ -55,10 +60,12 @@ def tables(K: ModuleType) -> Tables:
             condition_start.append(len(condition_surface))
         target_start.append(len(target_mode))
     resets = [IDENTITY if K.RESETS[tr[4]] == "identity" else tr[4] for tr in transitions]
-    return Tables(_int(K.CONTACT_OF_MODE), _int(watch_start), _int([tr[1] for tr in transitions]),
-                  _int([tr[2] for tr in transitions]), _int(resets), _int(target_start), _int(target_mode),
-                  _int(condition_start), _int(condition_surface), _int(condition_sign),
-                  _int(K.RATE_OF_SURFACE), _int([K.OUTPUTS.index(f) for f in FLOWS]), len(K.OUTPUTS))
+    parts = [K.CONTACT_OF_MODE, watch_start, [tr[1] for tr in transitions], [tr[2] for tr in transitions], resets,
+             target_start, target_mode, condition_start, condition_surface, condition_sign, K.RATE_OF_SURFACE,
+             [K.OUTPUTS.index(f) for f in FLOWS]]
+    starts = np.cumsum([0] + [len(part) for part in parts])[:-1]
+    data = np.ascontiguousarray(np.concatenate([np.asarray(part, dtype=np.int64) for part in parts]), dtype=np.int64)
+    return Tables(data, *map(int, starts), n_modes, len(transitions), len(K.SURFACES), len(K.OUTPUTS))
 
 
 def transition_rows(K: ModuleType) -> list[tuple]:

@@ -174,10 +174,10 @@ def peer_field(model: Model):
     kern = compiled_kernels(model.kernels)
     tab = tables(model.kernels)
     rhs, surface = kern.rhs, kern.surface
-    ws, sf, dr = tab.watch_start, tab.surface, tab.direction
-    ts, tm, cs, csf, csg = tab.target_start, tab.target_mode, tab.condition_start, tab.condition_surface, \
-        tab.condition_sign
-    initial = int(sf.shape[0])
+    ws, sf, dr, ts, tm, cs, csf, csg = (np.ascontiguousarray(tab.data[offset:]) for offset in (
+        tab.watch_start, tab.surface, tab.direction, tab.target_start, tab.target_mode, tab.condition_start,
+        tab.condition_surface, tab.condition_sign))
+    initial = tab.n_transitions
 
     @njit(error_model="numpy")
     def target(row, t, a, ad, p):
@@ -387,19 +387,19 @@ def _engine_partial(prob, method, cfg, m, t, t_end, y0, y1, level):
     """The engine's stepper in one mode (level 0), + its dense output every step (1), + its
     crossing check rules.first_crossing every step (2): a diagnostic, not the floor."""
     tab = prob.tables
-    K = np.empty((method.A.shape[0], 2))
-    Q = np.empty((2, method.P.shape[1]))
-    work = rules.Scratch(np.zeros(max(1, tab.surface.shape[0])), np.zeros(max(1, tab.surface.shape[0])),
-                         np.zeros(max(1, tab.surface_rate.shape[0])),
-                         np.zeros(max(1, tab.surface_rate.shape[0]), dtype=np.bool_))
-    K[0, 0], K[0, 1] = y1, prob.kernels.rhs(m, t, y0, y1, prob.p)
-    h = stepper.initial_step(prob, m, t, y0, y1, K[0, 1], t_end, method, cfg)
+    rhs, p = prob.kernels.rhs, prob.p
+    K = np.empty((method.n_rows, 2))
+    Q = np.empty((2, method.degree))
+    work = rules.Scratch(np.zeros(max(1, tab.n_transitions)), np.zeros(max(1, tab.n_transitions)),
+                         np.zeros(max(1, tab.n_surfaces)), np.zeros(max(1, tab.n_surfaces), dtype=np.bool_))
+    K[0, 0], K[0, 1] = y1, rhs(m, t, y0, y1, p)
+    h = stepper.initial_step(rhs, p, m, t, y0, y1, K[0, 1], t_end, method, cfg)
     steps, crossings, have_start, n = 0, 0, False, method.n_stages
     while t < t_end:
-        _, t_new, n0, n1, h_next, _, _ = stepper.step(prob, m, t, y0, y1, h, t_end, method, K, cfg)
+        _, t_new, n0, n1, h_next, _, _ = stepper.step(rhs, p, m, t, y0, y1, h, t_end, method, K, cfg)
         steps += 1
         if level >= 1:
-            stepper.dense_coefficients(prob, m, t, y0, y1, t_new - t, method, K, Q)
+            stepper.dense_coefficients(rhs, p, m, t, y0, y1, t_new - t, method, K, Q)
         if level >= 2:
             w, _ = rules.first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
             have_start = True
@@ -427,31 +427,41 @@ def engine_pieces(model, run, args, mode: int, rounds: int) -> dict:
 
 
 @njit(error_model="numpy")
-def _sample_loop(prob, work, m, s, n, a, ad):
+def _sample_loop(prob, work, m, n, a, ad):
+    tab = prob.tables
+    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
     acc = 0.0
     for i in range(n):
-        work.known[s] = False
-        acc += rules._sample(prob, m, s, i * 1e-8, a, ad, work)
+        rules._values_at(prob, m, w0, w1, i * 1e-8, a, ad, work.values, work.known)
+        acc += work.values[0]
     return acc
 
 
 @njit(error_model="numpy")
-def _direct_loop(prob, work, m, s, n, a, ad):
+def _direct_loop(prob, work, m, n, a, ad):
+    """The same surface values as _sample_loop, by direct kernel calls in the loop."""
+    tab = prob.tables
+    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
+    surface, p, values = prob.kernels.surface, prob.p, work.values
     acc = 0.0
-    surface, p = prob.kernels.surface, prob.p
     for i in range(n):
-        work.known[s] = False
-        acc += surface(m, s, i * 1e-8, a, ad, p)
+        for w in range(w0, w1):
+            s = tab.data[tab.surface + w]
+            values[s] = surface(m, s, i * 1e-8, a, ad, p)
+            r = tab.data[tab.surface_rate + s]
+            if r >= 0:
+                values[r] = surface(m, r, i * 1e-8, a, ad, p)
+        acc += values[0]
     return acc
 
 
 def call_costs(model, args, mode: int, calls: int = 200_000) -> dict:
-    """ns per call: the engine's per-sample helper rules._sample (Problem and Scratch named tuples
-    passed by value) against the surface kernel it wraps, both in a compiled loop."""
-    work = rules.scratch(args.prob.tables.surface.shape[0], args.prob.tables.surface_rate.shape[0])
+    """ns per sample: the engine's per-sample helper rules._values_at (the mode's watched surfaces
+    and their rates, each once) against the same kernel calls made directly, both compiled."""
+    work = rules.scratch(args.prob.tables.n_transitions, args.prob.tables.n_surfaces)
     a, ad = args.start.alpha, args.start.alpha_dot
-    fns = {"rules._sample(prob, ..., work)": lambda: _sample_loop(args.prob, work, mode, 0, calls, a, ad),
-           "surface kernel, direct": lambda: _direct_loop(args.prob, work, mode, 0, calls, a, ad)}
+    fns = {"rules._values_at(prob, ...)": lambda: _sample_loop(args.prob, work, mode, calls, a, ad),
+           "the same kernel calls, direct": lambda: _direct_loop(args.prob, work, mode, calls, a, ad)}
     for fn in fns.values():
         fn()
     times = floor.interleaved(fns, 7)
@@ -702,10 +712,11 @@ def engine_time_lines(fs: dict) -> list[str]:
              "| engine pieces | us per step |", "|---|---|"]
     lines += [f"| {k} | {v:.2f} |" for k, v in pieces.items()]
     (k1, ns1), (k2, ns2) = calls.items()
-    lines += ["", f"A call of `{k1}` costs {ns1:.0f} ns against {ns2:.0f} ns for the surface kernel it wraps "
-              "(both in a compiled loop): the `Problem` (13 arrays) and `Scratch` (4 arrays) named tuples go by "
-              "value into functions numba does not inline, and each such call increments and decrements the "
-              "reference count of every array in them.  `rules.first_crossing` makes ~12 such calls per step.", "",
+    lines += ["", f"A sample's surface values through `{k1}` cost {ns1:.0f} ns against {ns2:.0f} ns for the "
+              "same kernel calls made directly (both in a compiled loop).  Every call that passes a tuple of "
+              "arrays increments and decrements the reference count of each array in it; the automaton's "
+              "tables and the method are therefore one array each, and first_crossing calls this helper "
+              "once per sample.", "",
               f"`integrate()` on the same run (Python set-up of the tables, method and settings, and the "
               f"Trajectory, included): {rep.integrate_s * 1e3:.2f} ms against "
               f"{min(rep.times[floor.ENGINE]) * 1e3:.2f} ms for `run_compiled` alone."]

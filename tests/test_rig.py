@@ -325,3 +325,22 @@ def test_import_does_not_import_sympy():
     code = "import sys, camdyn.rig; sys.exit(any(m.split('.')[0] == 'sympy' for m in sys.modules))"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
     assert subprocess.run([sys.executable, "-c", code], env=env).returncode == 0
+
+
+def test_shipped_rig_files_state_each_parameters_meaning_and_unit():
+    """Issue 14 (R): every parameter line of a shipped TOML rig ends with the meaning and SI unit
+    of camdyn.rig.PARAMETERS (as Rig.to_toml writes them), so a user editing a file sees units."""
+    import re
+    from importlib.resources import files
+
+    from camdyn.rig import PARAMETERS
+
+    by_name = {p.name: p for p in PARAMETERS}
+    for path in files("camdyn.data").iterdir():
+        if not path.name.endswith(".toml"):
+            continue
+        lines = path.read_text(encoding="utf-8").split("[parameters]", 1)[1].splitlines()
+        params = [re.match(r"^(\w+)\s*=\s*[^#]*#\s*(.*)$", line) for line in lines if re.match(r"^\w+\s*=", line)]
+        assert params and all(params), path.name
+        for m in params:
+            assert m.group(2) == by_name[m.group(1)].meaning, (path.name, m.group(1))

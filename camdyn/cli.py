@@ -806,6 +806,23 @@ def cmd_scenes(args) -> int:
     return EXIT_OK
 
 
+def cmd_cache(args) -> int:
+    """List camdyn's compiled-code caches of this user, or clear them."""
+    from .engine import cache
+
+    if args.clear or args.clear_stale:
+        removed = cache.clear(stale_only=args.clear_stale)
+        print(f"removed {len(removed)} cache folder(s)" + "".join(f"\n  {d}" for d in removed))
+        return EXIT_OK
+    entries = cache.entries()
+    print(f"camdyn's compiled code for this user: {cache.user_cache_root()} (set {cache.ENV} to move it)")
+    if not entries:
+        print("  empty: the first run compiles the engine")
+    for folder, size, current in entries:
+        print(f"  {folder.name}  {size / 1e6:.1f} MB  {'current' if current else 'stale (another camdyn or engine)'}")
+    return EXIT_OK
+
+
 # --------------------------------------------------------------------------- parser
 class _Parser(argparse.ArgumentParser):
     """argparse that raises UsageError (one line, exit 2) instead of printing usage and exiting;
@@ -1107,6 +1124,15 @@ def _parser() -> argparse.ArgumentParser:
     p = command("scenes", "list the generated scenes and the shipped rigs",
                 "example:\n  camdyn scenes --json", cmd_scenes)
     p.add_argument("--json", action="store_true", help="print scenes, rigs and scene options as JSON")
+
+    p = command("cache", "list or clear the compiled code camdyn keeps for this user",
+                "examples:\n  camdyn cache\n  camdyn cache --clear-stale\n\n"
+                "The engine and each scene's kernels are compiled on first use and kept per user (never in\n"
+                "the installed package), one folder per camdyn version and engine source.", cmd_cache)
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--clear", action="store_true", help="delete every cache folder (the next run compiles again)")
+    g.add_argument("--clear-stale", action="store_true", dest="clear_stale",
+                   help="delete the folders of other camdyn versions or engines only")
     return parser
 
 

@@ -415,3 +415,31 @@ def test_backend_and_method_help_state_the_real_defaults_and_names(capsys):
         text = " ".join(_help(command, capsys).split())
         assert f"(default: {cli._default_backend()};" in text and "{default_backend}" not in text
         assert f"{', '.join(backends)} (default" in text and f"{', '.join(methods)} (default: DOP853)" in text
+
+
+def test_cache_lists_and_clears_only_what_it_is_asked_to(tmp_path, monkeypatch, capsys):
+    """`camdyn cache` lists the per-user cache folders; --clear-stale keeps the current one."""
+    from camdyn.engine import cache
+
+    monkeypatch.setenv("CAMDYN_CACHE_DIR", str(tmp_path))
+    (tmp_path / cache.engine_key() / "numba").mkdir(parents=True)
+    (tmp_path / cache.engine_key() / "numba" / "x.nbi").write_bytes(b"0" * 1000)
+    (tmp_path / "0.0.1-oldengine").mkdir()
+    assert main(["cache"]) == 0
+    out = capsys.readouterr().out
+    assert str(tmp_path) in out and f"{cache.engine_key()}" in out and "current" in out and "stale" in out
+    assert main(["cache", "--clear-stale"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == [cache.engine_key()]
+    assert main(["cache", "--clear"]) == 0
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_compiled_run_writes_nothing_inside_the_package():
+    """Issue 12 (8): numba's cache goes to the per-user folder, not next to camdyn's files."""
+    from pathlib import Path
+
+    import camdyn.generated
+
+    camdyn.simulate(camdyn.example_rig(), camdyn.Scene(), speed_rpm=300, t_end=1e-3)
+    for root in (Path(camdyn.__file__).parent, Path(camdyn.generated.__file__).parent):
+        assert not [p for p in root.rglob("*") if p.suffix in (".nbi", ".nbc")], root

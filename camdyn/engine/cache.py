@@ -148,6 +148,12 @@ def install() -> bool:
 
 
 def loop_cached() -> bool:
-    """Whether the compiled loop of this camdyn and engine is in the cache (numba's index file
-    of ``camdyn.engine.loop``'s compiled entry point)."""
-    return any((cache_dir() / "numba").rglob("loop._run_compiled-*.nbi"))
+    """Whether the compiled loop of this camdyn, engine and source file is in the cache: numba's
+    index for ``camdyn.engine.loop``'s entry point exists and matches the file (numba keys it by
+    the file's path and time stamp, so another checkout of the same engine does not count)."""
+    from .loop import _run_compiled
+
+    try:
+        return bool(_run_compiled._cache._cache_file._load_index())
+    except (AttributeError, OSError):  # numba's internals moved: any index of the loop
+        return any((cache_dir() / "numba").rglob("loop._run_compiled-*.nbi"))

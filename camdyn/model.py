@@ -15,6 +15,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
+from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT
 from .engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
@@ -155,7 +156,7 @@ class Model:
         """(d alpha_ddot/d alpha, d alpha_ddot/d alpha_dot) in mode m (Eqs. 21-22)."""
         out = np.empty(2)
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
-        return float(out[0]), float(out[1])
+        return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
 
     def outputs(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
         """The output quantities (``OUTPUTS``) in mode m at one state, by name."""

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .cam import CamMotion, ConstantSpeed
+from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, integrate
 from .errors import ParameterError
@@ -136,7 +137,7 @@ def _result(model: Model, traj, backend: str) -> Result:
     if traj.y.shape[0] == 5:
         for i, name in enumerate(("work_in", "dissipated_contact", "dissipated_friction")):
             outputs[name] = traj.y[2 + i].copy()
-    theta = np.broadcast_to(model.cam_state(t)[0], t.shape).astype(float) if t.size else t.copy()
+    theta = np.broadcast_to(model.cam_state(t)[CAM_THETA], t.shape).astype(float) if t.size else t.copy()
     contact = dict(zip(K.MODES, map(bool, K.CONTACT_OF_MODE)))
     return Result(t, alpha, alpha_dot, theta, traj.regime.astype(str), outputs, traj.switches,
                   traj.outcome, traj.stats, model.period, model.scene.slug, model.equilibrium.alpha,

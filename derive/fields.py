@@ -26,7 +26,7 @@ from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
 from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
-from .vocabulary import OUTPUTS, SceneSpec
+from .vocabulary import JACOBIAN, OUTPUTS, SceneSpec
 
 
 @dataclass(frozen=True)
@@ -134,8 +134,8 @@ def jacobian(spec: SceneSpec, mode: Mode) -> Kernel:
     f = field(spec, mode)
     by_alpha = derivatives(f.definitions, S.alpha_s)
     by_rate = derivatives(f.definitions, S.alpha_dot)
-    results = (derivative_symbol("alpha_ddot", S.alpha_s, by_alpha),
-               derivative_symbol("alpha_ddot", S.alpha_dot, by_rate))
+    by = {"d_alpha": (S.alpha_s, by_alpha), "d_alpha_dot": (S.alpha_dot, by_rate)}
+    results = tuple(derivative_symbol("alpha_ddot", *by[name]) for name in JACOBIAN)
     return Kernel(f.definitions + by_alpha + by_rate, results).pruned()
 
 

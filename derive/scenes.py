@@ -26,7 +26,7 @@ from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
 from .graph import Definition, quantity
-from .vocabulary import OPTIONS, OUTPUTS, SceneOptionError, SceneSpec  # noqa: F401  (re-exported)
+from .vocabulary import CAM_STATE, OPTIONS, OUTPUTS, SceneOptionError, SceneSpec  # noqa: F401  (re-exported)
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
 
@@ -121,7 +121,7 @@ def build(spec: SceneSpec) -> SceneModule:
     functions = []
     if spec.motion != "user":
         sub = motion_substitution(spec.motion)
-        functions.append(Function("cam", ("t", "p"), (), ("Theta", "Theta_dot", "Theta_ddot"),
+        functions.append(Function("cam", ("t", "p"), (), CAM_STATE,
                                   _single(*(sp.sympify(sub[k]) for k in (S.Theta_s, S.Theta_dot, S.Theta_ddot))),
                                   f"Cam angle and its rates at time t: {spec.motion} motion (Section 7); "
                                   "t may be an array.", "numpy"))

@@ -191,5 +191,12 @@ OUTPUTS: dict[str, tuple[str, str]] = {
     "D_c": ("W", "power dissipated by contact damping"),
     "D_f": ("W", "power dissipated by friction"),
 }
+#: the entries the generated ``jacobian`` kernel writes to ``out``, in order: the partial
+#: derivatives of alpha_ddot by alpha and by alpha_dot (Eqs. 21-22)
+JACOBIAN = ("d_alpha", "d_alpha_dot")
+JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
+#: the cam's state as the generated ``cam`` kernel and a user's cam motion return it
+CAM_STATE = ("Theta", "Theta_dot", "Theta_ddot")
+CAM_THETA, CAM_THETA_DOT, CAM_THETA_DDOT = range(len(CAM_STATE))
 #: the power flows integrated by the energy ledger (work of the drive, contact damping, friction)
 FLOWS = ("P_in", "D_c", "D_f")

@@ -15,14 +15,15 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
+from .derive.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
 from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT
 from .engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
 from .scene import Scene
 
-_DERIVED = ("alpha_star", "chi_star", "vartheta")
-_CAM = ("Omega_c", "Theta_p", "omega_c")
+_DERIVED = EQUILIBRIUM_NAMES  # computed here, not given by the rig
+_CAM = CAM_NAMES              # given by the cam motion
 
 
 @dataclass(frozen=True)

@@ -37,36 +37,31 @@ import sys
 from dataclasses import dataclass
 from numbers import Real
 from pathlib import Path
-from typing import Any, Callable, Collection, Mapping, NamedTuple
+from typing import Any, Collection, Mapping
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
+from .derive.parameters import RIG_PARAMETERS, RigParameter, Rule
 from .errors import ParameterError, RigFileError
 
 __all__ = ["PARAMETERS", "Parameter", "Rule", "Rig"]
 
 
-class Rule(NamedTuple):
-    """One condition on a parameter's value.
-
-    ``test(x, known)`` gets the value as a float and the already validated parameters
-    before it in :data:`PARAMETERS` (so ``e`` can be compared with ``r_c``).
-    ``text`` says what the value must be; ``hint`` explains a failure; ``guard`` marks a
-    unit-plausibility check rather than a physical range.
-    """
-
-    text: str
-    test: Callable[[float, Mapping[str, float]], bool]
-    hint: str = ""
-    guard: bool = False
+#: the units of :data:`PARAMETERS` that people read differently ("1": a pure number)
+_UNIT_WORDS = {"1": "dimensionless"}
 
 
 @dataclass(frozen=True)
 class Parameter:
-    """One row of :data:`PARAMETERS`: a rig parameter's specification."""
+    """One rig parameter's specification, read from ``camdyn.derive.parameters`` (where it
+    is declared once, beside the SymPy symbol the derivation makes of it).
+
+    ``rules``: the :class:`~camdyn.derive.parameters.Rule` s its value must satisfy, in order;
+    a rule may compare with a parameter declared before it (``e < r_c``).
+    """
 
     name: str
     unit: str
@@ -74,6 +69,11 @@ class Parameter:
     required: bool
     ref: str
     rules: tuple[Rule, ...] = ()
+
+    @classmethod
+    def declared(cls, row: RigParameter) -> Parameter:
+        return cls(row.name, _UNIT_WORDS.get(row.unit, row.unit), row.description, row.required, row.ref,
+                   row.rules)
 
     @property
     def valid(self) -> str:
@@ -87,7 +87,7 @@ class Parameter:
 
     def check(self, value: Any, known: Mapping[str, float]) -> float | None:
         """Return ``value`` as a float (``None`` if optional and not given) or raise
-        :class:`ParameterError`."""
+        :class:`ParameterError`; ``known``: the parameters validated before this one."""
         if value is None:
             if self.required:
                 raise ParameterError(self.name, None, "required", reason=self.meaning)
@@ -102,65 +102,16 @@ class Parameter:
             finite = "a finite real number" + ("" if self.valid == "finite" else f" {self.valid}")
             raise ParameterError(self.name, value, finite, reason=self.meaning)
         for rule in self.rules:
-            if not rule.test(x, known):
+            if not rule.holds(x, known):
                 reason = f"{self.meaning}; {rule.hint}" if rule.hint else self.meaning
                 raise ParameterError(self.name, value, rule.text, reason=reason)
         return x
 
 
-_MM = "given in mm? camdyn uses SI metres"
-_DEGREES = "given in degrees? camdyn uses radians"
-_POSITIVE = Rule("> 0", lambda x, _: x > 0)
-_NON_NEGATIVE = Rule(">= 0", lambda x, _: x >= 0)
-_LENGTH = (_POSITIVE, Rule("<= 10", lambda x, _: x <= 10.0, _MM, guard=True))
-_MODULUS = (_POSITIVE, Rule(">= 1e6", lambda x, _: x >= 1e6, "given in GPa or MPa? camdyn uses SI pascals", guard=True))
-_POISSON = (_NON_NEGATIVE, Rule("< 0.5", lambda x, _: x < 0.5))
-_ALPHA_MAX = math.pi / 2 - 0.05
-
-#: The rig parameters, in the paper's notation and SI units (Sec. 3, Fig. 1); the
-#: "0-state" is the follower just touching the cam at Theta = theta0, alpha = alpha0.
-PARAMETERS: tuple[Parameter, ...] = (
-    # required
-    Parameter("r_c", "m", "cam radius", True, "Eq. 4", _LENGTH),
-    Parameter("e", "m", "cam eccentricity, distance from the cam pivot E to the cam centre", True, "Eq. 3", (
-        _NON_NEGATIVE,
-        Rule("< r_c", lambda x, known: x < known["r_c"], "the cam pivot E must lie inside the cam disk"),
-    )),
-    Parameter("w_b", "m", "follower bar width", True, "Eq. 2", _LENGTH),
-    Parameter("chi0", "m", "distance from the follower pivot P to the contact along the bar in the 0-state", True, "Eq. 2, 5", _LENGTH),
-    Parameter("alpha0", "rad", "follower angle from the horizontal, clockwise, in the 0-state", True, "Eq. 5", (
-        Rule("in [-pi/2, pi/2]", lambda x, _: abs(x) <= math.pi / 2, _DEGREES, guard=True),
-        Rule("in (-pi/2 + 0.05, pi/2 - 0.05)", lambda x, _: abs(x) < _ALPHA_MAX, "tan and sec in Eq. 11 blow up near 90 degrees"),
-    )),
-    Parameter("theta0", "rad", "cam angle in the 0-state, counter-clockwise from the horizontal", True, "Eq. 5", (
-        Rule("in [-2 pi, 2 pi]", lambda x, _: abs(x) <= 2 * math.pi, _DEGREES, guard=True),
-    )),
-    Parameter("d_x", "m", "horizontal distance from the follower pivot P to the spring", True, "Eq. 10, 11", _LENGTH),
-    Parameter("d_y", "m", "height of the follower pivot P above the ground", True, "Eq. 11", (
-        Rule("in [-10, 10]", lambda x, _: abs(x) <= 10.0, _MM, guard=True),
-    )),
-    Parameter("L_us", "m", "free length of the follower spring", True, "Eq. 11", _LENGTH),
-    Parameter("k_s", "N/m", "follower spring stiffness", True, "Eq. 11", (_POSITIVE,)),
-    Parameter("I_Pb", "kg m^2", "moment of inertia of the follower about its pivot P", True, "Eq. 10",
-              (_POSITIVE, Rule(">= 1e-9", lambda x, _: x >= 1e-9,
-                               "given in g mm^2 or kg mm^2? camdyn uses SI kg m^2 (a follower lighter "
-                               "than 1e-9 kg m^2 has a contact mode too fast to integrate)", guard=True))),
-    Parameter("Y_c", "Pa", "Young's modulus of the cam", True, "Eq. 14", _MODULUS),
-    Parameter("Y_b", "Pa", "Young's modulus of the follower", True, "Eq. 14", _MODULUS),
-    Parameter("nu_c", "dimensionless", "Poisson's ratio of the cam", True, "Eq. 14", _POISSON),
-    Parameter("nu_b", "dimensionless", "Poisson's ratio of the follower", True, "Eq. 14", _POISSON),
-    # optional: None means "not given"
-    Parameter("l_lambda", "m", "length of the line contact", False, "Eq. 13", _LENGTH),
-    Parameter("mu_m", "dimensionless", "friction coefficient", False, "Sec. 3.2, friction models I and II", (_NON_NEGATIVE,)),
-    Parameter("s", "s/m", "smoothing factor of the tanh friction model", False, "Sec. 3.2, friction model II", (_POSITIVE,)),
-    Parameter("zeta_A", "dimensionless", "viscous damping ratio of damping model A", False, "Eq. 24", (_NON_NEGATIVE,)),
-    Parameter("zeta_D", "dimensionless", "viscous damping ratio of damping model D after maximum compression", False, "Eq. 27", (_NON_NEGATIVE,)),
-    Parameter("zeta_E", "dimensionless", "viscous damping ratio of damping model E after maximum compression", False, "Eq. 28", (_NON_NEGATIVE,)),
-    Parameter("beta_B", "s/m", "impact damping factor of damping model B", False, "Eq. 25", (_NON_NEGATIVE,)),
-    Parameter("beta_D", "s/m", "impact damping factor of damping model D up to maximum compression", False, "Eq. 27", (_NON_NEGATIVE,)),
-    Parameter("beta_C", "N s/m^1.25", "impact damping coefficient of damping model C", False, "Eq. 26", (_NON_NEGATIVE,)),
-    Parameter("beta_E", "N s/m^1.25", "impact damping coefficient of damping model E up to maximum compression", False, "Eq. 28", (_NON_NEGATIVE,)),
-)
+#: The rig parameters, in the paper's notation and SI units (Sec. 3, Fig. 1), as declared in
+#: ``camdyn.derive.parameters``; the "0-state" is the follower just touching the cam at
+#: Theta = theta0, alpha = alpha0.
+PARAMETERS: tuple[Parameter, ...] = tuple(Parameter.declared(row) for row in RIG_PARAMETERS)
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
 _TEXT_FIELDS = ("name", "description")
@@ -186,7 +137,22 @@ def _toml_string(text: str) -> str:
     return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
 
 
-@dataclass(frozen=True, kw_only=True)
+def _with_declared_fields(cls: type) -> type:
+    """Make ``cls`` a frozen, keyword-only dataclass with one float field per row of
+    :data:`PARAMETERS` (optional ones default to ``None``), then ``name`` and ``description``:
+    the fields come from the declaration in ``camdyn.derive.parameters``, not from a second list."""
+    notes: dict[str, str] = {}
+    for p in PARAMETERS:
+        notes[p.name] = "float" if p.required else "float | None"
+        if not p.required:
+            setattr(cls, p.name, None)
+    notes.update(name="str", description="str")
+    cls.name, cls.description = "unnamed", ""
+    cls.__annotations__ = notes
+    return dataclass(frozen=True, kw_only=True)(cls)
+
+
+@_with_declared_fields
 class Rig:
     """The parameters of one cam-follower rig, in the paper's notation and SI units.
 
@@ -194,35 +160,9 @@ class Rig:
     :meth:`from_toml`. Values are validated once, here: each must be a real number (not a
     bool), finite and in range, else :class:`~camdyn.errors.ParameterError`. Ints and
     numpy scalars are stored as floats. Instances are immutable; use :meth:`replace`.
+    Its fields are the rows of :data:`PARAMETERS` (declared in ``camdyn.derive.parameters``),
+    then ``name`` and ``description``.
     """
-
-    r_c: float
-    e: float
-    w_b: float
-    chi0: float
-    alpha0: float
-    theta0: float
-    d_x: float
-    d_y: float
-    L_us: float
-    k_s: float
-    I_Pb: float
-    Y_c: float
-    Y_b: float
-    nu_c: float
-    nu_b: float
-    l_lambda: float | None = None
-    mu_m: float | None = None
-    s: float | None = None
-    zeta_A: float | None = None
-    zeta_D: float | None = None
-    zeta_E: float | None = None
-    beta_B: float | None = None
-    beta_D: float | None = None
-    beta_C: float | None = None
-    beta_E: float | None = None
-    name: str = "unnamed"
-    description: str = ""
 
     def __post_init__(self) -> None:
         known: dict[str, float] = {}

@@ -1,7 +1,9 @@
 """Symbols of the model, by the paper's notation, with units and meaning.
 
-Every symbol used by the derivation is declared here once, with SymPy
-assumptions that reflect its physical range (positive lengths, real angles).
+The constants are declared once, in :mod:`camdyn.derive.parameters` (name, unit, meaning,
+valid range, shared with the runtime's :class:`camdyn.Rig`); here each becomes a SymPy
+symbol with the assumptions its range gives (positive lengths, real angles), and a
+module-level name so that the derivation reads like the paper.
 The state and the cam motion are functions of time (``dynamicsymbols``);
 :func:`to_plain` swaps them for plain symbols before code generation.
 
@@ -13,6 +15,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 from sympy.physics.vector import dynamicsymbols
+
+from . import parameters as declared
 
 t = dynamicsymbols._t  # the time symbol dynamicsymbols differentiate with
 
@@ -30,53 +34,17 @@ class Param:
         return self.symbol.name
 
 
-def _param(name: str, unit: str, meaning: str, **assumptions) -> Param:
-    return Param(sp.Symbol(name, real=True, **assumptions), unit, meaning)
+def _param(row) -> Param:
+    """The symbol of a declared constant (:mod:`camdyn.derive.parameters`), real, with the
+    sign its declaration gives."""
+    assumptions = {row.sign: True} if row.sign else {}
+    return Param(sp.Symbol(row.name, real=True, **assumptions), row.unit, row.description)
 
 
-# --- rig parameters (Section 3, Fig. 1) --------------------------------------------
-_RIG = [
-    _param("r_c", "m", "cam radius", positive=True),
-    _param("e", "m", "cam eccentricity |E G_c|", nonnegative=True),
-    _param("w_b", "m", "follower bar width", positive=True),
-    _param("chi0", "m", "P to contact along the bar in the 0-state", positive=True),
-    _param("alpha0", "rad", "follower angle in the 0-state"),
-    _param("theta0", "rad", "cam angle in the 0-state (Theta(0))"),
-    _param("d_x", "m", "horizontal distance from P to the follower spring", positive=True),
-    _param("d_y", "m", "height of the pivot P above ground"),
-    _param("L_us", "m", "free length of the follower spring", positive=True),
-    _param("k_s", "N/m", "follower spring stiffness", positive=True),
-    _param("I_Pb", "kg m^2", "follower moment of inertia about P", positive=True),
-    _param("Y_c", "Pa", "Young's modulus of the cam", positive=True),
-    _param("Y_b", "Pa", "Young's modulus of the follower", positive=True),
-    _param("nu_c", "1", "Poisson's ratio of the cam", nonnegative=True),
-    _param("nu_b", "1", "Poisson's ratio of the follower", nonnegative=True),
-    _param("l_lambda", "m", "line-contact length (Eq. 13)", positive=True),
-    _param("mu_m", "1", "friction coefficient (models I and II)", nonnegative=True),
-    _param("s", "s/m", "smoothing factor of friction model II", positive=True),
-    _param("zeta_A", "1", "viscous damping ratio, model A (Eq. 24)", nonnegative=True),
-    _param("beta_B", "s/m", "impact damping factor, model B (Eq. 25)", nonnegative=True),
-    _param("beta_C", "N s/m^1.25", "impact damping factor, model C (Eq. 26)", nonnegative=True),
-    _param("zeta_D", "1", "viscous damping ratio, model D (Eq. 27b)", nonnegative=True),
-    _param("beta_D", "s/m", "impact damping factor, model D (Eq. 27a)", nonnegative=True),
-    _param("zeta_E", "1", "viscous damping ratio, model E (Eq. 28b)", nonnegative=True),
-    _param("beta_E", "N s/m^1.25", "impact damping factor, model E (Eq. 28a)", nonnegative=True),
-]
-
-# --- quantities the runtime computes from the rig before a run ----------------------
-_DERIVED = [
-    _param("alpha_star", "rad", "static equilibrium angle alpha* (Eqs. 16-18)"),
-    _param("chi_star", "m", "chi* = chi0 - psi_j* at static equilibrium", positive=True),
-    _param("vartheta", "rad/s", "undamped linearized natural frequency (Eq. 23, misprint 4)",
-           positive=True),
-]
-
-# --- cam-motion constants ----------------------------------------------------------
-_CAM = [
-    _param("Omega_c", "rad/s", "constant cam speed (>0 counter-clockwise, de-energizing)"),
-    _param("Theta_p", "rad", "peak-to-peak cam angle of the oscillating cam (Section 7.2)"),
-    _param("omega_c", "rad/s", "frequency of the oscillating cam (Section 7.2)"),
-]
+# --- rig parameters (Section 3, Fig. 1), equilibrium results, cam-motion constants ------
+_RIG = [_param(row) for row in declared.RIG_PARAMETERS]
+_DERIVED = [_param(row) for row in declared.EQUILIBRIUM_QUANTITIES]
+_CAM = [_param(row) for row in declared.CAM_CONSTANTS]
 
 PARAMS: dict[str, Param] = {p.name: p for p in _RIG + _DERIVED + _CAM}
 RIG_NAMES = tuple(p.name for p in _RIG)

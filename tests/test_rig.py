@@ -1,6 +1,7 @@
 """Tests of camdyn.rig (the Rig parameter set) and camdyn.errors."""
 
 import dataclasses
+import importlib
 import math
 import os
 import pickle
@@ -24,8 +25,8 @@ VALID = dict(
 )
 REQUIRED = ["r_c", "e", "w_b", "chi0", "alpha0", "theta0", "d_x", "d_y", "L_us",
             "k_s", "I_Pb", "Y_c", "Y_b", "nu_c", "nu_b"]
-OPTIONAL = ["l_lambda", "mu_m", "s", "zeta_A", "zeta_D", "zeta_E",
-            "beta_B", "beta_D", "beta_C", "beta_E"]
+OPTIONAL = ["l_lambda", "mu_m", "s", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
+            "zeta_E", "beta_E"]
 
 
 @pytest.fixture
@@ -344,3 +345,18 @@ def test_shipped_rig_files_state_each_parameters_meaning_and_unit():
         assert params and all(params), path.name
         for m in params:
             assert m.group(2) == by_name[m.group(1)].meaning, (path.name, m.group(1))
+
+
+def test_rig_reads_the_one_declaration_in_derive():
+    """camdyn.Rig's fields, units and ranges are derive/parameters.py's rows, not a second list,
+    and every constant a generated scene reads is either a rig parameter, an equilibrium
+    result, a cam constant or a constant of the laws computed from them."""
+    from camdyn import generated
+    from camdyn.derive import parameters as declared
+    assert [p.name for p in PARAMETERS] == list(declared.RIG_NAMES)
+    for p, row in zip(PARAMETERS, declared.RIG_PARAMETERS):
+        assert (p.required, p.rules, p.description) == (row.required, row.rules, row.description)
+    known = set(declared.RIG_NAMES) | set(declared.EQUILIBRIUM_NAMES) | set(declared.CAM_NAMES)
+    for module in generated.SCENES.values():
+        kernels = importlib.import_module(f"camdyn.generated.{module}")
+        assert set(kernels.INPUTS) <= known, module

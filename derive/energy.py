@@ -22,7 +22,7 @@ import sympy as sp
 
 from . import dynamics, laws
 from . import symbols as S
-from .symbols import Theta, alpha, t
+from .symbols import alpha, t
 
 
 def kinetic() -> sp.Expr:
@@ -34,6 +34,19 @@ def spring_potential() -> sp.Expr:
     a = sp.Symbol("a", real=True)
     integrand = S.d_x * laws.spring_force(a)  # follows an edited spring law
     return sp.integrate(integrand, (a, 0, alpha))
+
+
+def real_logs(expr: sp.Expr) -> sp.Expr:
+    """The real definite integral from SymPy's: log(u) -> log|u|.
+
+    An antiderivative of a real trigonometric-rational integrand holds each log(u) from the
+    integral of u'/u with a real coefficient; SymPy writes log(u) where the real antiderivative
+    is log|u|, and the two differ by i pi where u < 0 (a cubic spring gives log(sin(alpha) - 1)).
+    In F(alpha) - F(0) those i pi cancel when u keeps its sign between 0 and alpha (it cannot
+    cross zero there: the integrand would have a pole), so log|u| gives the same real value
+    and generated code does not take the log of a negative number.
+    """
+    return expr.replace(sp.log, lambda u: sp.log(sp.Abs(u)))
 
 
 def spring_potential_printed() -> sp.Expr:

@@ -167,16 +167,23 @@ def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
 
 
 @lru_cache(maxsize=None)
-def _energy_terms(contact: str):
-    """V_s(alpha), its derivative, and in contact V_c(psi_i), in plain symbols (psi_i named).
+def spring_potential() -> sp.Expr:
+    """V_s(alpha) in plain symbols, as generated code computes it.
 
-    V_s is built as the integral of the spring moment d_x F_s (derive.energy), so its
-    derivative is d_x F_s: checked here, then used in the named form d_x F_s."""
+    Built as the integral of the spring moment d_x F_s (derive.energy), so its derivative is
+    d_x F_s: checked here; then written with real logarithms (:func:`derive.energy.real_logs`)."""
     V_s = S.to_plain(energy.spring_potential())
     moment = S.d_x * laws.spring_force(S.alpha_s)
     if sp.simplify(V_s.diff(S.alpha_s) - moment) != 0:
         raise RuntimeError("dV_s/dalpha is not the spring moment d_x F_s: check derive.energy.spring_potential")
-    return V_s, S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i)
+    return energy.real_logs(V_s)
+
+
+@lru_cache(maxsize=None)
+def _energy_terms(contact: str):
+    """V_s(alpha), its derivative in the named form d_x F_s, and in contact V_c(psi_i), in
+    plain symbols (psi_i named)."""
+    return spring_potential(), S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i)
 
 
 def outputs(spec: SceneSpec, mode: Mode) -> Kernel:

@@ -109,7 +109,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
                  "Follower angle in rigid contact alpha_i(Theta) (Eq. 29, misprint 10), its derivatives in "
                  "Theta, and the spring moment F_s d_x there.", "tuple"),
         Function("spring_potential", ("alpha", "p"), (), ("V_s", "V_s_printed"),
-                 _single(S.to_plain(energy.spring_potential()), S.to_plain(energy.spring_potential_printed())),
+                 _single(fields.spring_potential(), S.to_plain(energy.spring_potential_printed())),
                  "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33.", "tuple"),
     ]
 

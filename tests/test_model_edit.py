@@ -64,6 +64,44 @@ def load_generated(folder: Path, name: str):
     return package
 
 
+def full_copy(tmp_path: Path) -> Path:
+    """A checkout as installed, under tmp_path/src: camdyn/ with derive/ and generated/ inside it."""
+    pkg = tmp_path / "src" / "camdyn"
+    shutil.copytree(package_dir("camdyn"), pkg,
+                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "derive", "generated"))
+    copy_tree(package_dir("camdyn.derive"), pkg / "derive")
+    copy_tree(package_dir("camdyn.generated"), pkg / "generated")
+    return pkg
+
+
+def runtime_files(pkg: Path) -> dict[Path, bytes]:
+    """The runtime's files of a copy (all but derive/ and generated/), to show none changed."""
+    return {p.relative_to(pkg): p.read_bytes() for p in pkg.rglob("*.py")
+            if p.relative_to(pkg).parts[0] not in ("derive", "generated")}
+
+
+def scratch_cli(tmp_path: Path):
+    """``camdyn ...`` run in a fresh process on the copy of :func:`full_copy`."""
+    env = {**os.environ, "PYTHONPATH": str(tmp_path / "src")}
+
+    def camdyn_cli(*args):
+        return subprocess.run([sys.executable, "-m", "camdyn.cli", "--no-progress", *args], cwd=tmp_path,
+                              env=env, capture_output=True, text=True, timeout=600)
+    return camdyn_cli
+
+
+def csv_columns(path: Path) -> dict[str, np.ndarray]:
+    """The numeric columns of a ``camdyn simulate --csv`` file by quantity name (``alpha (rad)`` -> ``alpha``)."""
+    from camdyn.metadata import parse_column_header
+    rows = list(csv.reader(path.open()))
+    names = [parse_column_header(h) for h in rows[0]]
+    return {n: np.array([float(r[i]) for r in rows[1:]]) for i, n in enumerate(names) if n != "regime"}
+
+
+def trapezoid_cumulative(t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum((y[1:] + y[:-1]) / 2 * np.diff(t))])
+
+
 def friction_ratio_matches(F_f, F_n, v_r, mu_m, s, law) -> bool:
     contact = np.abs(F_n) > 1e-6 * np.max(np.abs(F_n))
     return np.allclose(F_f[contact] / F_n[contact], mu_m * law(s * v_r[contact]), rtol=1e-9, atol=1e-12)
@@ -122,14 +160,9 @@ def test_drift_check_catches_a_hand_edit_of_generated_code(tmp_path, capfd):
 
 @pytest.mark.slow
 def test_a_new_law_option_and_scene_need_no_edit_in_the_runtime(tmp_path):
-    # a checkout as installed: camdyn/ with derive/ and generated/ inside it
-    runtime = package_dir("camdyn")
-    pkg = tmp_path / "src" / "camdyn"
-    shutil.copytree(runtime, pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "derive", "generated"))
-    derive = copy_tree(package_dir("camdyn.derive"), pkg / "derive")
-    copy_tree(package_dir("camdyn.generated"), pkg / "generated")
-    before = {p.relative_to(pkg): p.read_bytes() for p in pkg.rglob("*.py")
-              if p.relative_to(pkg).parts[0] not in ("derive", "generated")}
+    pkg = full_copy(tmp_path)
+    derive = pkg / "derive"
+    before = runtime_files(pkg)
 
     # the edit: a new friction law "atan" (derive/laws.py) and one scene that uses it (derive/catalog.py)
     edit(derive / "vocabulary.py", 'FRICTION_MODELS = ("none", "coulomb", "tanh")',
@@ -137,12 +170,8 @@ def test_a_new_law_option_and_scene_need_no_edit_in_the_runtime(tmp_path):
     edit(derive / "laws.py", TANH, TANH + '\n    if model == "atan":\n        ' + ATAN)
     one_scene_catalog(derive, 'damping="D", friction="atan"', 'damping="D", friction="tanh"')
 
+    camdyn_cli = scratch_cli(tmp_path)
     env = {**os.environ, "PYTHONPATH": str(tmp_path / "src")}
-
-    def camdyn_cli(*args):
-        return subprocess.run([sys.executable, "-m", "camdyn.cli", "--no-progress", *args], cwd=tmp_path,
-                              env=env, capture_output=True, text=True, timeout=600)
-
     regen = camdyn_cli("regenerate", "--jobs", "2")  # the one command, as in the user's checkout
     assert regen.returncode == 0, regen.stderr
     assert "drift check: 3 files in sync" in regen.stdout and "2 of 2 scene modules" in regen.stdout
@@ -151,8 +180,8 @@ def test_a_new_law_option_and_scene_need_no_edit_in_the_runtime(tmp_path):
                      "--csv", "atan.csv")
     assert run.returncode == 0, run.stderr
     assert "scene line_d_atan_constant_nonlinear: SUCCESS" in run.stdout
-    rows = list(csv.DictReader((tmp_path / "atan.csv").open()))
-    F_f, F_n, v_r = (np.array([float(r[k]) for r in rows]) for k in ("F_f", "F_n", "v_r"))
+    columns = csv_columns(tmp_path / "atan.csv")
+    F_f, F_n, v_r = (columns[k] for k in ("F_f", "F_n", "v_r"))
     rig = camdyn.example_rig()
     assert friction_ratio_matches(F_f, F_n, v_r, rig.mu_m, rig.s, atan_law)
 
@@ -163,9 +192,7 @@ def test_a_new_law_option_and_scene_need_no_edit_in_the_runtime(tmp_path):
     assert from_python.returncode == 0, from_python.stderr
     assert from_python.stdout.startswith(str(pkg / "generated"))
 
-    after = {p.relative_to(pkg): p.read_bytes() for p in pkg.rglob("*.py")
-             if p.relative_to(pkg).parts[0] not in ("derive", "generated")}
-    assert after == before  # no file of the runtime changed
+    assert runtime_files(pkg) == before  # no file of the runtime changed
 
 
 def test_regenerate_refuses_a_folder_that_is_not_derive(tmp_path, capsys):
@@ -181,3 +208,68 @@ def test_the_documented_law_texts_still_exist():
     assert TANH in laws and 'FRICTION_MODELS = ("none", "coulomb", "tanh")' in vocabulary
     doc = (Path(__file__).resolve().parent.parent / "docs" / "model-editing.md").read_text()
     assert TANH in doc and ATAN in doc
+
+
+K_S_ROW = 'RigParameter("k_s", "N/m", "follower spring stiffness", True, "Eq. 11", (_POSITIVE,)),'
+K_S3_ROW = ('\n    RigParameter("k_s3", "N/m^3", "cubic stiffness of the follower spring", False, "a model edit",'
+            ' (_NON_NEGATIVE,)),')
+LINEAR_SPRING = "return S.k_s * spring_compression(a)"
+CUBIC_SPRING = "L = spring_compression(a)\n    return S.k_s * L + S.k_s3 * L**3"
+
+
+def test_a_new_parameter_needs_no_edit_in_the_runtime(tmp_path):
+    """docs/model-editing.md, "A law with a new parameter": a cubic spring term with its own
+    constant k_s3, declared once in derive/parameters.py, reaches the rig's validation, its
+    TOML reading and the simulation through the command line, with camdyn/ untouched.
+
+    Runs in the default suite: one scene is regenerated, and the runs use the interpreted
+    engine loop (no compile in the scratch package)."""
+    pkg = full_copy(tmp_path)
+    before = runtime_files(pkg)
+    derive = pkg / "derive"
+    edit(derive / "parameters.py", K_S_ROW, K_S_ROW + K_S3_ROW)
+    edit(derive / "symbols.py", 'k_s = PARAMS["k_s"].symbol', 'k_s = PARAMS["k_s"].symbol\nk_s3 = PARAMS["k_s3"].symbol')
+    edit(derive / "laws.py", LINEAR_SPRING, CUBIC_SPRING)
+    one_scene_catalog(derive, 'damping="D", friction="coulomb"')
+    cli = scratch_cli(tmp_path)
+    regen = cli("regenerate", "--jobs", "1")
+    assert regen.returncode == 0, regen.stderr
+    assert "k_s3" in (pkg / "generated" / "scene_line_d_coulomb_constant_nonlinear.py").read_text()
+
+    example = (package_dir("camdyn") / "data" / "example.toml").read_text()
+    runs = {}
+    for k_s3 in (0.0, 2e9):  # N/m^3: at the example rig's ~1 mm compression, k_s3 L^2 ~ k_s
+        rig = tmp_path / f"cubic_{k_s3:g}.toml"
+        rig.write_text(example.replace("[parameters]", f"[parameters]\nk_s3 = {k_s3!r}"))
+        run = cli("simulate", "--rig", str(rig), "--speed-rpm", "300", "--t-end", "0.01", "--backend", "python",
+                  "--csv", f"cubic_{k_s3:g}.csv")
+        assert run.returncode == 0, run.stderr
+        runs[k_s3] = csv_columns(tmp_path / f"cubic_{k_s3:g}.csv")
+    shipped = camdyn.simulate(camdyn.example_rig(), camdyn.Scene(damping="D", friction="coulomb"),
+                              speed_rpm=300, t_end=0.01, sample_rate_Hz=20_000)
+    # k_s3 = 0: the shipped model; the expressions differ (an added 0 * L^3), so agreement to
+    # the solver's tolerance (rtol 1e-8 on alpha ~ 0.2 rad), not bit for bit
+    assert np.allclose(runs[0.0]["alpha"], shipped.alpha, rtol=0, atol=1e-8)
+    assert np.allclose(runs[0.0]["F_s"], shipped.F_s, rtol=1e-6)
+    # k_s3 > 0: a stiffer spring, so a larger spring force at the new static equilibrium
+    cubic = runs[2e9]
+    assert cubic["F_s"][0] > runs[0.0]["F_s"][0] * 1.01
+    # the edited spring's potential (derived by integrating its moment) keeps the energy balance
+    # E(t) - E(0) = int (P_in - D_c - D_f) dt of Sec. 5; the bound is the trapezoid rule's own
+    # error on these samples, estimated from the same integral at half the sample rate
+    assert np.all(np.isfinite(cubic["energy"]))
+    power = cubic["P_in"] - cubic["D_c"] - cubic["D_f"]
+    fine = trapezoid_cumulative(cubic["t"], power)
+    coarse = trapezoid_cumulative(cubic["t"][::2], power[::2])
+    quadrature_error = np.max(np.abs(fine[::2] - coarse)) / 3
+    drift = np.abs(cubic["energy"][::2] - cubic["energy"][0] - fine[::2])
+    assert np.max(drift) < 10 * quadrature_error + 1e-9 * np.max(np.abs(cubic["energy"]))
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text(example.replace("[parameters]", "[parameters]\nk_s3 = -1.0"))
+    refused = cli("simulate", "--rig", str(bad), "--speed-rpm", "300", "--t-end", "0.001", "--backend", "python")
+    assert refused.returncode == 2
+    assert "k_s3" in refused.stderr and ">= 0" in refused.stderr and "N/m^3" in refused.stderr
+    missing = cli("simulate", "--speed-rpm", "300", "--t-end", "0.001", "--backend", "python")  # the example rig has no k_s3
+    assert missing.returncode == 2 and "k_s3" in missing.stderr
+    assert runtime_files(pkg) == before  # no file of the runtime changed

@@ -807,11 +807,13 @@ def cmd_scenes(args) -> int:
 
 
 def cmd_cache(args) -> int:
-    """List camdyn's compiled-code caches of this user, or clear them."""
+    """List camdyn's caches of this user (compiled code, scenes derived on demand), or clear them."""
+    from . import ondemand
     from .engine import cache
 
     if args.clear or args.clear_stale:
         removed = cache.clear(stale_only=args.clear_stale)
+        removed += _clear_scenes(ondemand, stale_only=args.clear_stale)
         print(f"removed {len(removed)} cache folder(s)" + "".join(f"\n  {d}" for d in removed))
         return EXIT_OK
     entries = cache.entries()
@@ -820,7 +822,26 @@ def cmd_cache(args) -> int:
         print("  empty: the first run compiles the engine")
     for folder, size, current in entries:
         print(f"  {folder.name}  {size / 1e6:.1f} MB  {'current' if current else 'stale (another camdyn or engine)'}")
+    scenes = ondemand.entries()
+    print(f"scenes derived on demand: {ondemand.scenes_root()}")
+    if not scenes:
+        print("  none: a scene outside the catalog is derived on first use")
+    for folder, slugs, current in scenes:
+        state = "current" if current else "stale (another derivation or SymPy)"
+        print(f"  {folder.name}  {state}: {', '.join(slugs) or 'no scenes'}")
     return EXIT_OK
+
+
+def _clear_scenes(ondemand, stale_only: bool) -> list:
+    """Delete the folders of derived scenes (with ``stale_only``: those of other derivations)."""
+    import shutil
+
+    removed = []
+    for folder, _, current in ondemand.entries():
+        if not (stale_only and current):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed.append(folder)
+    return removed
 
 
 # --------------------------------------------------------------------------- parser
@@ -1125,14 +1146,15 @@ def _parser() -> argparse.ArgumentParser:
                 "example:\n  camdyn scenes --json", cmd_scenes)
     p.add_argument("--json", action="store_true", help="print scenes, rigs and scene options as JSON")
 
-    p = command("cache", "list or clear the compiled code camdyn keeps for this user",
+    p = command("cache", "list or clear the compiled code and derived scenes camdyn keeps for this user",
                 "examples:\n  camdyn cache\n  camdyn cache --clear-stale\n\n"
                 "The engine and each scene's kernels are compiled on first use and kept per user (never in\n"
-                "the installed package), one folder per camdyn version and engine source.", cmd_cache)
+                "the installed package), one folder per camdyn version and engine source. A scene outside\n"
+                "the catalog is derived on first use (needs SymPy) and kept per derivation source.", cmd_cache)
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--clear", action="store_true", help="delete every cache folder (the next run compiles again)")
+    g.add_argument("--clear", action="store_true", help="delete every cache folder (the next run compiles, and derives, again)")
     g.add_argument("--clear-stale", action="store_true", dest="clear_stale",
-                   help="delete the folders of other camdyn versions or engines only")
+                   help="delete the folders of other camdyn versions, engines or derivations only")
     return parser
 
 

@@ -2,8 +2,9 @@
 
 A :class:`Scene` names the contact law, damping model, friction model, cam motion, model kind
 and the misprint and switch options (the vocabulary is ``camdyn.derive.vocabulary``, shared
-with the derivation).  Only scenes generated into ``camdyn.generated`` can run; to add one,
-add it to ``derive/catalog.py`` and run ``python -m camdyn.derive`` (no edit in ``camdyn/``).
+with the derivation).  The scenes of ``derive/catalog.py`` are generated into
+``camdyn.generated``; any other valid scene is derived on first use into the per-user cache
+(:mod:`camdyn.ondemand`, needs SymPy).
 """
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from types import ModuleType
 from camdyn import generated
 
 from .derive.vocabulary import SceneOptionError, SceneSpec
+from . import ondemand
 from .errors import SceneError
 
 
@@ -40,15 +42,19 @@ class Scene(SceneSpec):
         except SceneOptionError as exc:
             raise SceneError(str(exc)) from None
         if self.slug not in generated.SCENES:
-            near = [s for s in generated.SCENES if s.startswith(f"{self.contact}_{self.damping.lower()}_")]
-            raise SceneError(
-                f"scene {self.slug!r} is not generated. To generate it, add SceneSpec({self.options_text()}) "
-                f"to derive/catalog.py and run 'python -m camdyn.derive'"
-                + (f"; generated scenes with this contact and damping: {', '.join(sorted(near))}" if near else ""))
+            ondemand.check_derivable(self)
+
+    @property
+    def in_catalog(self) -> bool:
+        """Whether the scene is in the catalog (``camdyn.generated``) rather than derived on demand."""
+        return self.slug in generated.SCENES
 
     def kernels(self) -> ModuleType:
-        """The generated module of this scene."""
-        return importlib.import_module(f"camdyn.generated.{generated.SCENES[self.slug]}")
+        """The generated module of this scene: from ``camdyn.generated``, else from the per-user
+        cache, derived there on first use (:mod:`camdyn.ondemand`)."""
+        if self.in_catalog:
+            return importlib.import_module(f"camdyn.generated.{generated.SCENES[self.slug]}")
+        return ondemand.load(self)
 
     @staticmethod
     def available() -> list[str]:

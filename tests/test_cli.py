@@ -173,7 +173,6 @@ def test_errors_are_one_line_with_exit_code_2(tmp_path, capsys):
     (["simulate", "--speed-rpm", "fast"], "--speed-rpm"),
     (["simulate", "--speed-rpm", "300", "--oscillating-rpm", "40"], "not both"),
     (["simulate", "--speed-rpm", "300", "--rig", "missing.toml"], "missing.toml"),
-    (["simulate", "--speed-rpm", "300", "--contact", "point", "--damping", "B"], "not generated"),
     (["simulate", "--speed-rpm", "300", "--model", "linear_paper", "--damping", "B"], "constant damping coefficient"),
     (["simulate", "--speed-rpm", "300", "--csv", "/no/such/folder/run.csv"], "does not exist"),
     (["simulate", "--speed-rpm", "300", "--rtol", "1"], "rtol"),
@@ -186,6 +185,14 @@ def test_errors_are_one_line_with_exit_code_2(tmp_path, capsys):
 def test_bad_input_is_one_line_and_exit_code_2(argv, words, capsys):
     assert main(argv) == 2
     assert words in one_error_line(capsys)
+
+
+def test_a_scene_outside_the_catalog_without_sympy_is_exit_code_2(capsys, monkeypatch, tmp_path):
+    from camdyn import ondemand
+    monkeypatch.setenv("CAMDYN_CACHE_DIR", str(tmp_path))  # nothing derived earlier
+    monkeypatch.setattr(ondemand, "sympy_version", lambda: None)
+    assert main(["simulate", "--speed-rpm", "300", "--contact", "point", "--damping", "B"]) == 2
+    assert 'pip install "camdyn[derive]"' in one_error_line(capsys)
 
 
 def test_a_run_that_stops_early_exits_3_and_still_writes(tmp_path, monkeypatch, capsys):

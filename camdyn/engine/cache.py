@@ -29,6 +29,8 @@ from pathlib import Path
 ENV = "CAMDYN_CACHE_DIR"
 PACKAGE = Path(__file__).resolve().parent.parent          # camdyn/
 ENGINE = Path(__file__).resolve().parent                   # camdyn/engine/
+#: folders of the user cache root that are not compiled code (camdyn.ondemand's scenes)
+OTHER_FOLDERS = ("scenes",)
 
 
 def user_cache_root() -> Path:
@@ -66,7 +68,7 @@ def entries() -> list[tuple[Path, int, bool]]:
     if not root.is_dir():
         return []
     out = []
-    for d in sorted(p for p in root.iterdir() if p.is_dir()):
+    for d in sorted(p for p in root.iterdir() if p.is_dir() and p.name not in OTHER_FOLDERS):
         size = sum(f.stat().st_size for f in d.rglob("*") if f.is_file())
         out.append((d, size, d.name == engine_key()))
     return out

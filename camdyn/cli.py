@@ -61,14 +61,26 @@ def _progress_enabled(args) -> bool | None:
     return True if getattr(args, "no_progress", False) else None
 
 
+class _Share:
+    """The share of a long call done, as its progress callback reports it (None: unknown)."""
+
+    def __init__(self):
+        self.fraction: float | None = None
+
+    def __call__(self, fraction: float) -> None:
+        self.fraction = fraction
+
+
 @contextlib.contextmanager
 def _busy(description: str, args, after: float = 1.0):
-    """An elapsed-time bar for one long call: shown once it has taken ``after`` seconds, on a
-    terminal only (and never with --no-progress)."""
+    """A bar for one long call, shown once it has taken ``after`` seconds, on a terminal only
+    (and never with --no-progress): the percentage done, if the call reports it to the
+    :class:`_Share` this yields, and the elapsed time."""
     from tqdm import tqdm
 
     stop = threading.Event()
     disable = _progress_enabled(args)
+    share = _Share()
 
     def tick():
         if stop.wait(after):
@@ -76,7 +88,8 @@ def _busy(description: str, args, after: float = 1.0):
         started = time.monotonic() - after
         bar = tqdm(total=None, bar_format="{desc}", disable=disable, file=sys.stderr, leave=False)
         while True:
-            bar.set_description_str(f"{description}: {time.monotonic() - started:.0f} s")
+            done = "" if share.fraction is None else f"{100 * share.fraction:3.0f} % done, "
+            bar.set_description_str(f"{description}: {done}{time.monotonic() - started:.0f} s")
             if stop.wait(0.5):
                 break
         bar.close()
@@ -84,7 +97,7 @@ def _busy(description: str, args, after: float = 1.0):
     thread = threading.Thread(target=tick, daemon=True)
     thread.start()
     try:
-        yield
+        yield share
     finally:
         stop.set()
         thread.join()
@@ -235,8 +248,8 @@ def _simulate(args) -> _Run:
     else:
         kwargs["revolutions"] = args.revolutions
     rig = _rig(args)
-    with _busy(f"simulating {describe_scene(scene)}, {describe_cam(cam)}", args):
-        result = simulate(rig, scene, cam, **kwargs)
+    with _busy(f"simulating {describe_scene(scene)}, {describe_cam(cam)}", args) as share:
+        result = simulate(rig, scene, cam, progress=share, **kwargs)
     settings = {"backend": _default_backend(), **kwargs}
     return _Run(result, rig, settings)
 

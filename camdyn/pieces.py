@@ -35,15 +35,20 @@ def kernel_period(model: Model) -> float:
 
 
 def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, float], y0,
-                        t_eval: np.ndarray, options: SolverOptions) -> Trajectory:
+                        t_eval: np.ndarray, options: SolverOptions,
+                        progress: Callable[[float], None] | None = None) -> Trajectory:
     """``integrate`` (the engine's integrate(model, t_span, y0, t_eval, options, mode=...), its
     backend chosen) over t_span in phase-wrapped pieces; a short run, or a cam without a
-    period, in one call."""
+    period, in one call.  ``progress(fraction)`` is told the share of t_span done after each
+    piece (the pieces do not depend on it: a run with a progress report is the same run)."""
     t0, t_end = map(float, t_span)
     P = kernel_period(model)
     length = PIECE_PERIODS * P
     if not (math.isfinite(P) and P > 0) or (t_end <= length and t0 >= 0.0 and t_end - t0 <= length):
-        return integrate(model, (t0, t_end), y0, t_eval, options)
+        tr = integrate(model, (t0, t_end), y0, t_eval, options)
+        if progress is not None:
+            progress(1.0)
+        return tr
     phase = math.fmod(t0, P) % P
     t_eval = np.asarray(t_eval, dtype=float)
     parts: list[Trajectory] = []
@@ -63,6 +68,8 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
         shift = start - phase
         parts.append(_absolute(tr, own[:kept], kept, shift, work))
         budget -= len(tr.switches)
+        if progress is not None:
+            progress((end - t0) / (t_end - t0))
         if tr.outcome is not Outcome.SUCCESS or tr.t.size < local.size or budget <= 0:
             break
         y = tr.y[:2, -1].copy()

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Callable
 
 import numpy as np
 
@@ -36,7 +37,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              y0=None, t_start: float = 0.0, method: str = "DOP853", rtol: float = 1e-8,
              atol: float = 1e-12, max_step: float = math.inf,
              events: EventSettings | None = None, energy_ledger: bool = False,
-             backend: str = "compiled") -> Result:
+             backend: str = "compiled", progress: Callable[[float], None] | None = None) -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -53,6 +54,9 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     ``backend="compiled"`` (default) runs the loop compiled by numba (the first call on a
     machine compiles for a few seconds, later ones load the cache); ``"python"`` runs the
     same loop in Python, for a :class:`~camdyn.cam.UserMotion` (its callables are Python).
+    ``progress``, if given, is called with the share of the run done (0 to 1], after each
+    piece of a long run (:mod:`camdyn.pieces`: every 200 cam periods) and at its end; it
+    does not change the run.
     """
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")
@@ -73,7 +77,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     options = solver_options(method, rtol, atol, max_step, events, energy_ledger)
     run = functools.partial(integrate, backend=backend)
-    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options)
+    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress)
     return _result(model, traj, backend)
 
 

@@ -205,3 +205,31 @@ def test_misprint_2_damping_power_sign_during_approach(eq, damping, sign):
     D_c = r.D_c[approach]
     assert np.all(D_c >= 0) if sign == "dissipative" else np.all(D_c <= 0)
     assert np.abs(D_c).max() > 0
+
+
+def test_progress_reports_the_share_done_after_each_piece_and_does_not_change_the_run():
+    """A long run is integrated in pieces (camdyn.pieces); progress hears after each one."""
+    from camdyn.pieces import PIECE_PERIODS
+    rig, scene = camdyn.example_rig(), camdyn.Scene(damping="D", friction="coulomb")
+    revolutions = 2 * PIECE_PERIODS * 2 + 10  # 2 T per kernel period: two whole pieces and a part
+    kwargs = dict(speed_rpm=3000, revolutions=revolutions, sample_rate_Hz=50.0, rtol=1e-6, atol=1e-10)
+    heard = []
+    reported = camdyn.simulate(rig, scene, progress=heard.append, **kwargs)
+    assert reported.ok, reported.outcome.message
+    assert len(heard) == reported.stats["pieces"] == 3
+    expected = [2 * PIECE_PERIODS / revolutions, 4 * PIECE_PERIODS / revolutions, 1.0]
+    assert np.allclose(heard, expected, rtol=1e-12)  # rounding of the piece ends in t only
+    silent = camdyn.simulate(rig, scene, **kwargs)
+    assert np.array_equal(silent.alpha, reported.alpha)
+
+
+def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
+    import argparse
+    import time
+
+    from camdyn import cli
+    monkeypatch.setattr(cli, "_progress_enabled", lambda args: False)  # as on a terminal
+    with cli._busy("simulating", argparse.Namespace(), after=0.0) as share:
+        share(0.5)
+        time.sleep(0.3)
+    assert "50 % done" in capsys.readouterr().err

@@ -149,15 +149,6 @@ def _rig(args):
                          + f"; shipped rigs: {', '.join(available())}, or a rig file ending in .toml") from None
 
 
-def _rig_source(name: str) -> str:
-    """Where the rig of --rig came from, for the saved run's attributes."""
-    from .presets import available
-
-    if name in available():
-        return f"camdyn preset {name!r} (camdyn {_version()})"
-    return str(Path(name).resolve())
-
-
 def _cam(args):
     from .cam import ConstantSpeed, Oscillating
 
@@ -370,7 +361,7 @@ def cmd_simulate(args) -> int:
         write_csv(result, args.csv)
         print(f"  wrote {args.csv}")
     if args.netcdf:
-        write_netcdf(result, args.netcdf, run.rig, rig_source=_rig_source(args.rig), settings=run.settings,
+        write_netcdf(result, args.netcdf, run.rig, settings=run.settings,
                      attrs={"command": " ".join(["camdyn"] + (args.argv or []))})
         print(f"  wrote {args.netcdf}")
     if args.plot:

@@ -138,7 +138,7 @@ def _rig_attributes(rig, source: str | None) -> dict[str, Any]:
     from .rig import PARAMETERS
 
     out = {f"rig_{k}": str(getattr(rig, k)) for k in _RIG_TEXT}
-    out["rig_source"] = source or "not recorded (pass rig_source=)"
+    out["rig_source"] = source or rig.origin or "not recorded (a Rig built in code: pass rig_source=)"
     for p in PARAMETERS:
         value = getattr(rig, p.name)
         if value is not None:
@@ -171,7 +171,7 @@ def run_attributes(result, rig=None, *, rig_source: str | None = None,
         The rig it ran on; needed because ``result.meta`` holds only the rig's name
         (used from ``result.meta["rig"]`` when that is a Rig).
     rig_source : str, optional
-        Where the rig came from: a preset's name or a rig file's path.
+        Where the rig came from; by default ``rig.origin`` (a preset's name or a rig file's path).
     settings : mapping, optional
         The keyword arguments given to :func:`camdyn.simulate` (``method``, ``rtol``,
         ``atol``, ``backend``, ``sample_rate_Hz``, ``revolutions`` or ``t_end``...);
@@ -269,7 +269,8 @@ def from_attributes(attrs: Mapping[str, Any]) -> SavedRun:
     params = {k: float(v) for k, v in rig_values.items() if k in names}
     if not params:
         raise ValueError("these attributes hold no rig parameters (rig_<name>): not written by camdyn's run writer")
-    rig = Rig(**params, **{k: str(rig_values[k]) for k in _RIG_TEXT if k in rig_values})
+    origin = f"a saved run's attributes (rig from: {rig_values.get('source', 'not recorded')})"
+    rig = Rig(**params, **{k: str(rig_values[k]) for k in _RIG_TEXT if k in rig_values}, origin=origin)
     scene_values = _prefixed(attrs, "scene_")
     scene = Scene(**{f.name: str(scene_values[f.name]) for f in fields(Scene) if f.name in scene_values})
     cam_values = _prefixed(attrs, "cam_")

@@ -146,8 +146,9 @@ def _with_declared_fields(cls: type) -> type:
         notes[p.name] = "float" if p.required else "float | None"
         if not p.required:
             setattr(cls, p.name, None)
-    notes.update(name="str", description="str")
+    notes.update(name="str", description="str", origin="str")
     cls.name, cls.description = "unnamed", ""
+    cls.origin = dataclasses.field(default="", compare=False)  # provenance, not physics
     cls.__annotations__ = notes
     return dataclass(frozen=True, kw_only=True)(cls)
 
@@ -161,7 +162,9 @@ class Rig:
     bool), finite and in range, else :class:`~camdyn.errors.ParameterError`. Ints and
     numpy scalars are stored as floats. Instances are immutable; use :meth:`replace`.
     Its fields are the rows of :data:`PARAMETERS` (declared in ``camdyn.derive.parameters``),
-    then ``name`` and ``description``.
+    then ``name``, ``description`` and ``origin``: where the values came from (``"file
+    /path/rig.toml"``, ``"camdyn preset 'example' (camdyn 0.1.0)"``, then ``"; changed k_s"``
+    after :meth:`replace`), kept in saved runs; it takes no part in equality.
     """
 
     def __post_init__(self) -> None:
@@ -169,7 +172,7 @@ class Rig:
         for p in PARAMETERS:
             known[p.name] = p.check(getattr(self, p.name), known)
             object.__setattr__(self, p.name, known[p.name])
-        for field in _TEXT_FIELDS:
+        for field in (*_TEXT_FIELDS, "origin"):
             if not isinstance(getattr(self, field), str):
                 raise ParameterError(field, getattr(self, field), "a string")
 
@@ -193,13 +196,20 @@ class Rig:
 
     def replace(self, **changes: Any) -> Rig:
         """A validated copy with some fields changed; unknown names raise
-        :class:`~camdyn.errors.RigFileError` with a suggestion."""
-        _check_names(changes, "Rig.replace()", _FIELDS)
+        :class:`~camdyn.errors.RigFileError` with a suggestion.  The copy's ``origin`` says
+        which parameters changed (unless ``origin`` is given)."""
+        _check_names(changes, "Rig.replace()", (*_FIELDS, "origin"))
+        changed = sorted(k for k in changes if k in _BY_NAME)
+        if "origin" not in changes and self.origin and changed:
+            changes["origin"] = f"{self.origin}; changed {', '.join(changed)}"
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
-        """All fields as a flat dict, optional ones not given as ``None``; see :meth:`from_dict`."""
-        return dataclasses.asdict(self)
+        """The parameters, ``name`` and ``description`` as a flat dict, optional ones not given
+        as ``None`` (``origin`` left out: it is not a value of the rig); see :meth:`from_dict`."""
+        out = dataclasses.asdict(self)
+        del out["origin"]
+        return out
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], *, source: str = "<dict>") -> Rig:
@@ -211,7 +221,7 @@ class Rig:
         """
         if not isinstance(d, Mapping):
             raise RigFileError(source, f"expected a table of parameters, got {type(d).__name__}")
-        _check_names(d, source, _FIELDS)
+        _check_names(d, source, (*_FIELDS, "origin"))
         missing = [p.name for p in PARAMETERS if p.required and p.name not in d]
         if missing:
             raise RigFileError(source, f"missing required parameter(s): {', '.join(missing)}", key=missing[0])
@@ -240,7 +250,8 @@ class Rig:
             problem = "missing [parameters] table" if params is None else "'parameters' must be a table"
             raise RigFileError(source, problem, key="parameters")
         _check_names(params, source, _BY_NAME)
-        return cls.from_dict({**params, **{k: doc[k] for k in _TEXT_FIELDS if k in doc}}, source=source)
+        values = {**params, **{k: doc[k] for k in _TEXT_FIELDS if k in doc}}
+        return cls.from_dict({**values, "origin": f"file {Path(path).resolve()}"}, source=source)
 
     def to_toml(self, path: str | os.PathLike[str]) -> None:
         """Write the rig file read by :meth:`from_toml` (floats written with ``repr``, so the

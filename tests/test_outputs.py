@@ -68,7 +68,7 @@ def test_a_rig_file_is_recorded_by_its_path(tmp_path):
     path = tmp_path / "run.nc"
     assert main(["simulate", *QUICK, "--rig", str(rig_file), "--netcdf", str(path)]) == 0
     with xr.open_dataset(path, engine="scipy") as ds:
-        assert ds.attrs["rig_source"] == str(rig_file.resolve())
+        assert ds.attrs["rig_source"] == f"file {rig_file.resolve()}"
         assert ds.attrs["rig_name"] == "mine" and ds.attrs["rig_k_s"] == 2500.0
         assert metadata.from_attributes(ds.attrs).rig == camdyn.example_rig().replace(name="mine", k_s=2500.0)
 

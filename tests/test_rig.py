@@ -53,7 +53,7 @@ def test_ints_and_numpy_scalars_stored_as_float():
 def test_table_matches_dataclass_fields():
     fields = {f.name: f for f in dataclasses.fields(Rig)}
     assert [p.name for p in PARAMETERS] == REQUIRED + OPTIONAL
-    assert list(fields) == REQUIRED + OPTIONAL + ["name", "description"]
+    assert list(fields) == REQUIRED + OPTIONAL + ["name", "description", "origin"]
     for p in PARAMETERS:
         has_default = fields[p.name].default is not dataclasses.MISSING
         assert p.required is not has_default
@@ -360,3 +360,22 @@ def test_rig_reads_the_one_declaration_in_derive():
     for module in generated.SCENES.values():
         kernels = importlib.import_module(f"camdyn.generated.{module}")
         assert set(kernels.INPUTS) <= known, module
+
+
+def test_origin_records_where_the_values_came_from(tmp_path):
+    """Rig.origin: a file's path, a preset's name, and the parameters replace() changed;
+    it takes no part in equality and is not a value of to_dict()."""
+    import camdyn
+    example = camdyn.example_rig()
+    assert example.origin.startswith("camdyn preset 'example' (camdyn ")
+    changed = example.replace(k_s=2500.0, zeta_D=0.02)
+    assert changed.origin == example.origin + "; changed k_s, zeta_D"
+    assert example.replace(name="renamed").origin == example.origin  # no parameter changed
+    path = tmp_path / "mine.toml"
+    changed.to_toml(path)
+    loaded = Rig.from_toml(path)
+    assert loaded.origin == f"file {path.resolve()}"
+    assert loaded == changed and "origin" not in loaded.to_dict()
+    assert Rig(**VALID).origin == ""
+    with pytest.raises(ParameterError, match="origin"):
+        Rig(**VALID, origin=3)

@@ -52,11 +52,14 @@ def run(ctx: Context) -> StudyOutput:
     if f45:
         fa = f45.get("first_aperiodic_rpm", {})
         at = f45.get("class_at_155", {})
+
+        def first(model):
+            speed = fa.get(model)
+            return "none (periodic at every speed of the study)" if speed is None else f"{fmt(speed)} rev/min"
         qual += [
             ["Sec. 4", "chaos beyond about 155 rev/min for damping B and D",
-             f"first aperiodic speed: B {fmt(fa.get('B'))}, D {fmt(fa.get('D'))} rev/min", "fig4-5"],
-            ["Sec. 4", "damping E chaotic even before 155 rev/min", f"E: first aperiodic {fmt(fa.get('E'))} rev/min",
-             "fig4-5"],
+             f"first aperiodic speed: B {first('B')}, D {first('D')}", "fig4-5"],
+            ["Sec. 4", "damping E chaotic even before 155 rev/min", f"E: first aperiodic {first('E')}", "fig4-5"],
             ["Sec. 4", "damping A and C still periodic at 155 rev/min", f"A: {at.get('A')}, C: {at.get('C')}", "fig4-5"],
         ]
     else:

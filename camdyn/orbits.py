@@ -38,8 +38,10 @@ from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_di
 SCALE_SAMPLES = 64
 #: the line search halves the Newton step at most this many times (down to 2^-10 of it)
 MAX_HALVINGS = 10
-#: a multiplier within this of +1 makes M - I singular: the orbit is not isolated (a fold)
-SINGULAR_RCOND = 1e-12
+#: M - I (scaled) with a singular value below this is singular: a multiplier this close to +1
+#: (the orbit is not isolated: a fold) cannot be told from 1 by a finite-difference monodromy,
+#: whose entries carry errors ~rtol^(2/3) = 2e-7 at the default rtol
+SINGULAR_SIGMA = 1e-6
 
 
 class OrbitOutcome(enum.Enum):
@@ -143,7 +145,7 @@ def _residual(F: np.ndarray, scale: np.ndarray) -> float:
 def _newton_step(J: np.ndarray, F: np.ndarray, scale: np.ndarray):
     """The Newton step of P(x) - x = 0, solved in scaled variables; None when M - I is singular."""
     A = (J - np.eye(2)) * scale[None, :] / scale[:, None]
-    if not np.all(np.isfinite(A)) or 1.0 / np.linalg.cond(A) < SINGULAR_RCOND:
+    if not np.all(np.isfinite(A)) or np.linalg.svd(A, compute_uv=False)[-1] < SINGULAR_SIGMA:
         return None
     return -np.linalg.solve(A, F / scale) * scale
 

@@ -53,8 +53,8 @@ def _generator(rng) -> np.random.Generator:
 
 
 def _mean_square_displacement(z: np.ndarray, n_cut: int) -> np.ndarray:
-    """M(n) = mean over j of |z(j + n) - z(j)|^2 for n = 1..n_cut, by
-    |a - b|^2 = |a|^2 + |b|^2 - 2 Re(a conj b), the cross sums for all lags by one FFT."""
+    """``M(n) = mean over j of |z(j + n) - z(j)|^2`` for n = 1..n_cut, by
+    ``|a - b|^2 = |a|^2 + |b|^2 - 2 Re(a conj b)``, the cross sums for all lags by one FFT."""
     N = z.size
     size = 1 << int(2 * N - 1).bit_length()
     f = np.fft.fft(z, size)

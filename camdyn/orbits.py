@@ -10,7 +10,7 @@ matrices can replace it), and its eigenvalues are the Floquet multipliers: the o
 asymptotically stable when every multiplier has modulus < 1.
 
 Newton's residual is scaled by the size of the motion s (per component, from the warm-up's
-last revolution): r(x) = max_j |P_j(x) - x_j| / s_j.  It stops when r <= ``tol`` (default
+last revolution): ``r(x) = max_j |P_j(x) - x_j| / s_j``.  It stops when r <= ``tol`` (default
 1e-8: a hundred times the default solver tolerance rtol 1e-10, the level of the map's own
 integration error, below which a residual is noise).
 """
@@ -76,7 +76,7 @@ class PeriodicOrbit:
     ``state``: (alpha rad, alpha_dot rad/s) at the section time ``phase`` (s); ``mode``: the
     automaton's mode there (a name of the scene's MODES); ``periods``: n; ``multipliers``: the
     Floquet multipliers (eigenvalues of ``monodromy``), empty when not computed; ``stable``:
-    max |mu| < 1, None when not computed; ``residual``: the scaled residual r (see the module);
+    ``max |mu| < 1``, None when not computed; ``residual``: the scaled residual r (see the module);
     ``scale``: s; ``iterations``: Newton steps taken; ``outcome`` and ``message``: how it ended;
     ``map_evaluations`` (runs of P_n outside the provider) and ``jacobian_evaluations`` (provider
     calls: 5 runs each by finite differences) give the cost.
@@ -121,7 +121,7 @@ def warm_start(model: Model, revolutions: float, phase: float, y0=None,
                options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
     """The state and mode at the section time ``phase + revolutions T`` after a run from ``y0``
     (default the static equilibrium) at t = 0, and the size of the motion over its last
-    revolution (max |alpha - alpha*| and max |alpha_dot|: the residual's scale)."""
+    revolution (``max |alpha - alpha*|`` and ``max |alpha_dot|``: the residual's scale)."""
     T = model.period
     if isinstance(revolutions, bool) or not isinstance(revolutions, (int, np.integer)) or revolutions < 1:
         raise ParameterError("warmup_revolutions", revolutions, "an integer >= 1")
@@ -170,6 +170,9 @@ def _line_search(section_map, x, dx, r0, scale):
 
 
 class NewtonResult(NamedTuple):
+    """What :func:`newton` returns: the last iterate, dP/dx there, the scaled residual, the steps
+    taken, the outcome, and the cost (line-search map runs, provider calls)."""
+
     x: np.ndarray               # the last iterate
     jacobian: np.ndarray | None  # dP/dx there (None when the provider failed)
     residual: float

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -140,13 +140,16 @@ class StroboscopicMap:
         return self.evaluate(x).state
 
 
-#: a Jacobian provider: x -> (P(x), dP/dx at x); raises MapFailure where P cannot be evaluated
 class JacobianProvider(Protocol):
+    """The interface of a Jacobian provider: ``x -> (P(x), dP/dx at x)``, raising
+    :class:`MapFailure` where P cannot be evaluated (finite differences, or later the
+    variational equations with saltation matrices)."""
+
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 def finite_difference_steps(x, scale, rtol: float) -> np.ndarray:
-    """Central-difference steps h_j = rtol^(1/3) * max(|x_j|, scale_j).
+    """Central-difference steps ``h_j = rtol^(1/3) * max(|x_j|, scale_j)``.
 
     The map's value carries an error of the order of the solver's tolerance, rtol times the
     state's scale, that is not smooth in x (the accepted steps change with x); a central
@@ -158,7 +161,7 @@ def finite_difference_steps(x, scale, rtol: float) -> np.ndarray:
     return float(rtol) ** (1.0 / 3.0) * np.maximum(np.abs(x), scale)
 
 
-def finite_differences(section_map: StroboscopicMap, scale, step_factor: float = 1.0) -> Callable:
+def finite_differences(section_map: StroboscopicMap, scale, step_factor: float = 1.0) -> JacobianProvider:
     """A Jacobian provider by central differences of ``section_map``.
 
     ``scale`` (per state component: rad, rad/s) is the size of the motion, below which the

@@ -29,9 +29,9 @@ from .engine.config import SolverOptions
 from .engine.driver import integrate
 from .errors import ParameterError
 from .model import Model
+from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
-from .pieces import integrate_in_pieces
 from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
 
 #: samples of the warm-up's last revolution, for the size of the motion (the residual's scale)
@@ -73,10 +73,12 @@ class OrbitOutcome(enum.Enum):
 class PeriodicOrbit:
     """A periodic orbit found by shooting (or the last iterate of a failed search).
 
-    ``state``: (alpha rad, alpha_dot rad/s) at the section time ``phase`` (s); ``mode``: the
+    ``state``: (alpha rad, alpha_dot rad/s) at the section time ``phase`` (s), NaN only when
+    the warm-up run itself failed (outcome RUN_FAILED, the message says why); ``mode``: the
     automaton's mode there (a name of the scene's MODES); ``periods``: n; ``multipliers``: the
-    Floquet multipliers (eigenvalues of ``monodromy``), empty when not computed; ``stable``:
-    ``max |mu| < 1``, None when not computed; ``residual``: the scaled residual r (see the module);
+    Floquet multipliers (eigenvalues of ``monodromy``), only for a converged orbit (else empty:
+    a failed search's last iterate is no orbit); ``stable``: ``max |mu| < 1``, None unless
+    converged; ``monodromy``: dP_n/dx at ``state`` (also at a failed search's last iterate); ``residual``: the scaled residual r (see the module);
     ``scale``: s; ``iterations``: Newton steps taken; ``outcome`` and ``message``: how it ended;
     ``map_evaluations`` (runs of P_n outside the provider) and ``jacobian_evaluations`` (provider
     calls: 5 runs each by finite differences) give the cost.
@@ -127,6 +129,7 @@ def warm_start(model: Model, revolutions: float, phase: float, y0=None,
         raise ParameterError("warmup_revolutions", revolutions, "an integer >= 1")
     t_end = phase + revolutions * T
     t_eval = t_end - T + T * np.arange(SCALE_SAMPLES + 1) / SCALE_SAMPLES
+    t_eval[-1] = t_end                       # the section itself, not t_end - T + T rounded
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     run = functools.partial(integrate, backend=backend)
     tr = integrate_in_pieces(run, model, (0.0, t_end), y0, t_eval, options)
@@ -262,7 +265,7 @@ def _orbit(section_map: StroboscopicMap, found: NewtonResult, scale) -> Periodic
             outcome = OrbitOutcome.MODE_CHANGED
             message = f"{outcome.message} (starts in {modes[section_map.mode]!r}, ends in {modes[end]!r})"
     multipliers, stable = np.empty(0, dtype=complex), None
-    if found.jacobian is not None and np.all(np.isfinite(found.jacobian)):
+    if outcome is OrbitOutcome.CONVERGED and np.all(np.isfinite(found.jacobian)):
         multipliers = np.linalg.eigvals(found.jacobian).astype(complex)
         multipliers = multipliers[np.argsort(-np.abs(multipliers))]
         stable = bool(np.max(np.abs(multipliers)) < 1.0)

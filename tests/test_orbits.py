@@ -153,6 +153,24 @@ def test_the_contact_orbit_is_where_a_long_run_settles(contact):
     assert np.max(np.abs(x[-1] - contact.state) / contact.scale) <= TOL
 
 
+def test_a_failing_warm_up_is_reported_not_raised():
+    from camdyn.engine.config import EventSettings, SolverOptions
+    options = SolverOptions(rtol=1e-10, atol=1e-13, events=EventSettings(max_events=2))
+    orbit = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=5, options=options)
+    # one impact per revolution is 3 switches: the warm-up stops at the second
+    assert orbit.outcome is OrbitOutcome.RUN_FAILED and not orbit.ok
+    assert "max_events" in orbit.message and orbit.stable is None and orbit.multipliers.size == 0
+
+
+def test_a_search_that_does_not_converge_gives_no_multipliers():
+    """The 1500 rev/min search from 2 warm-up revolutions needs 4 Newton steps; stopped after one,
+    its last iterate is no orbit: no multipliers, no verdict, the outcome says what to do."""
+    orbit = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=2, settings=ShootingSettings(max_iterations=1))
+    assert orbit.outcome is OrbitOutcome.MAX_ITERATIONS and orbit.residual > TOL
+    assert orbit.multipliers.size == 0 and orbit.stable is None and "max_iterations" in orbit.message
+    assert np.all(np.isfinite(orbit.monodromy)) and np.all(np.isfinite(orbit.state))
+
+
 # ------------------------------------------------------------------ the map and its modes
 def test_a_given_mode_is_refused_outside_its_domain_and_the_initial_rule_chooses_otherwise():
     model = Model(RIG, SCENE, camdyn.ConstantSpeed(600.0))
@@ -224,6 +242,7 @@ def test_newton_reports_each_failure():
     assert newton(shift, finite_differences(shift, ones), np.zeros(2), ones).outcome is OrbitOutcome.SINGULAR
     P = FakeMap(_quadratic)
     few = newton(P, finite_differences(P, ones), X_STAR + 0.5, ones, ShootingSettings(tol=1e-14, max_iterations=1))
+    assert few.iterations == 1
     assert few.outcome is OrbitOutcome.MAX_ITERATIONS and np.isfinite(few.residual)
 
     def only_here(x):                                          # fails everywhere but near the start

@@ -39,6 +39,11 @@ _EXPORTS = {
     "EquilibriumError": "camdyn.errors",
     "SceneError": "camdyn.errors",
     "CompileNotice": "camdyn.errors",
+    "periodic_orbit": "camdyn.orbits",
+    "PeriodicOrbit": "camdyn.orbits",
+    "OrbitOutcome": "camdyn.orbits",
+    "StroboscopicMap": "camdyn.section_map",
+    "zero_one_test": "camdyn.chaos01",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

@@ -207,7 +207,8 @@ def attributes(spec: SweepSpec) -> dict:
     attrs = {"title": "camdyn parameter sweep", "source": f"camdyn {__version__}", "camdyn_version": __version__,
              "grid": " ".join(spec.names), "points": spec.size, "scene": scene.slug}
     attrs.update({f"scene_{k}": v for k, v in dataclasses.asdict(scene).items()})
-    attrs.update({"rig": rig.name, "rig_description": rig.description})
+    attrs.update({"rig": rig.name, "rig_description": rig.description,
+                  "rig_source": rig.origin or "not recorded (a Rig built in code)"})
     attrs.update({f"rig_{p.name}": getattr(rig, p.name) for p in PARAMETERS if getattr(rig, p.name) is not None})
     attrs["rig_units"] = ", ".join(f"{p.name} {_unit(p.unit)}" for p in PARAMETERS)
     attrs["measure"] = repr(spec.measure)

@@ -229,7 +229,7 @@ def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
 
     from camdyn import cli
     monkeypatch.setattr(cli, "_progress_enabled", lambda args: False)  # as on a terminal
-    with cli._busy("simulating", argparse.Namespace(), after=0.0) as share:
-        share(0.5)
-        time.sleep(0.3)
+    with cli._busy("simulating", argparse.Namespace(), after=0.05) as share:
+        share(0.5)  # before the bar first draws (after 0.05 s), which it then does every 0.5 s
+        time.sleep(1.2)
     assert "50 % done" in capsys.readouterr().err

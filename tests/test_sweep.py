@@ -88,6 +88,7 @@ def test_streamed_sweep_writes_the_same_dataset_self_described(serial, tmp_path)
     for name, value in RIG.to_dict().items():  # every parameter of the base rig
         if value is not None and name not in ("name", "description"):
             assert a[f"rig_{name}"] == value, name
+    assert a["rig_source"] == (RIG.origin or "not recorded (a Rig built in code)")
     assert a["simulate_rtol"] == 1e-8 and a["simulate_revolutions"] == 2 and a["samples_per_revolution"] == 32
     assert a["measure"] == "Summary(transient_revolutions=1)" and a["measure_transient_revolutions"] == 1
     assert back["speed_rpm"].attrs["units"] == "rev/min" and back["k_s"].attrs["units"] == "N/m"

@@ -48,9 +48,16 @@ class Start(NamedTuple):
     mode: int            # -1: chosen by the automaton's initial candidates
 
 
+#: rows of Samples.y (and so of a Trajectory's y): the state, then, with the energy ledger, the
+#: works of the flows P_in, D_c, D_f (camdyn.derive.vocabulary.FLOWS) in rows WORK..WORK + N_FLOWS
+ALPHA, ALPHA_DOT, WORK = 0, 1, 2
+#: how many rows Samples.y has without and with the ledger
+STATE_ROWS, LEDGER_ROWS = WORK, WORK + N_FLOWS
+
+
 class Samples(NamedTuple):
-    """The times to sample (t) and where the samples go: y rows alpha, alpha_dot and, with the
-    ledger, the work of the drive, contact damping and friction; mode the mode at each."""
+    """The times to sample (t) and where the samples go: y rows ALPHA, ALPHA_DOT and, with the
+    ledger, the works from row WORK on (the drive, contact damping, friction); mode the mode at each."""
 
     t: np.ndarray
     y: np.ndarray
@@ -88,16 +95,16 @@ def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tm
     """Write the samples at times <= t_stop from the step's interpolant; the next index.  With a
     ledger, ledger_work is the work at the step's start t."""
     n = samples.t.shape[0]
-    ledger = samples.y.shape[0] > 2
+    ledger = samples.y.shape[0] > STATE_ROWS
     while i < n and samples.t[i] <= t_stop:
         ts = samples.t[i]
-        samples.y[0, i], samples.y[1, i] = dense_eval(ts, t, h, y0, y1, Q)
+        samples.y[ALPHA, i], samples.y[ALPHA_DOT, i] = dense_eval(ts, t, h, y0, y1, Q)
         if ledger:
             for k in range(N_FLOWS):  # element by element, as in _record
                 ledger_tmp[k] = ledger_work[k]
             accumulate(prob, m, t, h, y0, y1, Q, t, ts, buf, ledger_tmp)
             for k in range(N_FLOWS):
-                samples.y[2 + k, i] = ledger_tmp[k]
+                samples.y[WORK + k, i] = ledger_tmp[k]
         samples.mode[i] = m
         i += 1
     return i
@@ -146,7 +153,7 @@ def run(prob, method, cfg, start, samples):
     g_prev = work.g_prev
     buf = np.empty(max(tab.n_outputs, 2))
     ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
-    ledger = samples.y.shape[0] > 2
+    ledger = samples.y.shape[0] > STATE_ROWS
     sw = np.empty(16, dtype=SWITCH)
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot

@@ -26,8 +26,8 @@ from numba import njit
 from . import cache
 from .jit import jitable
 from .ledger import N_FLOWS, accumulate
-from .rules import (NONFINITE, Scratch, across, chattering, first_crossing, initial_mode, left_at_start, switch,
-                    zero_at_start)
+from .rules import (NONFINITE, across, chattering, first_crossing, initial_mode, left_at_start, scratch,
+                    switch, zero_at_start)
 from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -147,10 +147,7 @@ def run(prob, method, cfg, start, samples):
     n = method.n_stages
     K = np.empty((method.n_rows, 2))
     Q = np.empty((2, method.degree))
-    n_watch = max(1, tab.n_transitions)
-    n_surf = max(1, tab.n_surfaces)
-    work = Scratch(np.zeros(n_watch), np.zeros(n_watch), np.zeros(n_surf), np.zeros(n_surf, dtype=np.bool_))
-    g_prev = work.g_prev
+    work = scratch(tab.n_transitions, tab.n_surfaces)
     buf = np.empty(max(tab.n_outputs, 2))
     ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
     ledger = samples.y.shape[0] > STATE_ROWS
@@ -181,7 +178,7 @@ def run(prob, method, cfg, start, samples):
                 nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
             w, t_cross = -1, t_new
             if watched:
-                on_surface = not have_start or zero_at_start(g_prev, n_watched)
+                on_surface = not have_start or zero_at_start(work, n_watched)
                 w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
                 if w == NONFINITE:
                     outcome = NONFINITE_STATE

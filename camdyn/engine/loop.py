@@ -148,8 +148,10 @@ def run(prob, method, cfg, start, samples):
     K = np.empty((method.n_rows, 2))
     Q = np.empty((2, method.degree))
     work = scratch(tab.n_transitions, tab.n_surfaces)
-    buf = np.empty(max(tab.n_outputs, 2))
-    ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
+    buf = np.empty(tab.n_outputs if tab.n_outputs > 2 else 2)
+    ledger_work, ledger_tmp = np.empty(N_FLOWS), np.empty(N_FLOWS)
+    for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
+        ledger_work[k] = 0.0
     ledger = samples.y.shape[0] > STATE_ROWS
     sw = np.empty(16, dtype=SWITCH)
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0

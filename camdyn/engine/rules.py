@@ -54,8 +54,14 @@ G_PREV, R_PREV, VALUES = 0, 1, 2
 @jitable
 def scratch(n_transitions, n_surfaces):
     """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES.  One array, not
-    three: a compiled call pays an atomic reference count per array it passes."""
-    return np.zeros((3, max(1, n_transitions, n_surfaces)))
+    three: a compiled call pays an atomic reference count per array it passes.  (np.empty and
+    a loop, no np.zeros or max of ints: each compiles one more overload on a cold start.)"""
+    n = n_transitions if n_transitions > n_surfaces else n_surfaces
+    work = np.empty((3, n if n > 1 else 1))
+    for r in range(3):
+        for k in range(work.shape[1]):
+            work[r, k] = 0.0
+    return work
 
 
 @jitable

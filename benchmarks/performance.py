@@ -39,6 +39,7 @@ from typing import Callable, NamedTuple
 import numba
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 import camdyn
 import floor
@@ -390,8 +391,7 @@ def _engine_partial(prob, method, cfg, m, t, t_end, y0, y1, level):
     rhs, p = prob.kernels.rhs, prob.p
     K = np.empty((method.n_rows, 2))
     Q = np.empty((2, method.degree))
-    work = rules.Scratch(np.zeros(max(1, tab.n_transitions)), np.zeros(max(1, tab.n_transitions)),
-                         np.zeros(max(1, tab.n_surfaces)), np.zeros(max(1, tab.n_surfaces), dtype=np.bool_))
+    work = rules.scratch(tab.n_transitions, tab.n_surfaces)
     K[0, 0], K[0, 1] = y1, rhs(m, t, y0, y1, p)
     h = stepper.initial_step(rhs, p, m, t, y0, y1, K[0, 1], t_end, method, cfg)
     steps, crossings, have_start, n = 0, 0, False, method.n_stages
@@ -426,41 +426,45 @@ def engine_pieces(model, run, args, mode: int, rounds: int) -> dict:
     return {k: min(v) / steps[k] * 1e6 for k, v in times.items()}
 
 
+@register_jitable(error_model="numpy")
+def _values_via_call(prob, m, t, a, ad, work):
+    """A mode's sampled surfaces (Tables.sampled) into work's VALUES row, as first_crossing
+    computes them, but in a called helper that takes the Problem and the work array."""
+    tab = prob.tables
+    for q in range(tab.data[tab.sampled_start + m], tab.data[tab.sampled_start + m + 1]):
+        s = tab.data[tab.sampled + q]
+        work[rules.VALUES, s] = prob.kernels.surface(m, s, t, a, ad, prob.p)
+
+
 @njit(error_model="numpy")
 def _sample_loop(prob, work, m, n, a, ad):
-    tab = prob.tables
-    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
     acc = 0.0
     for i in range(n):
-        rules._values_at(prob, m, w0, w1, i * 1e-8, a, ad, work.values, work.known)
-        acc += work.values[0]
+        _values_via_call(prob, m, i * 1e-8, a, ad, work)
+        acc += work[rules.VALUES, 0]
     return acc
 
 
 @njit(error_model="numpy")
 def _direct_loop(prob, work, m, n, a, ad):
-    """The same surface values as _sample_loop, by direct kernel calls in the loop."""
+    """The same surface values as _sample_loop, by direct kernel calls in the loop (as first_crossing)."""
     tab = prob.tables
-    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
-    surface, p, values = prob.kernels.surface, prob.p, work.values
+    surface, p = prob.kernels.surface, prob.p
     acc = 0.0
     for i in range(n):
-        for w in range(w0, w1):
-            s = tab.data[tab.surface + w]
-            values[s] = surface(m, s, i * 1e-8, a, ad, p)
-            r = tab.data[tab.surface_rate + s]
-            if r >= 0:
-                values[r] = surface(m, r, i * 1e-8, a, ad, p)
-        acc += values[0]
+        for q in range(tab.data[tab.sampled_start + m], tab.data[tab.sampled_start + m + 1]):
+            s = tab.data[tab.sampled + q]
+            work[rules.VALUES, s] = surface(m, s, i * 1e-8, a, ad, p)
+        acc += work[rules.VALUES, 0]
     return acc
 
 
 def call_costs(model, args, mode: int, calls: int = 200_000) -> dict:
-    """ns per sample: the engine's per-sample helper rules._values_at (the mode's watched surfaces
-    and their rates, each once) against the same kernel calls made directly, both compiled."""
+    """ns per sample: the mode's sampled surfaces through a called helper passing the Problem and
+    the work array, against the same kernel calls made directly, both compiled."""
     work = rules.scratch(args.prob.tables.n_transitions, args.prob.tables.n_surfaces)
     a, ad = args.start.alpha, args.start.alpha_dot
-    fns = {"rules._values_at(prob, ...)": lambda: _sample_loop(args.prob, work, mode, calls, a, ad),
+    fns = {"a helper(prob, ..., work)": lambda: _sample_loop(args.prob, work, mode, calls, a, ad),
            "the same kernel calls, direct": lambda: _direct_loop(args.prob, work, mode, calls, a, ad)}
     for fn in fns.values():
         fn()
@@ -715,8 +719,9 @@ def engine_time_lines(fs: dict) -> list[str]:
     lines += ["", f"A sample's surface values through `{k1}` cost {ns1:.0f} ns against {ns2:.0f} ns for the "
               "same kernel calls made directly (both in a compiled loop).  Every call that passes a tuple of "
               "arrays increments and decrements the reference count of each array in it; the automaton's "
-              "tables and the method are therefore one array each, and first_crossing calls this helper "
-              "once per sample.", "",
+              "tables, the method and first_crossing's work are therefore one array each, and first_crossing "
+              "calls the surface kernel directly at each sample (only a sample that may hide a crossing "
+              "calls the locating helpers).", "",
               f"`integrate()` on the same run (Python set-up of the tables, method and settings, and the "
               f"Trajectory, included): {rep.integrate_s * 1e3:.2f} ms against "
               f"{min(rep.times[floor.ENGINE]) * 1e3:.2f} ms for `run_compiled` alone."]

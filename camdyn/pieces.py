@@ -22,6 +22,7 @@ import numpy as np
 
 from .engine.config import SolverOptions
 from .engine.driver import Trajectory
+from .engine.loop import LEDGER_ROWS, STATE_ROWS, WORK
 from .model import Model
 from .outcome import Outcome
 
@@ -72,9 +73,9 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
             progress((end - t0) / (t_end - t0))
         if tr.outcome is not Outcome.SUCCESS or tr.t.size < local.size or budget <= 0:
             break
-        y = tr.y[:2, -1].copy()
+        y = tr.y[:STATE_ROWS, -1].copy()
         if options.ledger:
-            work = work + tr.y[2:5, -1]
+            work = work + tr.y[WORK:LEDGER_ROWS, -1]
         mode = tr.end_mode
         start, i = end, hi
     return _joined(parts)
@@ -83,8 +84,8 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
 def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.ndarray) -> Trajectory:
     """A piece's trajectory in absolute time: its own samples only, switches shifted, works offset."""
     y = tr.y[:, :kept].copy()
-    if y.shape[0] == 5:
-        y[2:5] += work[:, None]
+    if y.shape[0] == LEDGER_ROWS:
+        y[WORK:LEDGER_ROWS] += work[:, None]
     switches = [dataclasses.replace(s, t=s.t + shift) for s in tr.switches]
     return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches)
 

@@ -11,6 +11,7 @@ from .cam import CamMotion, ConstantSpeed
 from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, integrate
+from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
 from .errors import ParameterError
 from .model import Model
 from .pieces import integrate_in_pieces
@@ -133,14 +134,14 @@ def _result(model: Model, traj, backend: str) -> Result:
     sample's mode), and the ledger's works."""
     from .engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
     K = model.kernels
-    t, alpha, alpha_dot = traj.t, traj.y[0], traj.y[1]
+    t, alpha, alpha_dot = traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT]
     compiled = backend == "compiled"
     kern = compiled_kernels(K) if compiled else python_kernels(K, model.cam if model.scene.motion == "user" else None)
     values = outputs_on_samples(kern, compiled, traj.mode, t, alpha, alpha_dot, model.p, len(K.OUTPUTS))
     outputs = dict(zip(K.OUTPUTS, values))
-    if traj.y.shape[0] == 5:
+    if traj.y.shape[0] == LEDGER_ROWS:  # the works of FLOWS (P_in, D_c, D_f), in that order
         for i, name in enumerate(("work_in", "dissipated_contact", "dissipated_friction")):
-            outputs[name] = traj.y[2 + i].copy()
+            outputs[name] = traj.y[WORK + i].copy()
     theta = np.broadcast_to(model.cam_state(t)[CAM_THETA], t.shape).astype(float) if t.size else t.copy()
     contact = dict(zip(K.MODES, map(bool, K.CONTACT_OF_MODE)))
     return Result(t, alpha, alpha_dot, theta, traj.regime.astype(str), outputs, traj.switches,

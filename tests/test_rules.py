@@ -104,7 +104,7 @@ def test_root_is_located_superlinearly_on_the_far_side(cubic, most):
 def _scan(functions, directions, interior=3, t0=0.0, t1=1.0, rates=None, scale=1.0):
     prob = clock_problem(functions, directions, rates)
     y0, y1, n0, n1, Q = clock_step(t0, t1, scale)
-    work = rules.Scratch(np.zeros(8), np.zeros(8), np.zeros(8), np.zeros(8, dtype=bool))
+    work = rules.scratch(8, 8)
     return rules.first_crossing(prob, 0, t0, t1, y0, y1, n0, n1, Q, settings(interior), False, work)
 
 

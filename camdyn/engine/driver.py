@@ -17,7 +17,7 @@ from ..outcome import Outcome
 from . import cache
 from .config import BACKENDS, SolverOptions, settings
 from .kernels import compiled_kernels, python_kernels
-from .loop import OUTCOMES, Samples, Start, loop_loaded, run_compiled, run_interpreted
+from .loop import LEDGER_ROWS, OUTCOMES, STATE_ROWS, Samples, Start, loop_loaded, run_compiled, run_interpreted
 from .problem import Problem
 from .tableau import TABLEAUS, arrays
 from .tables import tables, transition_rows
@@ -44,7 +44,7 @@ class Trajectory:
     """Samples of the state with the mode at each, the switches, how the run ended."""
 
     t: np.ndarray
-    y: np.ndarray            # rows alpha, alpha_dot (and with the ledger W_in, W_c, W_f)
+    y: np.ndarray            # rows loop.ALPHA, ALPHA_DOT (and with the ledger the works from loop.WORK on)
     mode: np.ndarray         # mode index at each sample (into modes)
     modes: tuple             # the scene's MODES
     switches: list
@@ -81,7 +81,7 @@ def integrate(model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     cfg = settings(options, model.equilibrium.vartheta)
     t0, t_end = map(float, t_span)
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
-    samples = Samples(t_eval, np.empty((5 if options.ledger else 2, t_eval.size)),
+    samples = Samples(t_eval, np.empty((LEDGER_ROWS if options.ledger else STATE_ROWS, t_eval.size)),
                       np.zeros(t_eval.size, dtype=np.int64))
     y0 = np.asarray(y0, dtype=float)
     start = Start(t0, t_end, float(y0[0]), float(y0[1]), -1 if mode is None else int(mode))

@@ -26,8 +26,8 @@ from numba import njit
 from . import cache
 from .jit import jitable
 from .ledger import N_FLOWS, accumulate
-from .rules import (NONFINITE, Scratch, across, chattering, first_crossing, initial_mode, left_at_start, switch,
-                    zero_at_start)
+from .rules import (NONFINITE, across, chattering, first_crossing, initial_mode, left_at_start, scratch,
+                    switch, zero_at_start)
 from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -48,9 +48,16 @@ class Start(NamedTuple):
     mode: int            # -1: chosen by the automaton's initial candidates
 
 
+#: rows of Samples.y (and so of a Trajectory's y): the state, then, with the energy ledger, the
+#: works of the flows P_in, D_c, D_f (camdyn.derive.vocabulary.FLOWS) in rows WORK..WORK + N_FLOWS
+ALPHA, ALPHA_DOT, WORK = 0, 1, 2
+#: how many rows Samples.y has without and with the ledger
+STATE_ROWS, LEDGER_ROWS = WORK, WORK + N_FLOWS
+
+
 class Samples(NamedTuple):
-    """The times to sample (t) and where the samples go: y rows alpha, alpha_dot and, with the
-    ledger, the work of the drive, contact damping and friction; mode the mode at each."""
+    """The times to sample (t) and where the samples go: y rows ALPHA, ALPHA_DOT and, with the
+    ledger, the works from row WORK on (the drive, contact damping, friction); mode the mode at each."""
 
     t: np.ndarray
     y: np.ndarray
@@ -88,16 +95,16 @@ def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tm
     """Write the samples at times <= t_stop from the step's interpolant; the next index.  With a
     ledger, ledger_work is the work at the step's start t."""
     n = samples.t.shape[0]
-    ledger = samples.y.shape[0] > 2
+    ledger = samples.y.shape[0] > STATE_ROWS
     while i < n and samples.t[i] <= t_stop:
         ts = samples.t[i]
-        samples.y[0, i], samples.y[1, i] = dense_eval(ts, t, h, y0, y1, Q)
+        samples.y[ALPHA, i], samples.y[ALPHA_DOT, i] = dense_eval(ts, t, h, y0, y1, Q)
         if ledger:
             for k in range(N_FLOWS):  # element by element, as in _record
                 ledger_tmp[k] = ledger_work[k]
             accumulate(prob, m, t, h, y0, y1, Q, t, ts, buf, ledger_tmp)
             for k in range(N_FLOWS):
-                samples.y[2 + k, i] = ledger_tmp[k]
+                samples.y[WORK + k, i] = ledger_tmp[k]
         samples.mode[i] = m
         i += 1
     return i
@@ -140,13 +147,12 @@ def run(prob, method, cfg, start, samples):
     n = method.n_stages
     K = np.empty((method.n_rows, 2))
     Q = np.empty((2, method.degree))
-    n_watch = max(1, tab.n_transitions)
-    n_surf = max(1, tab.n_surfaces)
-    work = Scratch(np.zeros(n_watch), np.zeros(n_watch), np.zeros(n_surf), np.zeros(n_surf, dtype=np.bool_))
-    g_prev = work.g_prev
-    buf = np.empty(max(tab.n_outputs, 2))
-    ledger_work, ledger_tmp = np.zeros(N_FLOWS), np.zeros(N_FLOWS)
-    ledger = samples.y.shape[0] > 2
+    work = scratch(tab.n_transitions, tab.n_surfaces)
+    buf = np.empty(tab.n_outputs if tab.n_outputs > 2 else 2)
+    ledger_work, ledger_tmp = np.empty(N_FLOWS), np.empty(N_FLOWS)
+    for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
+        ledger_work[k] = 0.0
+    ledger = samples.y.shape[0] > STATE_ROWS
     sw = np.empty(16, dtype=SWITCH)
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
@@ -174,7 +180,7 @@ def run(prob, method, cfg, start, samples):
                 nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
             w, t_cross = -1, t_new
             if watched:
-                on_surface = not have_start or zero_at_start(g_prev, n_watched)
+                on_surface = not have_start or zero_at_start(work, n_watched)
                 w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
                 if w == NONFINITE:
                     outcome = NONFINITE_STATE

@@ -36,8 +36,6 @@ latest is a run making no progress: it stops (``Outcome.CHATTER``).
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
-
 import numpy as np
 
 from .jit import jitable
@@ -47,20 +45,23 @@ from .stepper import dense_eval
 NONFINITE = -2
 
 
-class Scratch(NamedTuple):
-    """Work arrays of :func:`first_crossing`: per watched transition, its surface's value and
-    rate at the previous sample; per surface, the value at the current sample and whether it
-    is known."""
-
-    g_prev: np.ndarray
-    r_prev: np.ndarray
-    values: np.ndarray
-    known: np.ndarray
+#: rows of first_crossing's work array (:func:`scratch`): per watched transition of the mode
+#: (k = w - watch_start[m]), its surface's value and rate at the previous sample; per surface,
+#: its value at the current sample
+G_PREV, R_PREV, VALUES = 0, 1, 2
 
 
-def scratch(n_transitions: int, n_surfaces: int) -> Scratch:
-    n, s = max(1, n_transitions), max(1, n_surfaces)
-    return Scratch(np.zeros(n), np.zeros(n), np.zeros(s), np.zeros(s, dtype=np.bool_))
+@jitable
+def scratch(n_transitions, n_surfaces):
+    """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES.  One array, not
+    three: a compiled call pays an atomic reference count per array it passes.  (np.empty and
+    a loop, no np.zeros or max of ints: each compiles one more overload on a cold start.)"""
+    n = n_transitions if n_transitions > n_surfaces else n_surfaces
+    work = np.empty((3, n if n > 1 else 1))
+    for r in range(3):
+        for k in range(work.shape[1]):
+            work[r, k] = 0.0
+    return work
 
 
 @jitable
@@ -216,28 +217,10 @@ def turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb
 
 
 @jitable
-def _values_at(prob, m, w0, w1, t, a, ad, values, known):
-    """values[s] for the surfaces transitions w0..w1 watch, and their rates, at (t, a, ad),
-    each surface once (known[s] marks those computed).
-
-    Compiled, a call that passes the Problem and Scratch tuples costs a reference count per
-    array they hold (about 0.2 us: measured); the loop's hot path, first_crossing, calls it once
-    per sample with the two arrays it writes."""
-    tab = prob.tables
-    surface_of = tab.data[tab.surface:tab.surface + tab.n_transitions]
-    rate_of = tab.data[tab.surface_rate:tab.surface_rate + tab.n_surfaces]
-    kernel, p = prob.kernels.surface, prob.p
-    for s in range(known.shape[0]):
-        known[s] = False
-    for w in range(w0, w1):
-        s = surface_of[w]
-        r = rate_of[s]
-        if not known[s]:
-            values[s] = kernel(m, s, t, a, ad, p)
-            known[s] = True
-        if r >= 0 and not known[r]:
-            values[r] = kernel(m, r, t, a, ad, p)
-            known[r] = True
+def _changes(direction, ga, gb, rate, ra, rb):
+    """Whether a sample may hide a crossing: a sign change in the direction, or (with a rate
+    surface) a turn of the rate (:func:`_turns`); :func:`_crossing_in` decides."""
+    return crossed(ga, gb, direction) or (rate >= 0 and _turns(direction, ga, ra, rb))
 
 
 @jitable
@@ -248,70 +231,77 @@ def _turns(direction, ga, ra, rb):
 
 
 @jitable
+def _crossing_in(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, xtol):
+    """The far-side time of transition's surface s crossing zero in ``direction`` inside
+    (ta, tb] of the step [t, t + h], or -1.0: a sign change (unless it is rounding noise, see
+    :func:`turned_back`) or a hidden excursion (:func:`hidden_excursion`), located."""
+    if crossed(ga, gb, direction):
+        lo, glo, genuine = ta, ga, True
+        if rate >= 0:
+            lo, glo, genuine = turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb)
+        if genuine:
+            return locate(prob, m, s, t, h, y0, y1, Q, lo, tb, glo, gb, xtol)[0]
+    elif rate >= 0 and _turns(direction, ga, ra, rb):
+        t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb)
+        if t_ext >= 0.0:
+            return locate(prob, m, s, t, h, y0, y1, Q, ta, t_ext, ga, g_ext, xtol)[0]
+    return -1.0
+
+
+@jitable
 def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     """Earliest crossing of mode m's watched transitions over the step [t0, t1].
 
     Returns (w, t): the transition's row and the located far-side time; w = -1 when nothing
-    crosses, NONFINITE when a value is not finite.  ``have_start``: work.g_prev and
-    work.r_prev already hold the values at t0 (the previous step's end); with no crossing,
-    they hold the values at t1 on return.  (Runs once per step: the arrays it reads are taken
-    out of their tuples once, and the rare locating calls only are calls.)
+    crosses, NONFINITE when a value is not finite.  ``have_start``: work's rows G_PREV and
+    R_PREV already hold the values at t0 (the previous step's end); with no crossing, they
+    hold the values at t1 on return.  (Runs once per step: the kernel is called here directly,
+    and only the rare crossing found is a call, :func:`_crossing_in`, each compiled call
+    passing arrays paying atomic reference counts.)
     """
     tab = prob.tables
-    surface_of = tab.data[tab.surface:tab.surface + tab.n_transitions]
-    direction_of = tab.data[tab.direction:tab.direction + tab.n_transitions]
-    rate_of = tab.data[tab.surface_rate:tab.surface_rate + tab.n_surfaces]
-    g_prev, r_prev, values, known = work.g_prev, work.r_prev, work.values, work.known
-    w0, w1 = tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]
+    data, kernel, p = tab.data, prob.kernels.surface, prob.p
+    w0, w1 = data[tab.watch_start + m], data[tab.watch_start + m + 1]
+    q0, q1 = data[tab.sampled_start + m], data[tab.sampled_start + m + 1]
     h = t1 - t0
     n_int = cfg.interior_points
-    if not have_start:
-        _values_at(prob, m, w0, w1, t0, y0, y1, values, known)
-        for w in range(w0, w1):
-            g_prev[w - w0] = values[surface_of[w]]
-            r_prev[w - w0] = values[rate_of[surface_of[w]]] if rate_of[surface_of[w]] >= 0 else 0.0
     best_w, best_t = -1, math.inf
     found = 0
-    for i in range(1, n_int + 2):
+    for i in range(1 if have_start else 0, n_int + 2):  # sample 0: the start, when not known yet
         ta = t0 + h * (i - 1) / (n_int + 1)
         last = i == n_int + 1
         tb = t1 if last else t0 + h * i / (n_int + 1)
         if tb >= best_t:
             break  # a root in (ta, tb] cannot beat one already located before tb
-        if last:
+        if i == 0:
+            a, ad = y0, y1
+        elif last:
             a, ad = n0, n1
         else:
             a, ad = dense_eval(tb, t0, h, y0, y1, Q)
-        _values_at(prob, m, w0, w1, tb, a, ad, values, known)
+        for q in range(q0, q1):
+            s = data[tab.sampled + q]
+            work[VALUES, s] = kernel(m, s, tb, a, ad, p)
         for w in range(w0, w1):
             k = w - w0
             if (found >> k) & 1:
                 continue
-            s, direction = surface_of[w], direction_of[w]
-            rate = rate_of[s]
-            ga, gb = g_prev[k], values[s]
-            if not (math.isfinite(ga) and math.isfinite(gb)):
-                return NONFINITE, tb
-            rb = values[rate] if rate >= 0 else 0.0
-            tk = -1.0
-            if crossed(ga, gb, direction):
-                lo, glo, genuine = ta, ga, True
-                if rate >= 0:
-                    lo, glo, genuine = turned_back(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
-                                                   r_prev[k], rb)
-                if genuine:
-                    tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, lo, tb, glo, gb, cfg.xtol)
-            elif rate >= 0 and _turns(direction, ga, r_prev[k], rb):
-                t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga,
-                                                r_prev[k], rb)
-                if t_ext >= 0.0:
-                    tk, _ = locate(prob, m, s, t0, h, y0, y1, Q, ta, t_ext, ga, g_ext, cfg.xtol)
-            g_prev[k] = gb
-            r_prev[k] = rb
-            if tk >= 0.0:
-                found |= 1 << k
-                if tk < best_t:
-                    best_w, best_t = w, tk
+            s = data[tab.surface + w]
+            rate = data[tab.surface_rate + s]
+            gb = work[VALUES, s]
+            rb = work[VALUES, rate] if rate >= 0 else 0.0
+            if i > 0:
+                ga, ra, direction = work[G_PREV, k], work[R_PREV, k], data[tab.direction + w]
+                if not (math.isfinite(ga) and math.isfinite(gb)):
+                    return NONFINITE, tb
+                if _changes(direction, ga, gb, rate, ra, rb):
+                    tk = _crossing_in(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, cfg.xtol)
+                    if tk >= 0.0:
+                        found |= 1 << k
+                        if tk < best_t:
+                            best_w, best_t = w, tk
+            work[G_PREV, k] = gb
+            work[R_PREV, k] = rb
     return best_w, best_t
 
 
@@ -329,11 +319,11 @@ def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
 
 
 @jitable
-def zero_at_start(g_prev, n_watched):
+def zero_at_start(work, n_watched):
     """Whether a watched value was exactly 0 at the step's start (a start on its surface):
-    g_prev[:n_watched] are the values first_crossing kept."""
+    work[G_PREV, :n_watched] are the values first_crossing kept."""
     for k in range(n_watched):
-        if g_prev[k] == 0.0:
+        if work[G_PREV, k] == 0.0:
             return True
     return False
 

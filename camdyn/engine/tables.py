@@ -39,6 +39,8 @@ class Tables(NamedTuple):
     condition_sign: int            # per condition: holds where sign * value >= 0
     surface_rate: int              # per surface: the surface that is its time derivative, or -1
     flows: int                     # the outputs integrated by the energy ledger (P_in, D_c, D_f)
+    sampled_start: int             # per mode, and one past the end: its sampled surfaces (rows)
+    sampled: int                   # per row: a surface mode m samples (watched, or a watched one's rate), once
     n_modes: int
     n_transitions: int
     n_surfaces: int
@@ -60,12 +62,29 @@ def tables(K: ModuleType) -> Tables:
             condition_start.append(len(condition_surface))
         target_start.append(len(target_mode))
     resets = [IDENTITY if K.RESETS[tr[4]] == "identity" else tr[4] for tr in transitions]
+    sampled_start, sampled = sampled_surfaces(K, transitions, watch_start)
     parts = [K.CONTACT_OF_MODE, watch_start, [tr[1] for tr in transitions], [tr[2] for tr in transitions], resets,
              target_start, target_mode, condition_start, condition_surface, condition_sign, K.RATE_OF_SURFACE,
-             [K.OUTPUTS.index(f) for f in FLOWS]]
+             [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled]
     starts = np.cumsum([0] + [len(part) for part in parts])[:-1]
     data = np.ascontiguousarray(np.concatenate([np.asarray(part, dtype=np.int64) for part in parts]), dtype=np.int64)
     return Tables(data, *map(int, starts), n_modes, len(transitions), len(K.SURFACES), len(K.OUTPUTS))
+
+
+def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tuple[list[int], list[int]]:
+    """Per mode, the surfaces its crossing check samples: those its transitions watch and their
+    declared rates, each once, in the order of first use (compressed rows: mode m's are
+    ``sampled[sampled_start[m]:sampled_start[m + 1]]``)."""
+    start, sampled = [0], []
+    for m in range(len(K.MODES)):
+        mine: list[int] = []
+        for tr in transitions[watch_start[m]:watch_start[m + 1]]:
+            for s in (tr[1], K.RATE_OF_SURFACE[tr[1]]):
+                if s >= 0 and s not in mine:
+                    mine.append(s)
+        sampled += mine
+        start.append(len(sampled))
+    return start, sampled
 
 
 def transition_rows(K: ModuleType) -> list[tuple]:

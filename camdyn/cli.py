@@ -688,8 +688,11 @@ specs = tuple(sorted(set(catalog.CATALOG), key=lambda s: s.slug))
 bar = dict(total=len(specs), desc="deriving scenes", unit="scene", file=sys.stderr, disable=None)
 if jobs > 1:
     from concurrent.futures import ProcessPoolExecutor
+    rank = getattr(writer, "cost_rank", None)  # slowest scenes first, where this derive says which
+    work = sorted(specs, key=rank) if rank else list(specs)
     with ProcessPoolExecutor(jobs) as pool:
-        texts = list(tqdm(pool.map(codegen.module_source, specs), **bar))
+        text_of = dict(zip(work, tqdm(pool.map(codegen.module_source, work), **bar)))
+    texts = [text_of[s] for s in specs]
 else:
     texts = [codegen.module_source(s) for s in tqdm(specs, **bar)]
 files = {writer.module_name(s) + ".py": t for s, t in zip(specs, texts)}

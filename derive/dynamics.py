@@ -114,6 +114,7 @@ Q = SimpleNamespace(**{name: quantity(name) for name in (
     "alpha_ddot")})
 
 
+@lru_cache(maxsize=None)  # pure (ContactRegime is frozen), shared by the scenes of a regime
 def mechanics(regime: ContactRegime | None) -> tuple[Definition, ...]:
     """The named quantities of one mode, in the order they are computed: the gap and its rate
     (Eqs. 6, 8), psi_j and the moment arm chi (Eqs. 7, 2), the spring force (Eq. 11), the
@@ -163,6 +164,7 @@ def named_forces(regime: ContactRegime | None) -> Forces:
     return Forces(Q.F_s, Q.F_n, Q.F_f if friction else zero, Q.v_r if friction else zero)
 
 
+@lru_cache(maxsize=None)  # pure (ContactRegime is frozen): a trigsimp, shared by the scenes of a regime
 def acceleration(regime: ContactRegime | None) -> Definition:
     """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free), in the named forces."""
     chi_ = S.chi0 if regime is None else Q.chi  # no normal force in free flight: chi does not enter

@@ -18,6 +18,8 @@ with dE/dt = P_in - D_c - D_f, an identity checked symbolically in the tests.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import sympy as sp
 
 from . import dynamics, laws
@@ -29,6 +31,7 @@ def kinetic() -> sp.Expr:
     return S.I_Pb * alpha.diff(t) ** 2 / 2
 
 
+@lru_cache(maxsize=None)  # pure: an integral, asked for by every scene
 def spring_potential() -> sp.Expr:
     """V_s(alpha), the potential of the spring moment of Eq. 10 (zero at alpha = 0)."""
     a = sp.Symbol("a", real=True)

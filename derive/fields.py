@@ -60,6 +60,7 @@ def motion_substitution(motion: str) -> dict:
     raise ValueError(f"motion {motion!r} is not a cam motion of Section 7")
 
 
+@lru_cache(maxsize=None)  # pure; the scenes of a worker share most expressions
 def plain(expr: sp.Expr, motion: str) -> sp.Expr:
     """An expression of alpha(t), Theta(t) in plain symbols, with the cam motion substituted."""
     return S.to_plain(expr).subs(motion_substitution(motion))

@@ -21,6 +21,7 @@ right-hand side along (alpha*, 0, Theta(t)), with time-varying coefficients.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import sympy as sp
 
@@ -40,6 +41,7 @@ class PaperLinearModel:
     F_l: sp.Expr   # a function of Theta(t) (plain symbol S.Theta_s)
 
 
+@lru_cache(maxsize=None)  # pure; its two simplifications take seconds, and field and jacobian both ask
 def paper_linear_model(c_lambda: sp.Expr, mu: sp.Expr, forcing_arm: str = "printed") -> PaperLinearModel:
     """Eqs. 36-38 by the paper's procedure; ``mu`` is the signed friction coefficient."""
     a_star, Th = S.alpha_star, S.Theta_s

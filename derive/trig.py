@@ -66,10 +66,45 @@ def _parts(u: sp.Expr):
     return a, T, sp.expand(rest - T)
 
 
+#: two points of the parameter space (positive, away from 0 and 1), one value per symbol in
+#: sorted order, at which a ratio is evaluated before it is simplified (:func:`_varies`)
+_PROBES = ((0.3141, 0.2718, 0.1618, 0.5772, 0.4142, 0.7071, 0.3333, 0.6931, 0.2357, 0.8660),
+           (0.6180, 0.4473, 0.7320, 0.1234, 0.8888, 0.3030, 0.5555, 0.2222, 0.6666, 0.1414))
+
+
+def _varies(q: sp.Expr) -> bool:
+    """True when q surely is not a constant: it takes clearly different values at the two
+    probe points.  Simplification preserves values, so ``sp.simplify(q)`` cannot be a number
+    then, and the (slow: seconds for an arcsine of the geometry) simplification is skipped.
+    False when unsure (no symbols, a symbol not positive-compatible, a value not finite, values
+    close): the caller simplifies as before, so the decisions and the output are unchanged."""
+    syms = sorted(q.free_symbols, key=sp.default_sort_key)
+    if not syms or any(s.is_nonpositive or s.is_integer for s in syms):
+        return False
+    values = []
+    for probe in _PROBES:
+        point = {s: sp.Float(probe[i % len(probe)] * (1 + i // len(probe)), 30) for i, s in enumerate(syms)}
+        v = sp.N(q.xreplace(point), 30)
+        if not v.is_number or v.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+            return False
+        values.append(complex(v))
+    a, b = values
+    return abs(a - b) > 1e-9 * (abs(a) + abs(b))
+
+
 def _ratio(x: sp.Expr, base: sp.Expr):
     """x / base if it is a non-zero integer, else None."""
-    q = sp.simplify(x / base)
+    q = x / base
+    if _varies(q):
+        return None
+    q = sp.simplify(q)
     return int(q) if q.is_Integer and q != 0 else None
+
+
+def _rational_multiple(x: sp.Expr, base: sp.Expr) -> bool:
+    """Whether x / base is a rational number."""
+    q = x / base
+    return not _varies(q) and sp.simplify(q).is_Rational
 
 
 def _time_bases(Ts: list[sp.Expr]) -> dict[sp.Expr, tuple[sp.Expr, int]]:
@@ -78,7 +113,7 @@ def _time_bases(Ts: list[sp.Expr]) -> dict[sp.Expr, tuple[sp.Expr, int]]:
     for T in Ts:
         for W in Ts:
             m = _ratio(T, W)
-            family = [other for other in Ts if sp.simplify(other / W).is_Rational]
+            family = [other for other in Ts if _rational_multiple(other, W)]
             if m is not None and all(_ratio(other, W) is not None for other in family):
                 out[T] = (W, m)
                 break

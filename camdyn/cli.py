@@ -32,6 +32,7 @@ import re
 import subprocess
 import sys
 import threading
+import warnings
 import time
 from pathlib import Path
 from typing import NamedTuple
@@ -1171,7 +1172,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = _parser().parse_args(argv)
         args.argv = argv
-        code = args.func(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_notice
+            code = args.func(args)
         sys.stdout.flush()  # here, so that a closed pipe is handled below, not at exit
         return code
     except KeyboardInterrupt:
@@ -1189,6 +1192,12 @@ def main(argv: list[str] | None = None) -> int:
         code, line = _classify(exc)
         print(f"camdyn: {line}", file=sys.stderr)
         return code
+
+
+def _show_notice(message, category, filename, lineno, file=None, line=None):
+    """Warnings on the command line as one line, ``camdyn: note: ...`` (not Python's source line):
+    the user of the CLI did not write the code the warning points at."""
+    print(f"camdyn: note: {message}", file=file or sys.stderr)
 
 
 def _classify(exc: BaseException) -> tuple[int, str]:

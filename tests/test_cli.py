@@ -450,3 +450,18 @@ def test_a_compiled_run_writes_nothing_inside_the_package():
     camdyn.simulate(camdyn.example_rig(), camdyn.Scene(), speed_rpm=300, t_end=1e-3)
     for root in (Path(camdyn.__file__).parent, Path(camdyn.generated.__file__).parent):
         assert not [p for p in root.rglob("*") if p.suffix in (".nbi", ".nbc")], root
+
+
+def test_warnings_print_as_one_note_line_not_python_source(capsys, monkeypatch):
+    """A CompileNotice (or any warning) on the command line: `camdyn: note: ...`, no file and line."""
+    import warnings
+
+    import camdyn.presets
+
+    def noisy():
+        warnings.warn("compiling, once", camdyn.CompileNotice)
+        return ["example"]
+    monkeypatch.setattr(camdyn.presets, "available", noisy)
+    assert main(["scenes"]) == 0
+    err = capsys.readouterr().err
+    assert "camdyn: note: compiling, once" in err and ".py:" not in err

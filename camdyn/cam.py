@@ -102,3 +102,15 @@ class UserMotion:
 
 
 CamMotion = ConstantSpeed | Oscillating | UserMotion
+
+
+def cam_motion(cam, speed_rpm: float | None):
+    """The cam motion of a call that takes ``cam`` or ``speed_rpm`` (a constant speed, rev/min):
+    exactly one of them, else :class:`~camdyn.errors.ParameterError`."""
+    if cam is None:
+        if speed_rpm is None:
+            raise ParameterError("cam", None, "a cam motion, or speed_rpm for a constant speed")
+        return ConstantSpeed(speed_rpm)
+    if speed_rpm is not None:
+        raise ParameterError("speed_rpm", speed_rpm, "not both cam and speed_rpm")
+    return cam

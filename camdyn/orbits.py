@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .cam import CamMotion, ConstantSpeed
+from .cam import CamMotion, cam_motion
 from .engine.config import SolverOptions
 from .engine.driver import integrate
 from .errors import ParameterError
@@ -231,12 +231,7 @@ def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, spee
     atol 1e-13).  The result says how the search ended (:class:`OrbitOutcome`); it raises
     only on bad input.
     """
-    if cam is None:
-        if speed_rpm is None:
-            raise ParameterError("cam", None, "a cam motion, or speed_rpm for a constant speed")
-        cam = ConstantSpeed(speed_rpm)
-    elif speed_rpm is not None:
-        raise ParameterError("speed_rpm", speed_rpm, "not both cam and speed_rpm")
+    cam = cam_motion(cam, speed_rpm)
     if not isinstance(settings, ShootingSettings):
         raise ParameterError("settings", settings, "a camdyn.orbits.ShootingSettings")
     model = Model(rig, scene, cam)

@@ -7,7 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from .cam import CamMotion, ConstantSpeed
+from .cam import CamMotion, cam_motion
 from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, integrate
@@ -62,12 +62,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")
     scene = scene if scene is not None else Scene()
-    if cam is None:
-        if speed_rpm is None:
-            raise ParameterError("cam", None, "a cam motion, or speed_rpm for a constant speed")
-        cam = ConstantSpeed(speed_rpm)
-    elif speed_rpm is not None:
-        raise ParameterError("speed_rpm", speed_rpm, "not both cam and speed_rpm")
+    cam = cam_motion(cam, speed_rpm)
     if backend == "compiled" and getattr(cam, "kind", None) == "user":
         raise ParameterError("backend", backend, "'python' for a UserMotion: its Theta(t) is a Python "
                              "callable, which compiled code cannot call")

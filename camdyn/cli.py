@@ -821,7 +821,7 @@ def cmd_cache(args) -> int:
 
     if args.clear or args.clear_stale:
         removed = cache.clear(stale_only=args.clear_stale)
-        removed += _clear_scenes(ondemand, stale_only=args.clear_stale)
+        removed += ondemand.clear(stale_only=args.clear_stale)
         print(f"removed {len(removed)} cache folder(s)" + "".join(f"\n  {d}" for d in removed))
         return EXIT_OK
     entries = cache.entries()
@@ -838,18 +838,6 @@ def cmd_cache(args) -> int:
         state = "current" if current else "stale (another derivation or SymPy)"
         print(f"  {folder.name}  {state}: {', '.join(slugs) or 'no scenes'}")
     return EXIT_OK
-
-
-def _clear_scenes(ondemand, stale_only: bool) -> list:
-    """Delete the folders of derived scenes (with ``stale_only``: those of other derivations)."""
-    import shutil
-
-    removed = []
-    for folder, _, current in ondemand.entries():
-        if not (stale_only and current):
-            shutil.rmtree(folder, ignore_errors=True)
-            removed.append(folder)
-    return removed
 
 
 # --------------------------------------------------------------------------- parser

@@ -17,7 +17,6 @@ that is neither generated nor cached is a :class:`~camdyn.errors.SceneError` tha
 """
 from __future__ import annotations
 
-import hashlib
 import importlib.metadata
 import importlib.util
 import json
@@ -30,7 +29,7 @@ from pathlib import Path
 from types import ModuleType
 
 from .derive.vocabulary import SceneSpec
-from .engine.cache import user_cache_root
+from .engine.cache import remove_folders, source_hash, user_cache_root
 from .errors import CompileNotice, SceneError
 
 SCENES_FOLDER = "scenes"
@@ -53,11 +52,7 @@ def sympy_version() -> str | None:
 def derive_key() -> str:
     """A hash of the installed derivation's sources and the SymPy version."""
     derive = Path(importlib.util.find_spec("camdyn.derive").submodule_search_locations[0])
-    h = hashlib.sha256(str(sympy_version()).encode())
-    for path in sorted(derive.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()[:12]
+    return source_hash(derive, salt=str(sympy_version()))
 
 
 def scenes_root() -> Path:
@@ -118,3 +113,8 @@ def entries() -> list[tuple[Path, list[str], bool]]:
         return []
     return [(d, sorted(p.stem.removeprefix("scene_") for p in d.glob("scene_*.py")), d.name == derive_key())
             for d in sorted(p for p in root.iterdir() if p.is_dir())]
+
+
+def clear(stale_only: bool = False) -> list[Path]:
+    """Delete the folders of derived scenes (only those of other derivations with ``stale_only``)."""
+    return remove_folders(entries(), stale_only)

@@ -17,6 +17,7 @@ Three groups:
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from typing import Union
 
@@ -25,6 +26,7 @@ __all__ = ["Rule", "Constant", "RigParameter", "RIG_PARAMETERS", "EQUILIBRIUM_QU
 
 #: the comparisons a rule may make; ``abs<``: |x| < bound, ``abs<=``: |x| <= bound
 OPERATORS = (">", ">=", "<", "<=", "abs<", "abs<=")
+_COMPARE = {">": operator.gt, ">=": operator.ge, "<": operator.lt, "<=": operator.le}
 
 
 @dataclass(frozen=True)
@@ -59,8 +61,8 @@ class Rule:
     def holds(self, x: float, known: dict) -> bool:
         """Whether ``x`` satisfies the rule; ``known``: the parameters validated before it."""
         b = known[self.bound] if isinstance(self.bound, str) else self.bound
-        return {">": x > b, ">=": x >= b, "<": x < b, "<=": x <= b,
-                "abs<": abs(x) < b, "abs<=": abs(x) <= b}[self.op]
+        compare = _COMPARE[self.op.removeprefix("abs")]
+        return compare(abs(x) if self.op.startswith("abs") else x, b)
 
 
 @dataclass(frozen=True)

@@ -191,9 +191,12 @@ OUTPUTS: dict[str, tuple[str, str]] = {
     "D_c": ("W", "power dissipated by contact damping"),
     "D_f": ("W", "power dissipated by friction"),
 }
+#: the continuous state, in order: as a reset writes it to ``out``, as the engine samples it
+STATE = ("alpha", "alpha_dot")
+STATE_ALPHA, STATE_ALPHA_DOT = range(len(STATE))
 #: the entries the generated ``jacobian`` kernel writes to ``out``, in order: the partial
-#: derivatives of alpha_ddot by alpha and by alpha_dot (Eqs. 21-22)
-JACOBIAN = ("d_alpha", "d_alpha_dot")
+#: derivatives of alpha_ddot by alpha and by alpha_dot (Eqs. 21-22), in the order of STATE
+JACOBIAN = tuple(f"d_{name}" for name in STATE)
 JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
 #: the cam's state as the generated ``cam`` kernel and a user's cam motion return it
 CAM_STATE = ("Theta", "Theta_dot", "Theta_ddot")

@@ -46,15 +46,20 @@ def user_cache_root() -> Path:
     return base / "camdyn"
 
 
+def source_hash(folder: Path, salt: str = "") -> str:
+    """12 hex digits of a hash of ``salt`` and the names and bytes of ``folder``'s modules."""
+    h = hashlib.sha256(salt.encode())
+    for path in sorted(folder.glob("*.py")):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:12]
+
+
 @lru_cache(maxsize=None)
 def engine_key() -> str:
     """camdyn's version and a hash of the engine's sources: the name of the current cache."""
     from .. import __version__
-    h = hashlib.sha256()
-    for path in sorted(ENGINE.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return f"{__version__}-{h.hexdigest()[:12]}"
+    return f"{__version__}-{source_hash(ENGINE)}"
 
 
 def cache_dir() -> Path:
@@ -76,8 +81,13 @@ def entries() -> list[tuple[Path, int, bool]]:
 
 def clear(stale_only: bool = False) -> list[Path]:
     """Delete the cache folders (only those of other versions or engines with ``stale_only``)."""
+    return remove_folders(entries(), stale_only)
+
+
+def remove_folders(listed, stale_only: bool) -> list[Path]:
+    """Delete the folders of ``listed`` ((folder, ..., current) rows), all or only the stale ones."""
     removed = []
-    for d, _, current in entries():
+    for d, *_, current in listed:
         if stale_only and current:
             continue
         shutil.rmtree(d, ignore_errors=True)

@@ -15,6 +15,7 @@ import numba
 import numpy as np
 from numba import njit, types
 
+from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from ..errors import SceneError
 from . import cache
 from .problem import Kernels
@@ -36,8 +37,8 @@ def _no_surface(m, s, t, alpha, alpha_dot, p):
 
 def _no_reset(j, t, alpha, alpha_dot, p, out):
     """A scene whose transitions all keep the state (identity resets): never called."""
-    out[0] = math.nan
-    out[1] = math.nan
+    out[STATE_ALPHA] = math.nan
+    out[STATE_ALPHA_DOT] = math.nan
 
 
 no_surface = numba.cfunc(SURFACE, cache=True)(_no_surface)

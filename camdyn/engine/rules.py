@@ -38,6 +38,7 @@ from __future__ import annotations
 import math
 import numpy as np
 
+from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from .jit import jitable
 from .stepper import dense_eval
 
@@ -344,7 +345,7 @@ def switch(prob, w, t, a, ad, cfg, buf):
     j = tab.data[tab.reset + w]
     if j >= 0:
         prob.kernels.reset(j, t, a, ad, prob.p, buf)
-        return m_new, buf[0], buf[1]
+        return m_new, buf[STATE_ALPHA], buf[STATE_ALPHA_DOT]
     return m_new, a, ad
 
 

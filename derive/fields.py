@@ -7,7 +7,9 @@ For one mode of the automaton (:mod:`derive.automaton`) this module derives
 * :func:`surface`: the value of one switching surface under the mode's laws;
 * :func:`outputs`: the output quantities of :data:`derive.vocabulary.OUTPUTS`;
 * :func:`jacobian`: d(alpha_ddot)/d(alpha, alpha_dot), by the chain rule through the named
-  quantities (Eqs. 21-22).
+  quantities (Eqs. 21-22);
+* :func:`surface_gradient`: dh/d(alpha, alpha_dot) and dh/dt of a surface's value h (the
+  saltation matrices of the tangent dynamics, ``camdyn.engine.saltation``).
 
 Each is a :class:`Kernel`: definitions (``psi_i = ...``, ``F_n = ...``) in the order they are
 computed, and the results.  Expressions are in the plain symbols t, alpha, alpha_dot and the
@@ -26,7 +28,7 @@ from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
 from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
-from .vocabulary import JACOBIAN, OUTPUTS, SceneSpec
+from .vocabulary import JACOBIAN, OUTPUTS, SURFACE_GRADIENT, SceneSpec
 
 
 @dataclass(frozen=True)
@@ -155,6 +157,32 @@ def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
         rate = v_t + v_a * S.alpha_dot + v_ad * Q.alpha_ddot
         return Kernel(side + _slip_partials(spec)[1:], (rate,)).pruned()
     return None
+
+
+#: the name of a surface's value in :func:`surface_gradient`'s definitions
+SURFACE_VALUE = quantity("surface_value")
+
+
+def surface_gradient(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
+    """dh/dalpha, dh/dalpha_dot and dh/dt (SURFACE_GRADIENT order) of surface ``name``'s value
+    h under the mode's laws, by the chain rule through the named quantities (a slip_rate
+    surface through the alpha_ddot it contains).  dh/dt is the derivative at a fixed state:
+    through Theta(t) = theta0 + Omega_c t (constant speed) or the oscillating motion; a user's
+    motion gives Theta_dot and Theta_ddot, so dh/dt = h_t + Theta_dot h_Theta + Theta_ddot
+    h_Theta_dot, and None where h needs Theta_ddot (its derivative is not given)."""
+    h = surface(spec, mode, name)
+    if h is None:
+        return None
+    defs = h.definitions + (Definition(SURFACE_VALUE, h.results[0], f"the value of surface {name}"),)
+    by = {x: derivatives(defs, x) for x in (S.alpha_s, S.alpha_dot, S.t_s, S.Theta_s, S.Theta_dot)}
+    grad = {x: derivative_symbol(SURFACE_VALUE.name, x, d) for x, d in by.items()}
+    d_t = grad[S.t_s]
+    if spec.motion == "user":
+        if any(sp.sympify(d.expr).has(S.Theta_ddot) for d in defs):
+            return None
+        d_t = d_t + S.Theta_dot * grad[S.Theta_s] + S.Theta_ddot * grad[S.Theta_dot]
+    results = dict(zip(SURFACE_GRADIENT, (grad[S.alpha_s], grad[S.alpha_dot], d_t)))
+    return Kernel(defs + sum(by.values(), ()), tuple(results[n] for n in SURFACE_GRADIENT)).pruned()
 
 
 def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:

@@ -3,14 +3,14 @@
 Along a run, the tangent vectors of the state x = (alpha, alpha_dot) evolve by the variational
 equation between switches and jump by the saltation matrices at them (:mod:`camdyn.tangent`).
 Every cam period T the basis Q of two tangent vectors is propagated, Phi Q = Q' R (QR
-re-orthonormalisation), and log |R_ii| is the stretching of the i-th direction over that
+re-orthonormalisation), and log abs(R_ii) is the stretching of the i-th direction over that
 revolution; the exponents are their sums over the revolutions divided by the time:
 
-    lambda_i = sum_k log |R_ii^(k)| / (N T)   (1/s),  lambda_1 >= lambda_2.
+    lambda_i = sum_k log abs(R_ii^(k)) / (N T)   (1/s),  lambda_1 >= lambda_2.
 
 lambda_1 is the largest exponent (the first column of Q is a single tangent vector
-renormalised every period, Benettin's algorithm); lambda_1 + lambda_2 = log |det Phi| / (N T),
-the time mean of the field's divergence d(alpha_ddot)/d(alpha_dot) plus the switches' log |det S|
+renormalised every period, Benettin's algorithm); lambda_1 + lambda_2 = log abs(det Phi) / (N T),
+the time mean of the field's divergence d(alpha_ddot)/d(alpha_dot) plus the switches' log abs(det S)
 divided by the time (Liouville).  A stick entry (a Filippov sliding mode) has det S = 0: the
 second exponent is then -inf.
 
@@ -38,6 +38,8 @@ from .rig import Rig
 from .scene import Scene
 from .section_map import DEFAULT_OPTIONS
 from .tangent import TangentSettings, tangent
+
+__all__ = ["lyapunov_exponents", "spectrum", "LyapunovExponents", "LyapunovSettings"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +70,7 @@ class LyapunovExponents:
     the exponents times T (nats per cam revolution); ``revolutions``: N measured;
     ``transient``: revolutions discarded before; ``period``: T (s); ``divergence_mean``: the
     time mean of d(alpha_ddot)/d(alpha_dot) over the measured run (1/s); ``saltation_rate``:
-    sum of log |det S| over its switches divided by its time (1/s); ``switches``: how many."""
+    sum of log abs(det S) over its switches divided by its time (1/s); ``switches``: how many."""
 
     exponents: np.ndarray
     standard_error: np.ndarray

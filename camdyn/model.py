@@ -159,6 +159,19 @@ class Model:
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
         return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
 
+    def field_sensitivity(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
+        """d(alpha_ddot)/d(q) in mode m at a fixed state and time for the scene's continuation
+        parameters q (the generated ``field_sensitivity``; its ``SENSITIVITY`` names them, in
+        the order of ``CONTINUATION_PARAMETERS``: the cam's speed constant in rad/s, k_s, e,
+        the damping constants), total derivatives: the static equilibrium follows the rig.
+        Raises :class:`SceneError` for a scene without it (the linear models)."""
+        kernel = getattr(self.kernels, "field_sensitivity", None)
+        if kernel is None:
+            raise SceneError(f"scene {self.kernels.SLUG!r} has no parameter derivatives (non-linear model only)")
+        out = np.empty(len(self.kernels.SENSITIVITY))
+        kernel(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        return dict(zip(self.kernels.SENSITIVITY, map(float, out)))
+
     def surface_gradient(self, m: int, s: int, t: float, alpha: float, alpha_dot: float) -> np.ndarray:
         """(dh/dalpha, dh/dalpha_dot, dh/dt) of surface s's value h under mode m's laws (the
         generated ``surface_gradient``, order ``SURFACE_GRADIENT``), for a surface m watches.

@@ -5,8 +5,8 @@ P_n (:class:`camdyn.section_map.StroboscopicMap`): P_n(x) - x = 0.  :func:`perio
 finds one by Newton's method from a warm start (the state at the section after a short
 simulation), with a backtracking line search; the monodromy matrix M = dP_n/dx at the fixed
 point comes from a Jacobian provider (central finite differences by default,
-:func:`camdyn.section_map.finite_differences`; the variational equations with saltation
-matrices can replace it), and its eigenvalues are the Floquet multipliers: the orbit is
+:func:`camdyn.section_map.finite_differences`; or the variational equations with saltation
+matrices, ``jacobian=camdyn.tangent.variational``), and its eigenvalues are the Floquet multipliers: the orbit is
 asymptotically stable when every multiplier has modulus < 1.
 
 Newton's residual is scaled by the size of the motion s (per component, from the warm-up's

@@ -11,7 +11,7 @@ state; then it integrates the augmented system (x, Phi) mode by mode between con
 times with SciPy's DOP853 (``TangentSettings``: tight tolerances), restarting x at each switch
 from the engine's recorded state (so the augmented x never drifts from the engine's trajectory)
 and applying S evaluated there.  The augmented system also integrates the divergence of the
-field, d(alpha_ddot)/d(alpha_dot), whose integral with the switches' log |det S| is log |det Phi|
+field, d(alpha_ddot)/d(alpha_dot), whose integral with the switches' log abs(det S) is log abs(det Phi)
 (Liouville's formula).
 
 :func:`variational` is a Jacobian provider for :mod:`camdyn.orbits`: x -> (P_n(x), dP_n/dx).
@@ -32,6 +32,8 @@ from .errors import CamdynError, ParameterError
 from .model import Model
 from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
 
+__all__ = ["tangent", "variational", "TangentResult", "TangentSettings", "TangentFailure"]
+
 #: rows of the augmented state: x, then Phi row by row, then the integral of the divergence
 _PHI = slice(2, 6)
 _DIVERGENCE = 6
@@ -50,7 +52,7 @@ class TangentFailure(CamdynError):
 @dataclass(frozen=True)
 class TangentSettings:
     """The tolerances of the augmented (x, Phi) integration between switches (DOP853); atol is
-    scaled by max |Phi| at the segment's start for the entries of Phi.  (rtol 1e-11, atol 1e-13
+    scaled by max abs(Phi) at the segment's start for the entries of Phi.  (rtol 1e-11, atol 1e-13
     failed on a contact segment of the chaotic test case: "required step size is less than
     spacing between numbers", where Phi grew from 1 to 4e4 within 3e-5 s.)"""
 
@@ -71,7 +73,7 @@ class TangentResult:
     ``state``: x(t1) from the engine; ``phi``: dx(t1)/dx(t0) times the start's ``phi0``;
     ``end_mode``: the mode at t1 (index into MODES); ``switches``: the saltation matrices
     applied; ``divergence``: the integral of d(alpha_ddot)/d(alpha_dot) over the run (1);
-    ``log_det_saltation``: the sum of log |det S| over the switches (-inf after a stick entry,
+    ``log_det_saltation``: the sum of log abs(det S) over the switches (-inf after a stick entry,
     whose S is singular); ``flow_state``: x(t1) of the augmented integration's last segment (a
     check against ``state``)."""
 
@@ -88,7 +90,7 @@ def _augmented(model: Model, m: int, t_start: float):
     """The field of (x, Phi, integral of the divergence) in mode m.  At the segment's start the
     Jacobian is its limit from inside the segment, taken LOOK_AHEAD along the motion as the
     engine's rules do: a segment that starts on a surface may start on a kink of the law (the
-    impact damping's |psi_i| at first contact, whose generated derivative is 0 at psi_i = 0),
+    impact damping's abs(psi_i) at first contact, whose generated derivative is 0 at psi_i = 0),
     and a first stage with the kink's value would stall the step-size control."""
     p, K = model.p, model.kernels
     extra = model._extra

@@ -10,6 +10,9 @@ Kernels (arguments in the order of the generated module's docstring):
   rhs(m, t, alpha, alpha_dot, p)              alpha_ddot in mode m
   surface(m, s, t, alpha, alpha_dot, p)       the value of surface s under mode m's laws
   jacobian(m, t, alpha, alpha_dot, p, out)    out[:] = d(alpha_ddot)/d(alpha, alpha_dot)
+  field_sensitivity(m, t, alpha, alpha_dot, p, out)
+                                              out[:] = d(alpha_ddot)/d(SENSITIVITY), the continuation
+                                              parameters (non-linear model)
   surface_gradient(m, s, t, alpha, alpha_dot, p, out)
                                               out[:] = dh/d(alpha, alpha_dot), dh/dt of surface s
                                               under mode m's laws, for the surfaces m watches
@@ -154,6 +157,14 @@ def build(spec: SceneSpec) -> SceneModule:
                               _mode_cases(A, lambda mode: fields.jacobian(spec, mode)),
                               "Second row of the state Jacobian in mode m (Eqs. 21-22): out[0] = "
                               "d(alpha_ddot)/d(alpha), out[1] = d(alpha_ddot)/d(alpha_dot).", "fill"))
+    if spec.model == "nonlinear":
+        names = fields.continuation_parameters(spec, A.modes)
+        functions.append(Function("field_sensitivity", _state_args(spec, "m", out=True), ("m",),
+                                  tuple(f"dalpha_ddot_d{n}" for n in names),
+                                  _mode_cases(A, lambda mode: fields.field_sensitivity(spec, mode, names)),
+                                  "Derivatives of alpha_ddot in mode m by the continuation parameters of "
+                                  "SENSITIVITY (total: the static equilibrium's alpha*, chi*, vartheta follow "
+                                  "them), at a fixed state and time: out[SENS_<NAME>].", "fill"))
     if A.transitions:
         functions.append(Function("surface_gradient", _state_args(spec, "m", "s", out=True), ("m", "s"),
                                   ("dh_dalpha", "dh_dalpha_dot", "dh_dt"), _gradient_cases(spec, A),

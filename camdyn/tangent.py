@@ -8,7 +8,8 @@ saltation matrix S of each switch (:mod:`camdyn.engine.saltation`): Phi+ = S Phi
 :func:`tangent` runs the engine once (:func:`camdyn.engine.integrate`), which locates the
 switches and records, for each, the time, the transition, the modes before and after and the
 state; then it integrates the augmented system (x, Phi) mode by mode between consecutive switch
-times with SciPy's DOP853 (``TangentSettings``: tight tolerances), restarting x at each switch
+times with DOP853 (``TangentSettings``: tight tolerances; compiled, :mod:`camdyn.engine.variational`,
+with the compiled backend, else SciPy's ``solve_ivp`` over the Python kernels), restarting x at each switch
 from the engine's recorded state (so the augmented x never drifts from the engine's trajectory)
 and applying S evaluated there.  The augmented system also integrates the divergence of the
 field, d(alpha_ddot)/d(alpha_dot), whose integral with the switches' log abs(det S) is log abs(det Phi)
@@ -27,7 +28,10 @@ from scipy.integrate import solve_ivp
 from .derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from .engine.config import LOOK_AHEAD, SolverOptions
 from .engine.driver import integrate
+from .engine.kernels import compiled_jacobian, compiled_kernels
 from .engine.saltation import switch_saltation
+from .engine.tableau import TABLEAUS, arrays
+from .engine.variational import integrate_segment
 from .errors import CamdynError, ParameterError
 from .model import Model
 from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
@@ -111,18 +115,24 @@ def _augmented(model: Model, m: int, t_start: float):
     return f
 
 
-def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: TangentSettings):
-    """(x, Phi, integral of the divergence) at t1 from (x, Phi) at t0 in mode m."""
+def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: TangentSettings, compiled: bool):
+    """(x, Phi, integral of the divergence) at t1 from (x, Phi) at t0 in mode m: compiled
+    (:mod:`camdyn.engine.variational`) or by SciPy's DOP853 over the Python kernels."""
     y0 = np.concatenate([x, phi.ravel(), [0.0]])
     if t1 <= t0:
         return np.asarray(x, dtype=float), phi, 0.0
-    scale = np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(phi)))), [1.0]])
-    sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol,
-                    atol=settings.atol * scale)
-    if not sol.success:
+    atol = settings.atol * np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(phi)))), [1.0]])
+    if compiled:
+        K = model.kernels
+        y, ok = integrate_segment(compiled_kernels(K).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
+                                  settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
+        message = "the step size fell below the spacing of t"
+    else:
+        sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
+        y, ok, message = sol.y[:, -1], sol.success, sol.message
+    if not ok or not np.all(np.isfinite(y)):
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
-                             f"failed: {sol.message}")
-    y = sol.y[:, -1]
+                             f"failed: {message}")
     return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
 
 
@@ -138,11 +148,12 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     if not tr.outcome.ok or tr.t.size != 1:
         raise TangentFailure(f"the run from {tuple(map(float, x))} failed: {tr.outcome.message}", tr.outcome)
     K = model.kernels
+    compiled = backend == "compiled"
     phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
     m = K.MODES.index(tr.switches[0].before) if tr.switches else tr.end_mode
     t, divergence, log_det = t0, 0.0, 0.0
     for sw in tr.switches:
-        _, phi, d = _segment(model, m, t, sw.t, x, phi, settings)
+        _, phi, d = _segment(model, m, t, sw.t, x, phi, settings, compiled)
         divergence += d
         before, after = K.MODES.index(sw.before), K.MODES.index(sw.after)
         x = np.array([sw.alpha, sw.alpha_dot])
@@ -154,7 +165,7 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
         det = abs(np.linalg.det(S))
         log_det += math.log(det) if det > 0 else -math.inf
         t, m = sw.t, after
-    flow_x, phi, d = _segment(model, m, t, t1, x, phi, settings)
+    flow_x, phi, d = _segment(model, m, t, t1, x, phi, settings, compiled)
     return TangentResult(tr.y[:2, -1].copy(), phi, int(tr.end_mode), len(tr.switches), divergence + d, log_det,
                          flow_x)
 

@@ -31,6 +31,7 @@ FD_STEP = 0.1
 
 @pytest.fixture(scope="module")
 def orbits():
+    """The orbits, found with the default Jacobian provider (the tangent dynamics)."""
     return {speed: periodic_orbit(RIG, SCENE, speed_rpm=speed, warmup_revolutions=warm)
             for speed, warm in ((600.0, 20), (1500.0, 2), (1200.0, 2))}
 
@@ -78,9 +79,11 @@ def test_monodromy_in_permanent_contact_obeys_liouville(orbits):
 
 
 def test_variational_provider_finds_the_same_orbit_and_multipliers(orbits):
-    fd = orbits[1500.0]
-    var = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=2, jacobian=variational)
-    assert var.ok, var.message
+    """The default provider (variational) and finite differences find the same orbit."""
+    var = orbits[1500.0]
+    fd = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=2, jacobian=finite_differences)
+    assert var.ok and fd.ok, (var.message, fd.message)
+    assert periodic_orbit.__kwdefaults__["jacobian"] is variational
     # the same fixed point within both searches' tolerance (Newton's tol 1e-8, scaled)
     assert np.max(np.abs(var.state - fd.state) / fd.scale) <= 1e-7
     # multipliers: the finite differences' error ~rtol^(2/3) = 2e-7 of the scale, times the
@@ -163,3 +166,16 @@ def test_saltation_matrix_against_finite_differences_across_one_switch(orbits):
 def test_bad_tangent_settings_name_the_parameter():
     with pytest.raises(camdyn.ParameterError, match="rtol"):
         TangentSettings(rtol=0.0)
+
+
+def test_compiled_and_python_tangent_dynamics_agree(orbits):
+    """The compiled segment integrator (camdyn.engine.variational) and SciPy's DOP853 over the
+    Python kernels: the same Phi to their tolerances (rtol 1e-10; measured 5e-11 relative)."""
+    orbit = orbits[1500.0]
+    model = Model(RIG, SCENE, camdyn.ConstantSpeed(1500.0))
+    span, m = (0.0, model.period), model.mode(orbit.mode)
+    compiled = tangent(model, span, orbit.state, mode=m)
+    python = tangent(model, span, orbit.state, mode=m, backend="python")
+    assert compiled.switches == python.switches == 3
+    np.testing.assert_allclose(compiled.phi, python.phi, rtol=0, atol=1e-7 * np.max(np.abs(python.phi)))
+    assert compiled.divergence == pytest.approx(python.divergence, rel=1e-8)

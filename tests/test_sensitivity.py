@@ -72,6 +72,6 @@ def test_k_s_acts_through_the_equilibrium_in_the_viscous_law():
 
 
 def test_linear_models_have_no_parameter_derivatives():
-    model = Model(RIG, camdyn.Scene(damping="none", friction="none", model="linear_exact"), camdyn.ConstantSpeed(300))
+    model = Model(RIG, camdyn.Scene(damping="D", friction="coulomb", model="linear_exact"), camdyn.ConstantSpeed(300))
     with pytest.raises(camdyn.SceneError, match="non-linear"):
         model.field_sensitivity(0, 0.0, 0.0, 0.0)

@@ -179,3 +179,18 @@ def test_compiled_and_python_tangent_dynamics_agree(orbits):
     assert compiled.switches == python.switches == 3
     np.testing.assert_allclose(compiled.phi, python.phi, rtol=0, atol=1e-7 * np.max(np.abs(python.phi)))
     assert compiled.divergence == pytest.approx(python.divergence, rel=1e-8)
+
+
+def test_a_user_cam_motion_gives_the_built_in_motions_tangent_dynamics():
+    """The user motion's dh/dt goes through Theta_dot and Theta_ddot (derive.fields.surface_gradient):
+    a user motion equal to the constant speed gives the constant-speed scene's Phi (tanh friction:
+    the gap and gap-rate surfaces), to the integrations' tolerances (measured 1e-9 relative)."""
+    w = 1500.0 * 2 * np.pi / 60
+    user = camdyn.UserMotion(lambda t: RIG.theta0 + w * t, lambda t: w + 0 * t, lambda t: 0 * t, period=2 * np.pi / w)
+    as_user = Model(RIG, camdyn.Scene(damping="D", friction="tanh", motion="user"), user)
+    built_in = Model(RIG, camdyn.Scene(damping="D", friction="tanh"), camdyn.ConstantSpeed(1500.0))
+    x0, span = built_in.static_state(), (0.0, 3 * built_in.period)
+    a = tangent(as_user, span, x0, backend="python")
+    b = tangent(built_in, span, x0)
+    assert a.switches == b.switches > 0
+    np.testing.assert_allclose(a.phi, b.phi, rtol=0, atol=1e-7 * np.max(np.abs(b.phi)))

@@ -4,10 +4,11 @@ A periodic orbit of period n T (T the cam's period) is a fixed point of the stro
 P_n (:class:`camdyn.section_map.StroboscopicMap`): P_n(x) - x = 0.  :func:`periodic_orbit`
 finds one by Newton's method from a warm start (the state at the section after a short
 simulation), with a backtracking line search; the monodromy matrix M = dP_n/dx at the fixed
-point comes from a Jacobian provider (by default the variational equations with saltation
-matrices, :func:`camdyn.tangent.variational`; or central finite differences,
-``jacobian=camdyn.section_map.finite_differences``, whose entries carry ~rtol^(2/3) of the
-motion's scale), and its eigenvalues are the Floquet multipliers: the orbit is
+point comes from a Jacobian provider (central finite differences by default,
+:func:`camdyn.section_map.finite_differences`, whose entries carry ~rtol^(2/3) of the motion's
+scale; or the variational equations with saltation matrices, ``jacobian=camdyn.tangent.variational``,
+exact to the integration's tolerance and cheaper, but not for damping C and E, whose impact
+laws have an unbounded Jacobian at first contact: see :mod:`camdyn.tangent`), and its eigenvalues are the Floquet multipliers: the orbit is
 asymptotically stable when every multiplier has modulus < 1.
 
 Newton's residual is scaled by the size of the motion s (per component, from the warm-up's
@@ -33,8 +34,7 @@ from .model import Model
 from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
-from .tangent import variational
+from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
 
 #: samples of the warm-up's last revolution, for the size of the motion (the residual's scale)
 SCALE_SAMPLES = 64
@@ -83,8 +83,8 @@ class PeriodicOrbit:
     converged; ``monodromy``: dP_n/dx at ``state`` (also at a failed search's last iterate); ``residual``: the scaled residual r (see the module);
     ``scale``: s; ``iterations``: Newton steps taken; ``outcome`` and ``message``: how it ended;
     ``map_evaluations`` (runs of P_n outside the provider) and ``jacobian_evaluations`` (provider
-    calls: one run and its tangent dynamics each by default, 5 runs by finite differences) give
-    the cost.
+    calls: 5 runs each by finite differences, one run and its tangent dynamics by the variational
+    provider) give the cost.
     """
 
     state: np.ndarray
@@ -223,14 +223,14 @@ def newton(section_map: StroboscopicMap, jacobian, x0, scale,
 def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, speed_rpm: float | None = None,
                    periods: int = 1, phase: float = 0.0, warmup_revolutions: int = 20, y0=None,
                    settings: ShootingSettings = ShootingSettings(), options: SolverOptions = DEFAULT_OPTIONS,
-                   jacobian=variational, backend: str = "compiled") -> PeriodicOrbit:
+                   jacobian=finite_differences, backend: str = "compiled") -> PeriodicOrbit:
     """A periodic orbit of period ``periods`` cam periods, by Newton shooting on P_n.
 
     The warm start is the state and mode at the section time ``phase + warmup_revolutions T``
     (s) of a run from ``y0`` (default the static equilibrium) at t = 0; the map starts every
     run in that mode (:class:`~camdyn.section_map.StroboscopicMap`).  ``jacobian(map, scale)``
-    makes the Jacobian provider (default: the tangent dynamics, :func:`camdyn.tangent.variational`;
-    :func:`camdyn.section_map.finite_differences` for central differences).  ``settings`` holds
+    makes the Jacobian provider (default: central finite differences; :func:`camdyn.tangent.variational`
+    for the tangent dynamics).  ``settings`` holds
     Newton's tolerance and iteration limit, ``options`` the solver's (default rtol 1e-10,
     atol 1e-13).  The result says how the search ended (:class:`OrbitOutcome`); it raises
     only on bad input.

@@ -16,6 +16,13 @@ field, d(alpha_ddot)/d(alpha_dot), whose integral with the switches' log abs(det
 (Liouville's formula).
 
 :func:`variational` is a Jacobian provider for :mod:`camdyn.orbits`: x -> (P_n(x), dP_n/dx).
+
+Limitation: damping C and E's impact laws, c proportional to abs(psi_i)^(1/4) (Eqs. 26, 28a),
+have a Jacobian that grows without bound as psi_i -> 0 at first contact (an integrable
+singularity: Phi stays finite, but grows like (t - t_a)^(1/4)); the step-size control of an
+explicit method cannot pass it, and :func:`tangent` raises :class:`TangentFailure` there.  Use
+finite differences (:func:`camdyn.section_map.finite_differences`) for those scenes.  This is
+why the finite differences stay :func:`camdyn.periodic_orbit`'s default provider.
 """
 from __future__ import annotations
 
@@ -132,7 +139,8 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
         y, ok, message = sol.y[:, -1], sol.success, sol.message
     if not ok or not np.all(np.isfinite(y)):
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
-                             f"failed: {message}")
+                             f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
+                             "first contact: use camdyn.section_map.finite_differences)")
     return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
 
 

@@ -31,8 +31,8 @@ FD_STEP = 0.1
 
 @pytest.fixture(scope="module")
 def orbits():
-    """The orbits, found with the default Jacobian provider (the tangent dynamics)."""
-    return {speed: periodic_orbit(RIG, SCENE, speed_rpm=speed, warmup_revolutions=warm)
+    """The orbits, found with the tangent dynamics' Jacobian provider."""
+    return {speed: periodic_orbit(RIG, SCENE, speed_rpm=speed, warmup_revolutions=warm, jacobian=variational)
             for speed, warm in ((600.0, 20), (1500.0, 2), (1200.0, 2))}
 
 
@@ -79,11 +79,10 @@ def test_monodromy_in_permanent_contact_obeys_liouville(orbits):
 
 
 def test_variational_provider_finds_the_same_orbit_and_multipliers(orbits):
-    """The default provider (variational) and finite differences find the same orbit."""
+    """The variational provider and finite differences (the default) find the same orbit."""
     var = orbits[1500.0]
     fd = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=2, jacobian=finite_differences)
     assert var.ok and fd.ok, (var.message, fd.message)
-    assert periodic_orbit.__kwdefaults__["jacobian"] is variational
     # the same fixed point within both searches' tolerance (Newton's tol 1e-8, scaled)
     assert np.max(np.abs(var.state - fd.state) / fd.scale) <= 1e-7
     # multipliers: the finite differences' error ~rtol^(2/3) = 2e-7 of the scale, times the
@@ -194,3 +193,13 @@ def test_a_user_cam_motion_gives_the_built_in_motions_tangent_dynamics():
     b = tangent(built_in, span, x0)
     assert a.switches == b.switches > 0
     np.testing.assert_allclose(a.phi, b.phi, rtol=0, atol=1e-7 * np.max(np.abs(b.phi)))
+
+
+def test_damping_e_impact_law_is_refused_with_the_way_out():
+    """Damping E's impact law c = beta_E abs(psi_i)^(1/4) has an unbounded Jacobian at first
+    contact: the tangent dynamics raise, naming finite differences (camdyn.tangent's docstring)."""
+    from camdyn.tangent import TangentFailure
+    scene = camdyn.Scene(contact="line", damping="E", friction="coulomb")
+    model = Model(RIG, scene, camdyn.ConstantSpeed(1500.0))
+    with pytest.raises(TangentFailure, match="finite_differences"):
+        tangent(model, (0.0, 3 * model.period), model.static_state())

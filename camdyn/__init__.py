@@ -43,6 +43,9 @@ _EXPORTS = {
     "PeriodicOrbit": "camdyn.orbits",
     "OrbitOutcome": "camdyn.orbits",
     "StroboscopicMap": "camdyn.section_map",
+    "lyapunov_exponents": "camdyn.lyapunov",
+    "LyapunovExponents": "camdyn.lyapunov",
+    "LyapunovSettings": "camdyn.lyapunov",
     "zero_one_test": "camdyn.chaos01",
 }
 

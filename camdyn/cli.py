@@ -496,6 +496,32 @@ def cmd_contact_loss(args) -> int:
     return EXIT_OK
 
 
+def cmd_lyapunov(args) -> int:
+    from .engine.config import SolverOptions
+    from .lyapunov import LyapunovSettings, lyapunov_exponents
+    from .metadata import describe_cam, describe_scene
+
+    cam = _cam(args)
+    scene = _scene(args, cam.kind)
+    settings = LyapunovSettings(args.revolutions, args.transient_revolutions, args.batches)
+    options = SolverOptions(method=args.method, rtol=args.rtol, atol=args.atol)
+    rig = _rig(args)
+    with _busy(f"Lyapunov exponents of {describe_scene(scene)}, {describe_cam(cam)}", args):
+        L = lyapunov_exponents(rig, scene, cam, settings=settings, options=options, **_backend_kwargs(args))
+    if args.json:
+        print(json.dumps({"exponents_per_s": [float(x) for x in L.exponents],
+                          "standard_error_per_s": [float(x) for x in L.standard_error],
+                          "per_revolution": [float(x) for x in L.per_revolution], "period_s": L.period,
+                          "revolutions": L.revolutions, "transient_revolutions": L.transient,
+                          "divergence_mean_per_s": L.divergence_mean, "saltation_rate_per_s": L.saltation_rate,
+                          "switches": L.switches}, indent=2))
+        return EXIT_OK
+    for i, (lam, se, rev) in enumerate(zip(L.exponents, L.standard_error, L.per_revolution), start=1):
+        print(f"lambda_{i} = {lam:.6g} 1/s +- {se:.2g} (standard error), {rev:.6g} per revolution")
+    print(f"over {L.revolutions} revolutions after {L.transient} of transient, {L.switches} switches")
+    return EXIT_OK
+
+
 # --- sweep ---------------------------------------------------------------------------
 def _sweep_module():
     try:
@@ -975,11 +1001,12 @@ def _add_run(p, revolutions: float = 3.0, sample_rate: float = 20_000.0):
 
 
 def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s (default: {default_backend}; "
-                                      "python: the same loop in Python, slow, for checking)"):
+                                      "python: the same loop in Python, slow, for checking)",
+                rtol: float = 1e-8, atol: float = 1e-12):
     g.add_argument("--method", default="DOP853", metavar="METHOD", choices=_Lazy(lambda: _solvers()[1]),
                    help="Runge-Kutta pair with dense output: %(choices)s (default: DOP853)")
-    g.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (default: 1e-8)")
-    g.add_argument("--atol", type=float, default=1e-12, help="absolute tolerance (default: 1e-12)")
+    g.add_argument("--rtol", type=float, default=rtol, help=f"relative tolerance (default: {rtol:g})")
+    g.add_argument("--atol", type=float, default=atol, help=f"absolute tolerance (default: {atol:g})")
     g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
                    help=backend_help)
 
@@ -1066,6 +1093,24 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--rig", default="example", help="shipped rig name or a .toml rig file (default: example)")
     p.add_argument("--k-s", dest="k_s", metavar="VALUES",
                    help="spring stiffnesses in N/m: 'start:stop:count[:log]' or 'v1,v2,...'")
+
+    p = command("lyapunov", "Lyapunov exponents of a run (tangent dynamics with saltation matrices)",
+                "examples:\n"
+                "  camdyn lyapunov --speed-rpm 1100\n"
+                "  camdyn lyapunov --rig reference-experiment --speed-rpm 196 --revolutions 400 --json\n\n"
+                "From the static equilibrium, after --transient-revolutions, the tangent vectors are\n"
+                "propagated over each cam period and re-orthonormalised (camdyn.lyapunov); prints both\n"
+                "exponents (1/s, largest first) with the standard error of their batch means.", cmd_lyapunov)
+    _add_physics(p)
+    _add_cam(p)
+    g = p.add_argument_group("run and solver")
+    g.add_argument("--revolutions", type=int, default=200, help="revolutions measured (default: 200)")
+    g.add_argument("--transient-revolutions", type=int, default=50, dest="transient_revolutions", metavar="N",
+                   help="revolutions discarded first (default: 50)")
+    g.add_argument("--batches", type=int, default=10,
+                   help="batches for the standard error; divides --revolutions (default: 10)")
+    _add_solver(g, rtol=1e-10, atol=1e-13)
+    p.add_argument("--json", action="store_true", help="print the exponents and their estimate as JSON")
 
     p = command("sweep", "sweep the cam speed (and one rig parameter): bifurcation diagram or contact map",
                 "examples:\n"

@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
 from .derive.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
-from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT
+from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
 from .engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
@@ -158,6 +158,37 @@ class Model:
         out = np.empty(2)
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
         return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
+
+    def field_sensitivity(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
+        """d(alpha_ddot)/d(q) in mode m at a fixed state and time for the scene's continuation
+        parameters q (the generated ``field_sensitivity``; its ``SENSITIVITY`` names them, in
+        the order of ``CONTINUATION_PARAMETERS``: the cam's speed constant in rad/s, k_s, e,
+        the damping constants), total derivatives: the static equilibrium follows the rig.
+        Raises :class:`SceneError` for a scene without it (the linear models)."""
+        kernel = getattr(self.kernels, "field_sensitivity", None)
+        if kernel is None:
+            raise SceneError(f"scene {self.kernels.SLUG!r} has no parameter derivatives (non-linear model only)")
+        out = np.empty(len(self.kernels.SENSITIVITY))
+        kernel(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        return dict(zip(self.kernels.SENSITIVITY, map(float, out)))
+
+    def surface_gradient(self, m: int, s: int, t: float, alpha: float, alpha_dot: float) -> np.ndarray:
+        """(dh/dalpha, dh/dalpha_dot, dh/dt) of surface s's value h under mode m's laws (the
+        generated ``surface_gradient``, order ``SURFACE_GRADIENT``), for a surface m watches.
+        Raises :class:`SceneError` where the scene has none (no switching surfaces) or it is
+        not defined (a surface m does not watch; a user cam motion where dh/dt needs the
+        derivative of Theta_ddot)."""
+        kernel = getattr(self.kernels, "surface_gradient", None)
+        if kernel is None:
+            raise SceneError(f"scene {self.kernels.SLUG!r} has no switching surfaces to differentiate")
+        out = np.empty(len(SURFACE_GRADIENT))
+        kernel(m, s, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        if not np.all(np.isfinite(out)):
+            raise SceneError(f"the gradient of surface {self.kernels.SURFACES[s]!r} in mode "
+                             f"{self.kernels.MODES[m]!r} of scene {self.kernels.SLUG!r} is not defined at "
+                             f"t = {t:g} s: a surface the mode does not watch, or a user cam motion whose "
+                             "Theta_ddot would have to be differentiated (give the scene a built-in motion)")
+        return out
 
     def outputs(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
         """The output quantities (``OUTPUTS``) in mode m at one state, by name."""

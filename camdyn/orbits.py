@@ -5,8 +5,10 @@ P_n (:class:`camdyn.section_map.StroboscopicMap`): P_n(x) - x = 0.  :func:`perio
 finds one by Newton's method from a warm start (the state at the section after a short
 simulation), with a backtracking line search; the monodromy matrix M = dP_n/dx at the fixed
 point comes from a Jacobian provider (central finite differences by default,
-:func:`camdyn.section_map.finite_differences`; the variational equations with saltation
-matrices can replace it), and its eigenvalues are the Floquet multipliers: the orbit is
+:func:`camdyn.section_map.finite_differences`, whose entries carry ~rtol^(2/3) of the motion's
+scale; or the variational equations with saltation matrices, ``jacobian=camdyn.tangent.variational``,
+exact to the integration's tolerance and cheaper, but not for damping C and E, whose impact
+laws have an unbounded Jacobian at first contact: see :mod:`camdyn.tangent`), and its eigenvalues are the Floquet multipliers: the orbit is
 asymptotically stable when every multiplier has modulus < 1.
 
 Newton's residual is scaled by the size of the motion s (per component, from the warm-up's
@@ -81,7 +83,8 @@ class PeriodicOrbit:
     converged; ``monodromy``: dP_n/dx at ``state`` (also at a failed search's last iterate); ``residual``: the scaled residual r (see the module);
     ``scale``: s; ``iterations``: Newton steps taken; ``outcome`` and ``message``: how it ended;
     ``map_evaluations`` (runs of P_n outside the provider) and ``jacobian_evaluations`` (provider
-    calls: 5 runs each by finite differences) give the cost.
+    calls: 5 runs each by finite differences, one run and its tangent dynamics by the variational
+    provider) give the cost.
     """
 
     state: np.ndarray
@@ -226,7 +229,8 @@ def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, spee
     The warm start is the state and mode at the section time ``phase + warmup_revolutions T``
     (s) of a run from ``y0`` (default the static equilibrium) at t = 0; the map starts every
     run in that mode (:class:`~camdyn.section_map.StroboscopicMap`).  ``jacobian(map, scale)``
-    makes the Jacobian provider (default: central finite differences).  ``settings`` holds
+    makes the Jacobian provider (default: central finite differences; :func:`camdyn.tangent.variational`
+    for the tangent dynamics).  ``settings`` holds
     Newton's tolerance and iteration limit, ``options`` the solver's (default rtol 1e-10,
     atol 1e-13).  The result says how the search ended (:class:`OrbitOutcome`); it raises
     only on bad input.

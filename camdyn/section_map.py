@@ -14,8 +14,9 @@ a surface the mode watches, by :func:`camdyn.engine.rules.across`): the engine w
 the mode's law where it does not hold.
 
 A *Jacobian provider* is any callable ``x -> (P(x), dP/dx)``; :func:`finite_differences`
-makes one by central differences of the map.  A provider of the variational equations with
-saltation matrices can replace it without change to the shooting (:mod:`camdyn.orbits`).
+makes one by central differences of the map; :func:`camdyn.tangent.variational` one by the
+variational equations with saltation matrices, without change to the shooting
+(:mod:`camdyn.orbits`).
 """
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ from . import symbols as S
 from . import trig
 from .automaton import Automaton
 from .scenes import Case, Function, SceneModule, build
-from .vocabulary import OUTPUTS, SURFACES, SceneSpec
+from .vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, SceneSpec
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
@@ -41,11 +41,15 @@ ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
         "cam": "(Theta, Theta_dot, Theta_ddot) of the user's cam motion at t (rad, rad/s, rad/s^2)",
         "out": "a float64 array the results are written into (length: the number of results)"}
 RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_ddot_dalpha_dot": "1/s",
-                "value": "m, m/s or m/s^2", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2",
+                "value": "m, m/s or m/s^2",
+                "dh_dalpha": "surface unit/rad", "dh_dalpha_dot": "surface unit s/rad", "dh_dt": "surface unit/s", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2",
                 "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
                 "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "V_s": "J", "V_s_printed": "J",
-                **{name: unit for name, (unit, _) in OUTPUTS.items()}}
+                **{name: unit for name, (unit, _) in OUTPUTS.items()},
+                **{f"dalpha_ddot_d{n}": f"rad/s^2 per {UNITS[n]}" for n in CONTINUATION_PARAMETERS}}
+#: the prefix of field_sensitivity's result names (the parameter's name follows)
+SENSITIVITY_PREFIX = "dalpha_ddot_d"
 _STATE = {"t": S.t_s, "alpha": S.alpha_s, "alpha_dot": S.alpha_dot, "Theta": S.Theta_s}
 
 
@@ -251,8 +255,9 @@ class _Writer:
         if style == "return":
             return [f"return {code[0]}"]
         if style == "fill":
-            target = [constant_name("OUT", n) if self.f.name == "outputs" else str(i)
-                      for i, n in enumerate(self.f.results)]
+            target = [constant_name("OUT", n) if self.f.name == "outputs" else
+                      constant_name("SENS", n[len(SENSITIVITY_PREFIX):]) if self.f.name == "field_sensitivity"
+                      else str(i) for i, n in enumerate(self.f.results)]
             return [f"out[{t}] = {c}" for t, c in zip(target, code)] + ["return"]
         if style == "numpy":
             arrays = ", ".join(a for a in self.f.args if a in _STATE)
@@ -405,6 +410,11 @@ def module_source(spec: SceneSpec) -> str:
     data += _automaton_code(A)
     data += ["# --- output quantities (camdyn.derive.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
     data += _index_constants("OUT", OUTPUTS)
+    sensitivity = next((f.results for f in mod.functions if f.name == "field_sensitivity"), None)
+    if sensitivity is not None:
+        names = tuple(n[len(SENSITIVITY_PREFIX):] for n in sensitivity)
+        data += ["# --- continuation parameters of field_sensitivity (vocabulary.CONTINUATION_PARAMETERS) ---",
+                 "SENSITIVITY = " + repr(names)] + _index_constants("SENS", names)
     body = [_Writer(f, A, params).source(families[f.name], _universe(f, A)) for f in mod.functions]
     imports = ["from math import *  # noqa: F401,F403  (sin, cos, sqrt, ... on floats)", "", "import numpy"]
     parts = ["\n".join(header), "\n".join(_module_doc(spec, A)), "\n".join(imports), "\n".join(data), pack] + body

@@ -7,7 +7,11 @@ For one mode of the automaton (:mod:`derive.automaton`) this module derives
 * :func:`surface`: the value of one switching surface under the mode's laws;
 * :func:`outputs`: the output quantities of :data:`derive.vocabulary.OUTPUTS`;
 * :func:`jacobian`: d(alpha_ddot)/d(alpha, alpha_dot), by the chain rule through the named
-  quantities (Eqs. 21-22).
+  quantities (Eqs. 21-22);
+* :func:`field_sensitivity`: d(alpha_ddot)/d(continuation parameter), total derivatives with
+  the static equilibrium's quantities (alpha*, chi*, vartheta) following the parameter;
+* :func:`surface_gradient`: dh/d(alpha, alpha_dot) and dh/dt of a surface's value h (the
+  saltation matrices of the tangent dynamics, ``camdyn.engine.saltation``).
 
 Each is a :class:`Kernel`: definitions (``psi_i = ...``, ``F_n = ...``) in the order they are
 computed, and the results.  Expressions are in the plain symbols t, alpha, alpha_dot and the
@@ -21,12 +25,12 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import dynamics, energy, geometry, laws, linear
+from . import dynamics, energy, equilibrium, geometry, laws, linear
 from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
 from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
-from .vocabulary import JACOBIAN, OUTPUTS, SceneSpec
+from .vocabulary import CONTINUATION_PARAMETERS, JACOBIAN, OUTPUTS, SURFACE_GRADIENT, SceneSpec
 
 
 @dataclass(frozen=True)
@@ -155,6 +159,81 @@ def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
         rate = v_t + v_a * S.alpha_dot + v_ad * Q.alpha_ddot
         return Kernel(side + _slip_partials(spec)[1:], (rate,)).pruned()
     return None
+
+
+def continuation_parameters(spec: SceneSpec, modes) -> tuple[str, ...]:
+    """The CONTINUATION_PARAMETERS the fields of ``modes`` read, in that order."""
+    read = set().union(*(sp.sympify(d.expr).free_symbols for m in modes for d in field(spec, m).definitions))
+    return tuple(n for n in CONTINUATION_PARAMETERS if S.PARAMS[n].symbol in read)
+
+
+@lru_cache(maxsize=None)
+def _equilibrium_rates(contact: str, name: str) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
+    """(quantity, its derivative by parameter ``name``) for the equilibrium's alpha*, chi* and
+    vartheta, where not zero: M(alpha*) = 0 (Eq. 18) gives dalpha*/dq = -M_q / M_alpha (implicit
+    function theorem), chi* = chi0 - psi_j*(alpha*) (Eq. 17) and vartheta = sqrt(-M_alpha / I_Pb)
+    (Eq. 23), all at alpha = alpha*, as the runtime solves them (camdyn.model)."""
+    q = S.PARAMS[name].symbol
+    M = S.to_plain(equilibrium.static_moment(contact))
+    psi_j = S.to_plain(equilibrium.static_gap()[1])
+    at = {S.alpha_s: S.alpha_star}
+    M_a = M.diff(S.alpha_s)
+    d_alpha = (-M.diff(q) / M_a).subs(at)
+    d_chi = -(psi_j.diff(S.alpha_s) * d_alpha + psi_j.diff(q)).subs(at)
+    d_vartheta = (-(M_a.diff(q) + M_a.diff(S.alpha_s) * d_alpha) / (2 * S.I_Pb * S.vartheta)).subs(at)
+    rates = ((S.alpha_star, d_alpha), (S.chi_star, d_chi), (S.vartheta, d_vartheta))
+    return tuple((sym, rate) for sym, rate in rates if rate != 0)
+
+
+def field_sensitivity(spec: SceneSpec, mode: Mode, names: tuple[str, ...]) -> Kernel:
+    """d(alpha_ddot)/dq of the mode's field for each continuation parameter q in ``names``: the
+    total derivative, at a fixed state and time, through the parameter's direct appearances
+    and through the static equilibrium's alpha*, chi*, vartheta (:func:`_equilibrium_rates`),
+    which the runtime computes from the rig."""
+    f = field(spec, mode)
+    defs, results, done = list(f.definitions), [], {}
+    for name in names:
+        q = S.PARAMS[name].symbol
+        direct = derivatives(f.definitions, q)
+        defs += direct
+        total = derivative_symbol("alpha_ddot", q, direct)
+        for sym, rate in _equilibrium_rates(spec.contact, name):
+            if sym not in done:
+                done[sym] = derivatives(f.definitions, sym)
+                defs += done[sym]
+            part = derivative_symbol("alpha_ddot", sym, done[sym])
+            if part != 0:
+                rate_symbol = quantity(f"d{sym.name}_d{name}")
+                defs.append(Definition(rate_symbol, rate, f"d({sym.name})/d({name}) of the static equilibrium"))
+                total += part * rate_symbol
+        results.append(total)
+    return Kernel(tuple(defs), tuple(results)).pruned()
+
+
+#: the name of a surface's value in :func:`surface_gradient`'s definitions
+SURFACE_VALUE = quantity("surface_value")
+
+
+def surface_gradient(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
+    """dh/dalpha, dh/dalpha_dot and dh/dt (SURFACE_GRADIENT order) of surface ``name``'s value
+    h under the mode's laws, by the chain rule through the named quantities (a slip_rate
+    surface through the alpha_ddot it contains).  dh/dt is the derivative at a fixed state:
+    through Theta(t) = theta0 + Omega_c t (constant speed) or the oscillating motion; a user's
+    motion gives Theta_dot and Theta_ddot, so dh/dt = h_t + Theta_dot h_Theta + Theta_ddot
+    h_Theta_dot, and None where h needs Theta_ddot (its derivative is not given)."""
+    h = surface(spec, mode, name)
+    if h is None:
+        return None
+    defs = h.definitions + (Definition(SURFACE_VALUE, h.results[0], f"the value of surface {name}"),)
+    by = {x: derivatives(defs, x) for x in (S.alpha_s, S.alpha_dot, S.t_s, S.Theta_s, S.Theta_dot)}
+    grad = {x: derivative_symbol(SURFACE_VALUE.name, x, d) for x, d in by.items()}
+    d_t = grad[S.t_s]
+    if spec.motion == "user":
+        if any(sp.sympify(d.expr).has(S.Theta_ddot) for d in defs):
+            return None
+        d_t = d_t + S.Theta_dot * grad[S.Theta_s] + S.Theta_ddot * grad[S.Theta_dot]
+    results = dict(zip(SURFACE_GRADIENT, (grad[S.alpha_s], grad[S.alpha_dot], d_t)))
+    return Kernel(defs + sum(by.values(), ()), tuple(results[n] for n in SURFACE_GRADIENT)).pruned()
 
 
 def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:

@@ -10,6 +10,12 @@ Kernels (arguments in the order of the generated module's docstring):
   rhs(m, t, alpha, alpha_dot, p)              alpha_ddot in mode m
   surface(m, s, t, alpha, alpha_dot, p)       the value of surface s under mode m's laws
   jacobian(m, t, alpha, alpha_dot, p, out)    out[:] = d(alpha_ddot)/d(alpha, alpha_dot)
+  field_sensitivity(m, t, alpha, alpha_dot, p, out)
+                                              out[:] = d(alpha_ddot)/d(SENSITIVITY), the continuation
+                                              parameters (non-linear model)
+  surface_gradient(m, s, t, alpha, alpha_dot, p, out)
+                                              out[:] = dh/d(alpha, alpha_dot), dh/dt of surface s
+                                              under mode m's laws, for the surfaces m watches
   outputs(m, t, alpha, alpha_dot, p, out)     out[:] = the OUTPUTS
   cam(t, p)                                   Theta and its rates (built-in motions; arrays too)
   static_moment, reach, rigid_contact, spring_potential: run-independent (equilibrium, Eq. 29)
@@ -83,6 +89,18 @@ def _surface_cases(spec: SceneSpec, automaton: Automaton) -> tuple[Case, ...]:
     return tuple(out)
 
 
+def _gradient_cases(spec: SceneSpec, automaton: Automaton) -> tuple[Case, ...]:
+    """The gradient of each surface a mode watches (its transitions'), under the mode's laws."""
+    out = []
+    for m, mode in enumerate(automaton.modes):
+        watched = {tr.surface for tr in automaton.watched(mode.name)}
+        for s, name in enumerate(automaton.surfaces):
+            kernel = fields.surface_gradient(spec, mode, name) if name in watched else None
+            if kernel is not None:
+                out.append(Case((m, s), kernel))
+    return tuple(out)
+
+
 def _single(*results: sp.Expr) -> tuple[Case, ...]:
     return (Case((), Kernel((), tuple(results))),)
 
@@ -139,6 +157,21 @@ def build(spec: SceneSpec) -> SceneModule:
                               _mode_cases(A, lambda mode: fields.jacobian(spec, mode)),
                               "Second row of the state Jacobian in mode m (Eqs. 21-22): out[0] = "
                               "d(alpha_ddot)/d(alpha), out[1] = d(alpha_ddot)/d(alpha_dot).", "fill"))
+    if spec.model == "nonlinear":
+        names = fields.continuation_parameters(spec, A.modes)
+        functions.append(Function("field_sensitivity", _state_args(spec, "m", out=True), ("m",),
+                                  tuple(f"dalpha_ddot_d{n}" for n in names),
+                                  _mode_cases(A, lambda mode: fields.field_sensitivity(spec, mode, names)),
+                                  "Derivatives of alpha_ddot in mode m by the continuation parameters of "
+                                  "SENSITIVITY (total: the static equilibrium's alpha*, chi*, vartheta follow "
+                                  "them), at a fixed state and time: out[SENS_<NAME>].", "fill"))
+    if A.transitions:
+        functions.append(Function("surface_gradient", _state_args(spec, "m", "s", out=True), ("m", "s"),
+                                  ("dh_dalpha", "dh_dalpha_dot", "dh_dt"), _gradient_cases(spec, A),
+                                  "Gradient of switching surface s's value h under mode m's laws, for the "
+                                  "surfaces m watches: out[GRAD_D_ALPHA] = dh/dalpha, out[GRAD_D_ALPHA_DOT] = "
+                                  "dh/dalpha_dot, out[GRAD_D_T] = dh/dt at a fixed state (through Theta(t)); "
+                                  "nan elsewhere.", "fill"))
     functions.append(Function("outputs", _state_args(spec, "m", out=True), ("m",), tuple(OUTPUTS),
                               _mode_cases(A, lambda mode: fields.outputs(spec, mode)),
                               "The output quantities in mode m: out[OUT_<NAME>] for each name of OUTPUTS.",

@@ -198,6 +198,18 @@ STATE_ALPHA, STATE_ALPHA_DOT = range(len(STATE))
 #: derivatives of alpha_ddot by alpha and by alpha_dot (Eqs. 21-22), in the order of STATE
 JACOBIAN = tuple(f"d_{name}" for name in STATE)
 JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
+#: the entries the generated ``surface_gradient`` kernel writes to ``out``, in order: the
+#: partial derivatives of a surface's value h by the state (in the order of STATE) and the
+#: total derivative by t at a fixed state (through the cam angle Theta(t)); a slip_rate surface
+#: is differentiated through the alpha_ddot it contains
+SURFACE_GRADIENT = JACOBIAN + ("d_t",)
+GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T = range(len(SURFACE_GRADIENT))
+#: the continuation parameters, in the order the generated ``field_sensitivity`` kernel writes
+#: d(alpha_ddot)/d(parameter) to ``out`` (each scene: those its fields read, listed in its
+#: module's SENSITIVITY): the cam's speed (Omega_c at constant speed, omega_c for the
+#: oscillating cam), the spring stiffness k_s, the eccentricity e, then the damping constants
+CONTINUATION_PARAMETERS = ("Omega_c", "omega_c", "k_s", "e", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
+                           "zeta_E", "beta_E")
 #: the cam's state as the generated ``cam`` kernel and a user's cam motion return it
 CAM_STATE = ("Theta", "Theta_dot", "Theta_ddot")
 CAM_THETA, CAM_THETA_DOT, CAM_THETA_DDOT = range(len(CAM_STATE))

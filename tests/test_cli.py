@@ -102,6 +102,22 @@ def test_contact_loss_single_and_over_k_s(capsys):
     assert math.isclose(speeds[1], 2 * speeds[0], rel_tol=1e-5)  # Omega_loss ~ sqrt(k_s)
 
 
+def test_lyapunov_prints_the_exponents_and_json(capsys):
+    run = ["lyapunov", "--speed-rpm", "1500", "--revolutions", "20", "--transient-revolutions", "10",
+           "--batches", "4"]
+    assert main(run) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("lambda_1 = ") and lines[1].startswith("lambda_2 = ")
+    assert main(run + ["--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    # the stable 1500 rev/min orbit (tests/test_orbits.py): both exponents negative, their sum
+    # the mean divergence (the saltation matrices of damping D have det 1), to rtol 1e-6
+    assert all(x < 0 for x in data["exponents_per_s"]) and data["revolutions"] == 20
+    assert math.isclose(sum(data["exponents_per_s"]), data["divergence_mean_per_s"], rel_tol=1e-6)
+    assert main(["lyapunov", "--speed-rpm", "1500", "--revolutions", "15"]) == 2
+    assert "revolutions" in one_error_line(capsys)
+
+
 def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
     xr = pytest.importorskip("xarray")
     pytest.importorskip("matplotlib")
@@ -136,7 +152,7 @@ def test_scenes_lists_generated_scenes(capsys):
     assert "friction" in data["options"]
 
 
-COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "sweep",
+COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "lyapunov", "sweep",
             "regenerate", "reproduce", "scenes"]
 
 

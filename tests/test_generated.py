@@ -200,11 +200,14 @@ def test_kernels_match_lambdify_oracle(slug):
 @pytest.mark.parametrize("slug", SCENES)
 def test_each_named_quantity_is_computed_once_per_branch(slug):
     """In each mode's branch of a kernel a named quantity (psi_i, F_n, ...) is assigned once
-    (its law variants are alternatives of one if/elif/else), and no module exceeds 1,400 lines
-    (the size of a module that emitted each expression once, per the automaton issue; the
-    Coulomb scenes were 2,700-3,100 lines when they re-emitted them)."""
+    (its law variants are alternatives of one if/elif/else), and no module exceeds 2,100 lines
+    (1,400: the size of a module that emitted each expression once, per the automaton issue; the
+    Coulomb scenes were 2,700-3,100 lines when they re-emitted them; plus the kernels of the
+    tangent dynamics and continuation: surface_gradient, at most 480 lines, most of it the
+    slip_rate surfaces' derivatives through alpha_ddot in the stick modes, and
+    field_sensitivity, at most 374; the largest module is 2,044 lines)."""
     text = Path(_module(slug).__file__).read_text()
-    assert len(text.splitlines()) <= 1400
+    assert len(text.splitlines()) <= 2100
     for name in ("rhs", "jacobian", "outputs"):
         body = inspect.getsource(getattr(_module(slug), name))
         blocks, block = [], []

@@ -66,6 +66,19 @@ def compiled_kernels(K: ModuleType) -> Kernels:
     return _compiled(K.__name__)
 
 
+@lru_cache(maxsize=None)
+def _compiled_jacobian(module_name: str):
+    import importlib
+    return numba.cfunc(FILL, cache=True)(importlib.import_module(module_name).jacobian)
+
+
+def compiled_jacobian(K: ModuleType):
+    """The generated ``jacobian`` kernel of a scene module as a cfunc (the tangent dynamics',
+    :mod:`camdyn.tangent`; compiled on first use, then from the disk cache)."""
+    _check_compilable(K)
+    return _compiled_jacobian(K.__name__)
+
+
 def _guarded(fn):
     """A Python kernel that gives NaN where a law is undefined (a trial stage far outside its
     domain: log of a negative, sin of inf), as compiled code does, instead of raising."""

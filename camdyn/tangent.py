@@ -1,0 +1,197 @@
+"""Tangent dynamics of the hybrid model: the state's sensitivity to its start, across switches.
+
+The fundamental matrix Phi(t) = dx(t)/dx(t0) of a run, x = (alpha, alpha_dot), obeys the
+variational equation Phi' = J(t, x) Phi between switches, J = [[0, 1], [a_alpha, a_alpha_dot]]
+with the second row from the generated ``jacobian`` kernel (Eqs. 21-22), and jumps by the
+saltation matrix S of each switch (:mod:`camdyn.engine.saltation`): Phi+ = S Phi-.
+
+:func:`tangent` runs the engine once (:func:`camdyn.engine.integrate`), which locates the
+switches and records, for each, the time, the transition, the modes before and after and the
+state; then it integrates the augmented system (x, Phi) mode by mode between consecutive switch
+times with DOP853 (``TangentSettings``: tight tolerances; compiled, :mod:`camdyn.engine.variational`,
+with the compiled backend, else SciPy's ``solve_ivp`` over the Python kernels), restarting x at each switch
+from the engine's recorded state (so the augmented x never drifts from the engine's trajectory)
+and applying S evaluated there.  The augmented system also integrates the divergence of the
+field, d(alpha_ddot)/d(alpha_dot), whose integral with the switches' log abs(det S) is log abs(det Phi)
+(Liouville's formula).
+
+:func:`variational` is a Jacobian provider for :mod:`camdyn.orbits`: x -> (P_n(x), dP_n/dx).
+
+Limitation: damping C and E's impact laws, c proportional to abs(psi_i)^(1/4) (Eqs. 26, 28a),
+have a Jacobian that grows without bound as psi_i -> 0 at first contact (an integrable
+singularity: Phi stays finite, but grows like (t - t_a)^(1/4)); the step-size control of an
+explicit method cannot pass it, and :func:`tangent` raises :class:`TangentFailure` there.  Use
+finite differences (:func:`camdyn.section_map.finite_differences`) for those scenes.  This is
+why the finite differences stay :func:`camdyn.periodic_orbit`'s default provider.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
+from .engine.config import LOOK_AHEAD, SolverOptions
+from .engine.driver import integrate
+from .engine.kernels import compiled_jacobian, compiled_kernels
+from .engine.saltation import switch_saltation
+from .engine.tableau import TABLEAUS, arrays
+from .engine.variational import integrate_segment
+from .errors import CamdynError, ParameterError
+from .model import Model
+from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
+
+__all__ = ["tangent", "variational", "TangentResult", "TangentSettings", "TangentFailure"]
+
+#: rows of the augmented state: x, then Phi row by row, then the integral of the divergence
+_PHI = slice(2, 6)
+_DIVERGENCE = 6
+
+
+class TangentFailure(CamdynError):
+    """The tangent dynamics could not be integrated: the engine's run failed (``outcome`` is its
+    :class:`~camdyn.Outcome`), a segment's integration failed, or a switch grazed its surface
+    (a non-finite saltation matrix)."""
+
+    def __init__(self, message: str, outcome=None):
+        super().__init__(message)
+        self.outcome = outcome
+
+
+@dataclass(frozen=True)
+class TangentSettings:
+    """The tolerances of the augmented (x, Phi) integration between switches (DOP853); atol is
+    scaled by max abs(Phi) at the segment's start for the entries of Phi.  (rtol 1e-11, atol 1e-13
+    failed on a contact segment of the chaotic test case: "required step size is less than
+    spacing between numbers", where Phi grew from 1 to 4e4 within 3e-5 s.)"""
+
+    rtol: float = 1e-10
+    atol: float = 1e-12
+
+    def __post_init__(self):
+        for name in ("rtol", "atol"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
+                raise ParameterError(name, value, "0 < value < 1")
+
+
+@dataclass(frozen=True)
+class TangentResult:
+    """The end of a run with its fundamental matrix.
+
+    ``state``: x(t1) from the engine; ``phi``: dx(t1)/dx(t0) times the start's ``phi0``;
+    ``end_mode``: the mode at t1 (index into MODES); ``switches``: the saltation matrices
+    applied; ``divergence``: the integral of d(alpha_ddot)/d(alpha_dot) over the run (1);
+    ``log_det_saltation``: the sum of log abs(det S) over the switches (-inf after a stick entry,
+    whose S is singular); ``flow_state``: x(t1) of the augmented integration's last segment (a
+    check against ``state``)."""
+
+    state: np.ndarray
+    phi: np.ndarray
+    end_mode: int
+    switches: int
+    divergence: float
+    log_det_saltation: float
+    flow_state: np.ndarray
+
+
+def _augmented(model: Model, m: int, t_start: float):
+    """The field of (x, Phi, integral of the divergence) in mode m.  At the segment's start the
+    Jacobian is its limit from inside the segment, taken LOOK_AHEAD along the motion as the
+    engine's rules do: a segment that starts on a surface may start on a kink of the law (the
+    impact damping's abs(psi_i) at first contact, whose generated derivative is 0 at psi_i = 0),
+    and a first stage with the kink's value would stall the step-size control."""
+    p, K = model.p, model.kernels
+    extra = model._extra
+    jac = np.empty(2)
+
+    def f(t, y):
+        a, ad = y[STATE_ALPHA], y[STATE_ALPHA_DOT]
+        add = K.rhs(m, t, a, ad, p, *extra(t))
+        if t == t_start:
+            d = LOOK_AHEAD
+            K.jacobian(m, t + d, a + d * ad, ad + d * add, p, *extra(t + d), jac)
+        else:
+            K.jacobian(m, t, a, ad, p, *extra(t), jac)
+        j0, j1 = jac
+        phi = y[_PHI]
+        return np.array([ad, add,
+                         phi[2], phi[3], j0 * phi[0] + j1 * phi[2], j0 * phi[1] + j1 * phi[3], j1])
+    return f
+
+
+def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: TangentSettings, compiled: bool):
+    """(x, Phi, integral of the divergence) at t1 from (x, Phi) at t0 in mode m: compiled
+    (:mod:`camdyn.engine.variational`) or by SciPy's DOP853 over the Python kernels."""
+    y0 = np.concatenate([x, phi.ravel(), [0.0]])
+    if t1 <= t0:
+        return np.asarray(x, dtype=float), phi, 0.0
+    atol = settings.atol * np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(phi)))), [1.0]])
+    if compiled:
+        K = model.kernels
+        y, ok = integrate_segment(compiled_kernels(K).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
+                                  settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
+        message = "the step size fell below the spacing of t"
+    else:
+        sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
+        y, ok, message = sol.y[:, -1], sol.success, sol.message
+    if not ok or not np.all(np.isfinite(y)):
+        raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
+                             f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
+                             "first contact: use camdyn.section_map.finite_differences)")
+    return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
+
+
+def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
+            options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled",
+            settings: TangentSettings = TangentSettings()) -> TangentResult:
+    """x(t1) and Phi(t1) = dx(t1)/dx(t0) phi0 of a run of ``model`` over t_span from y0 (see
+    the module docstring).  ``mode`` is the mode to start in (default: the automaton's initial
+    rule), ``options`` the engine's, ``settings`` the augmented integration's tolerances."""
+    t0, t1 = map(float, t_span)
+    x = np.asarray(y0, dtype=float)
+    tr = integrate(model, (t0, t1), x, np.array([t1]), options, mode=mode, backend=backend)
+    if not tr.outcome.ok or tr.t.size != 1:
+        raise TangentFailure(f"the run from {tuple(map(float, x))} failed: {tr.outcome.message}", tr.outcome)
+    K = model.kernels
+    compiled = backend == "compiled"
+    phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
+    m = K.MODES.index(tr.switches[0].before) if tr.switches else tr.end_mode
+    t, divergence, log_det = t0, 0.0, 0.0
+    for sw in tr.switches:
+        _, phi, d = _segment(model, m, t, sw.t, x, phi, settings, compiled)
+        divergence += d
+        before, after = K.MODES.index(sw.before), K.MODES.index(sw.after)
+        x = np.array([sw.alpha, sw.alpha_dot])
+        S = switch_saltation(model, before, after, K.SURFACES.index(sw.surface), sw.t, x)
+        if not np.all(np.isfinite(S)):
+            raise TangentFailure(f"the switch at t = {sw.t:g} s across {sw.surface!r} grazes it (the field is "
+                                 "tangent to the surface): no saltation matrix")
+        phi = S @ phi
+        det = abs(np.linalg.det(S))
+        log_det += math.log(det) if det > 0 else -math.inf
+        t, m = sw.t, after
+    flow_x, phi, d = _segment(model, m, t, t1, x, phi, settings, compiled)
+    return TangentResult(tr.y[:2, -1].copy(), phi, int(tr.end_mode), len(tr.switches), divergence + d, log_det,
+                         flow_x)
+
+
+def variational(section_map: StroboscopicMap, scale=None, settings: TangentSettings = TangentSettings()):
+    """A Jacobian provider x -> (P_n(x), dP_n/dx) by the tangent dynamics (one engine run and
+    one augmented integration per call, against 5 runs by finite differences).  ``scale`` is
+    accepted for the signature of :func:`camdyn.orbits.periodic_orbit`'s ``jacobian`` and not
+    used.  Raises :class:`~camdyn.section_map.MapFailure` where the map cannot be evaluated."""
+
+    def provider(x):
+        x = np.asarray(x, dtype=float)
+        m = section_map.start_mode(x)
+        try:
+            r = tangent(section_map.model, section_map.t_span, x, mode=m, options=section_map.options,
+                        backend=section_map.backend, settings=settings)
+        except TangentFailure as failure:
+            raise MapFailure(str(failure), failure.outcome) from failure
+        return r.state, r.phi
+
+    return provider

@@ -1,0 +1,94 @@
+"""Lyapunov exponents of hybrid trajectories (issue 13): against a periodic orbit's multipliers,
+the spectrum's sum identity (Liouville with saltation), the chaotic case of tests/test_chaos.py,
+and convergence as the tolerance tightens.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import camdyn
+from camdyn.engine.config import SolverOptions
+from camdyn.lyapunov import LyapunovSettings, lyapunov_exponents
+from camdyn.orbits import periodic_orbit
+
+RIG = camdyn.example_rig()
+SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
+CHAOS_RIG = camdyn.load_rig("reference-experiment")     # tests/test_chaos.py's case
+CHAOS_SPEED = 196.0
+CHAOS = LyapunovSettings(revolutions=100, transient=100, batches=10)
+
+
+def _chaos(rtol):
+    return lyapunov_exponents(CHAOS_RIG, SCENE, speed_rpm=CHAOS_SPEED, settings=CHAOS,
+                              options=SolverOptions(rtol=rtol, atol=1e-3 * rtol))
+
+
+@pytest.fixture(scope="module")
+def chaotic():
+    return _chaos(1e-10)
+
+
+def test_a_periodic_orbits_exponent_is_its_largest_multipliers_rate():
+    """Started on the stable 1500 rev/min orbit, lambda_1 = log|mu_max| / T.  Its multipliers are
+    a complex pair: a tangent vector's norm after N periods is |mu|^N times a factor within
+    [1/kappa, kappa], kappa the condition number of the real basis (Re v, Im v) of the
+    eigenvectors, so |lambda_1 - log|mu| / T| <= log(kappa) / (N T)."""
+    orbit = periodic_orbit(RIG, SCENE, speed_rpm=1500.0, warmup_revolutions=2)
+    assert orbit.ok, orbit.message
+    N = 40
+    L = lyapunov_exponents(RIG, SCENE, speed_rpm=1500.0, y0=orbit.state,
+                           settings=LyapunovSettings(revolutions=N, transient=0, batches=4))
+    mu, V = np.linalg.eig(orbit.monodromy)
+    T = 60.0 / 1500.0
+    kappa = np.linalg.cond(np.column_stack([V[:, 0].real, V[:, 0].imag]))
+    expected = math.log(np.max(np.abs(mu))) / T
+    assert abs(L.largest - expected) <= math.log(kappa) / (N * T)
+    # the pair's product is exact: lambda_1 + lambda_2 = log|det M| / T, to the tangent
+    # integration's tolerance (rtol 1e-10) over N periods, and the orbit's own residual
+    assert L.exponents.sum() == pytest.approx(math.log(abs(np.linalg.det(orbit.monodromy))) / T, rel=1e-6)
+
+
+@pytest.mark.parametrize("speed", [1100.0, 1500.0])
+def test_spectrum_sum_is_mean_divergence_plus_saltation(speed):
+    """lambda_1 + lambda_2 = time mean of d(alpha_ddot)/d(alpha_dot) + sum log|det S| / time
+    (Liouville's formula between switches, det of each jump).  The divergence is integrated with
+    the tangent dynamics; the QR sums reproduce log|det Phi| to the integration's tolerance:
+    relative 1e-6.  (Damping D: det S = 1 at each switch here -- at maximum compression the
+    damping force vanishes under both laws, at separation the gap has no alpha_dot
+    component -- so the saltation term is ~1e-9 1/s, rounding.)"""
+    L = lyapunov_exponents(RIG, SCENE, speed_rpm=speed, settings=LyapunovSettings(40, 20, 4))
+    assert L.switches > 0
+    assert L.exponents.sum() == pytest.approx(L.divergence_mean + L.saltation_rate, rel=1e-6)
+    assert abs(L.saltation_rate) < 1e-6 * abs(L.divergence_mean)
+
+
+def test_the_chaotic_case_has_a_positive_exponent_near_the_measured_divergence(chaotic):
+    """tests/test_chaos.py measured two runs 1e-9 rad apart separating by e^0.62 per revolution
+    (median of 10 starts, range 0.39-1.04).  lambda_1 T over 100 revolutions: positive by more
+    than 3 standard errors, and inside that range."""
+    lam, se = chaotic.largest, chaotic.standard_error[0]
+    assert lam > 3 * se
+    assert 0.39 <= lam * chaotic.period <= 1.04
+    assert chaotic.exponents[1] < 0 < chaotic.exponents[0]     # dissipative: the sum is negative
+    assert chaotic.revolutions == 100 and chaotic.transient == 100
+
+
+def test_the_chaotic_exponent_converges_as_rtol_tightens(chaotic):
+    """A chaotic trajectory changes with the tolerance, its exponent only within its
+    statistical error: rtol 1e-9 and 1e-11 against 1e-10 within 4 combined standard errors."""
+    for rtol in (1e-9, 1e-11):
+        other = _chaos(rtol)
+        combined = math.hypot(other.standard_error[0], chaotic.standard_error[0])
+        assert abs(other.largest - chaotic.largest) <= 4 * combined
+
+
+def test_bad_settings_name_the_parameter():
+    with pytest.raises(camdyn.ParameterError, match="revolutions"):
+        LyapunovSettings(revolutions=15, batches=10)
+    with pytest.raises(camdyn.ParameterError, match="transient"):
+        LyapunovSettings(transient=-1)
+    with pytest.raises(camdyn.ParameterError, match="settings"):
+        lyapunov_exponents(RIG, SCENE, speed_rpm=1500.0, settings=None)

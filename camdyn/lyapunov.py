@@ -4,7 +4,11 @@ Along a run, the tangent vectors of the state x = (alpha, alpha_dot) evolve by t
 equation between switches and jump by the saltation matrices at them (:mod:`camdyn.tangent`).
 Every cam period T the basis Q of two tangent vectors is propagated, Phi Q = Q' R (QR
 re-orthonormalisation), and log abs(R_ii) is the stretching of the i-th direction over that
-revolution; the exponents are their sums over the revolutions divided by the time:
+revolution; the exponents are their sums over the revolutions divided by the time.  Within a
+revolution the basis is re-orthonormalised as well, after every switch and every stretch of
+contact that could contract it by e^100 (``tangent(..., renormalise=True)``: a stiff contact's
+damping contracts Phi by more than the range of a double in one revolution), and R is the
+product of those factors:
 
     lambda_i = sum_k log abs(R_ii^(k)) / (N T)   (1/s),  lambda_1 >= lambda_2.
 
@@ -116,12 +120,8 @@ def spectrum(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=N
     divergence, log_det, switches = 0.0, 0.0, 0
     for k in range(settings.revolutions):
         t0 = ((settings.transient + k) % 2) * T        # the kernels' period is 2 T
-        r = tangent(model, (t0, t0 + T), x, Q, mode, options, backend, tangent_settings)
-        Q, R = np.linalg.qr(r.phi)
-        signs = np.where(np.diag(R) < 0, -1.0, 1.0)
-        Q, diag = Q * signs[None, :], np.abs(np.diag(R))
-        with np.errstate(divide="ignore"):
-            logs[k] = np.log(diag)
+        r = tangent(model, (t0, t0 + T), x, Q, mode, options, backend, tangent_settings, renormalise=True)
+        Q, logs[k] = r.phi, r.log_growth   # Q R_k with log abs(diag R_k) = log_growth: Q is orthonormal
         x, mode = r.state, r.end_mode
         divergence, log_det, switches = divergence + r.divergence, log_det + r.log_det_saltation, switches + r.switches
     time = settings.revolutions * T

@@ -27,7 +27,7 @@ why the finite differences stay :func:`camdyn.periodic_orbit`'s default provider
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -86,7 +86,9 @@ class TangentResult:
     applied; ``divergence``: the integral of d(alpha_ddot)/d(alpha_dot) over the run (1);
     ``log_det_saltation``: the sum of log abs(det S) over the switches (-inf after a stick entry,
     whose S is singular); ``flow_state``: x(t1) of the augmented integration's last segment (a
-    check against ``state``)."""
+    check against ``state``); ``log_growth``: with ``renormalise``, the logs of the diagonals of
+    the triangular factors taken out of Phi (dx(t1)/dx(t0) phi0 = phi R, log abs(diag R) = log_growth),
+    else zeros."""
 
     state: np.ndarray
     phi: np.ndarray
@@ -95,6 +97,7 @@ class TangentResult:
     divergence: float
     log_det_saltation: float
     flow_state: np.ndarray
+    log_growth: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
 
 def _augmented(model: Model, m: int, t_start: float):
@@ -144,12 +147,55 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
     return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
 
 
+#: with renormalisation, a segment is integrated in pieces over which Phi grows or shrinks by at
+#: most about e^RENORMALISE_NATS (rate bound below), and Phi is re-orthonormalised after each:
+#: a contact segment's damping contracts Phi by e^-700 within a revolution on a stiff rig, below
+#: the smallest double (e^-745), where Phi would underflow to 0
+RENORMALISE_NATS = 100.0
+
+
+def _piece_end(model: Model, m: int, t: float, x, t1: float) -> float:
+    """The end of the next piece of a segment to t1: its rate bound is abs(a_alpha_dot) (the
+    divergence) plus sqrt(a_alpha) where the stiffness term repels (Eqs. 21-22 at the start)."""
+    jac = np.empty(2)
+    model.kernels.jacobian(m, t, float(x[0]), float(x[1]), model.p, *model._extra(t), jac)
+    rate = abs(jac[1]) + math.sqrt(max(jac[0], 0.0))
+    if not math.isfinite(rate) or rate <= 0.0:
+        return t1
+    return min(t1, t + RENORMALISE_NATS / rate)
+
+
+def _orthonormalised(phi, log_growth):
+    """phi = Q R with diag R >= 0: (Q, log_growth + log diag R)."""
+    Q, R = np.linalg.qr(phi)
+    signs = np.where(np.diag(R) < 0, -1.0, 1.0)
+    with np.errstate(divide="ignore"):
+        return Q * signs[None, :], log_growth + np.log(np.abs(np.diag(R)))
+
+
+def _flow(model, m, t0, t1, x, phi, settings, compiled, log_growth):
+    """_segment from t0 to t1, in renormalised pieces when log_growth is not None."""
+    if log_growth is None:
+        x, phi, d = _segment(model, m, t0, t1, x, phi, settings, compiled)
+        return x, phi, d, None
+    divergence, t = 0.0, t0
+    while t < t1:
+        t_next = _piece_end(model, m, t, x, t1)
+        x, phi, d = _segment(model, m, t, t_next, x, phi, settings, compiled)
+        phi, log_growth = _orthonormalised(phi, log_growth)
+        divergence, t = divergence + d, t_next
+    return x, phi, divergence, log_growth
+
+
 def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
             options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled",
-            settings: TangentSettings = TangentSettings()) -> TangentResult:
+            settings: TangentSettings = TangentSettings(), renormalise: bool = False) -> TangentResult:
     """x(t1) and Phi(t1) = dx(t1)/dx(t0) phi0 of a run of ``model`` over t_span from y0 (see
     the module docstring).  ``mode`` is the mode to start in (default: the automaton's initial
-    rule), ``options`` the engine's, ``settings`` the augmented integration's tolerances."""
+    rule), ``options`` the engine's, ``settings`` the augmented integration's tolerances.
+    With ``renormalise`` (for Lyapunov exponents), Phi is re-orthonormalised (QR) after every
+    switch and every piece of RENORMALISE_NATS, so that it neither underflows nor overflows; the
+    result's ``phi`` is then the last Q and its ``log_growth`` the logs taken out."""
     t0, t1 = map(float, t_span)
     x = np.asarray(y0, dtype=float)
     tr = integrate(model, (t0, t1), x, np.array([t1]), options, mode=mode, backend=backend)
@@ -160,8 +206,9 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
     m = K.MODES.index(tr.switches[0].before) if tr.switches else tr.end_mode
     t, divergence, log_det = t0, 0.0, 0.0
+    growth = np.zeros(2) if renormalise else None
     for sw in tr.switches:
-        _, phi, d = _segment(model, m, t, sw.t, x, phi, settings, compiled)
+        _, phi, d, growth = _flow(model, m, t, sw.t, x, phi, settings, compiled, growth)
         divergence += d
         before, after = K.MODES.index(sw.before), K.MODES.index(sw.after)
         x = np.array([sw.alpha, sw.alpha_dot])
@@ -170,12 +217,14 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
             raise TangentFailure(f"the switch at t = {sw.t:g} s across {sw.surface!r} grazes it (the field is "
                                  "tangent to the surface): no saltation matrix")
         phi = S @ phi
+        if renormalise:
+            phi, growth = _orthonormalised(phi, growth)
         det = abs(np.linalg.det(S))
         log_det += math.log(det) if det > 0 else -math.inf
         t, m = sw.t, after
-    flow_x, phi, d = _segment(model, m, t, t1, x, phi, settings, compiled)
+    flow_x, phi, d, growth = _flow(model, m, t, t1, x, phi, settings, compiled, growth)
     return TangentResult(tr.y[:2, -1].copy(), phi, int(tr.end_mode), len(tr.switches), divergence + d, log_det,
-                         flow_x)
+                         flow_x, np.zeros(2) if growth is None else growth)
 
 
 def variational(section_map: StroboscopicMap, scale=None, settings: TangentSettings = TangentSettings()):

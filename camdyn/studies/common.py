@@ -332,6 +332,33 @@ def impact_run(rig, damping: str, speed_rpm: float, revolutions: float, transien
     return out
 
 
+#: a largest Lyapunov exponent is told from zero when it is this many standard errors of its
+#: batch means away from it (about 99.7 % for independent, normally distributed batch means)
+CONFIDENCE_SE = 3.0
+
+
+def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revolutions: int, batches: int) -> dict:
+    """The largest Lyapunov exponent (camdyn.lyapunov) of the impacting rig's run from the
+    static equilibrium, over ``revolutions`` after ``transient`` (the window of
+    :func:`impact_run`'s class), and the verdict it gives: *chaotic* where it is positive by CONFIDENCE_SE standard errors,
+    *regular* where it is negative by as many, else *undecided*; *n/a* where the tangent
+    dynamics cannot be integrated (damping C and E: their impact law's Jacobian is unbounded at
+    first contact, camdyn.tangent), with the reason."""
+    from camdyn.lyapunov import LyapunovSettings, lyapunov_exponents
+    from camdyn.tangent import TangentFailure
+
+    scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
+    settings = LyapunovSettings(revolutions=revolutions, transient=transient, batches=batches)
+    try:
+        ly = lyapunov_exponents(rig, scene, speed_rpm=speed_rpm, settings=settings)
+    except TangentFailure as failure:
+        return {"lyapunov": None, "lyapunov_se": None, "chaos": "n/a", "chaos_reason": str(failure)}
+    lam, se = ly.largest, float(ly.standard_error[0])
+    verdict = ("chaotic" if lam > CONFIDENCE_SE * se else "regular" if lam < -CONFIDENCE_SE * se
+               else "undecided")
+    return {"lyapunov": lam, "lyapunov_se": se, "lyapunov_per_rev": lam * ly.period, "chaos": verdict}
+
+
 def continuation_start(end_state, from_rpm: float, to_rpm: float) -> tuple[list[float], float]:
     """(y0, t_start) that continue a run ended in ``end_state`` (alpha, alpha_dot, t) at
     ``from_rpm`` at the speed ``to_rpm``, at the same cam angle (Theta = Theta0 + Omega_c t):

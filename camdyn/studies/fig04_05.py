@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import (EXPERIMENT_SPEEDS, Context, StudyOutput, continuation_start, experiment_rig, figure, fmt,
-                     impact_run, md_table, parallel_map, save)
+from .common import (CONFIDENCE_SE, EXPERIMENT_SPEEDS, Context, StudyOutput, chaos_by_lyapunov, continuation_start,
+                     experiment_rig, figure, fmt, impact_run, md_table, parallel_map, save)
 
 NAME, TITLE = "fig4-5", "Figs. 4–5: residual response against speed, damping models A–E"
 MODELS = "ABCDE"
@@ -16,9 +16,9 @@ COLORS = dict(A="tab:blue", B="tab:orange", C="tab:green", D="tab:red", E="tab:p
 
 def settings(fast: bool) -> dict:
     if fast:
-        return dict(speeds=[135.0, 155.0], revolutions=6, transient=3, max_revolutions=9, history=2)
+        return dict(speeds=[135.0, 155.0], revolutions=6, transient=3, max_revolutions=9, history=2, batches=3)
     speeds = sorted(set(EXPERIMENT_SPEEDS) | {125.0, 130.0, 165.0})
-    return dict(speeds=speeds, revolutions=200, transient=100, max_revolutions=500, history=6)
+    return dict(speeds=speeds, revolutions=200, transient=100, max_revolutions=500, history=6, batches=10)
 
 
 def _job(args):
@@ -31,6 +31,7 @@ def _job(args):
     for sp in s["speeds"]:
         r = impact_run(rig, d, sp, s["revolutions"], s["transient"], max_revolutions=s["max_revolutions"],
                        keep_history=s["history"] if sp == 155.0 else 0.0)
+        r.update(chaos_by_lyapunov(rig, d, sp, s["transient"], s["revolutions"] - s["transient"], s["batches"]))
         if prev is not None:
             y0, t_start = continuation_start(prev["end_state"], prev["speed_rpm"], sp)
             u = impact_run(rig, d, sp, s["revolutions"], s["transient"], max_revolutions=s["max_revolutions"],
@@ -68,6 +69,8 @@ def run(ctx: Context) -> StudyOutput:
 
     def cell(r):
         text = f"{r['class']}, rms {fmt(r['rms'], 3)}, p-p {fmt(r['p2p'], 3)}"
+        if r.get("lyapunov") is not None:
+            text += f", λ1 {fmt(r['lyapunov'], 3)} ± {fmt(r['lyapunov_se'], 2)} 1/s ({r['chaos']})"
         if r.get("revolutions", s["revolutions"]) > s["revolutions"]:
             text += f" ({r['revolutions']:g} rev)"
         if r.get("up") and r["up"] is not r and coexist(r):
@@ -82,10 +85,13 @@ def run(ctx: Context) -> StudyOutput:
         ap = [sp for sp in speeds if (by[d, sp].get("up") or {}).get("class") == "aperiodic"]
         first_aperiodic_up[d] = min(ap) if ap else None
     at155 = {d: by[d, 155.0]["class"] for d in MODELS if (d, 155.0) in by}
+    chaos155 = {d: by[d, 155.0].get("chaos") for d in MODELS if (d, 155.0) in by}
+    first_chaotic = {d: next((sp for sp in speeds if by[d, sp].get("chaos") == "chaotic"), None) for d in MODELS}
+    judged = {d: any(by[d, sp].get("chaos") not in (None, "n/a") for sp in speeds) for d in MODELS}
     coexisting = {d: [sp for sp in speeds[1:] if coexist(by[d, sp])] for d in MODELS}
     extended = {d: [sp for sp in speeds if by[d, sp].get("revolutions", 0) > s["revolutions"]] for d in MODELS}
 
-    checks = _checks(first_aperiodic, at155, speeds)
+    checks = _checks(first_aperiodic, at155, speeds) + _lyapunov_checks(first_chaotic, chaos155, judged)
     n_co = sum(len(v) for v in coexisting.values())
     co_text = "; ".join(f"{d}: {', '.join(f'{v:g}' for v in coexisting[d])}" for d in MODELS if coexisting[d])
     md = "\n\n".join([
@@ -95,8 +101,14 @@ def run(ctx: Context) -> StudyOutput:
         f"the static equilibrium (as in Sec. 4); {s['revolutions']} revolutions per run, statistics over the last "
         f"{s['revolutions'] - s['transient']} (the first {s['transient']} are dropped as transient). "
         "A run is *periodic (Pn)* when its Poincaré section (α_r once per cam revolution) repeats with period "
-        "n ≤ 8 to 0.2 % of its peak-to-peak, else *aperiodic* (chaotic or a long transient; not proven chaotic "
-        f"by a Lyapunov exponent). A run whose last {s['revolutions'] - s['transient']} revolutions are aperiodic "
+        "n ≤ 8 to 0.2 % of its peak-to-peak, else *aperiodic* (chaotic or a long transient). "
+        f"Chaos is judged by the largest Lyapunov exponent λ1 of the same window (tangent dynamics with "
+        f"saltation matrices, `camdyn.lyapunov`, renormalised every revolution, from the static equilibrium "
+        f"after the same {s['transient']} transient revolutions; ± the standard error of {s['batches']} batch "
+        f"means): *chaotic* where λ1 > {CONFIDENCE_SE:g} standard errors, *regular* where λ1 < −{CONFIDENCE_SE:g} "
+        "standard errors, else *undecided*. Damping C and E have no exponent (*n/a*): their impact law's "
+        "Jacobian, c ∝ |ψ_i|^(1/4), is unbounded at first contact, which the tangent integration cannot pass; "
+        "for them the periodicity verdict stands alone. A run whose last {s['revolutions'] - s['transient']} revolutions are aperiodic "
         f"is continued, {s['revolutions'] - s['transient']} revolutions at a time, up to {s['max_revolutions']} "
         "in all, and classed by its last window, so that a motion wandering between coexisting attractors "
         "before it settles is classed by where it settles (the run length is then given in the table). Each "
@@ -119,7 +131,8 @@ def run(ctx: Context) -> StudyOutput:
         "is scanned by `python -m camdyn.studies chaos-scan` (next section).",
         md_table(["Ω_c (rev/min)"] + [f"model {d}" for d in MODELS], rows),
     ])
-    numbers = {"first_aperiodic_rpm": first_aperiodic, "first_aperiodic_rpm_upsweep": first_aperiodic_up,
+    numbers = {"first_aperiodic_rpm": first_aperiodic, "first_chaotic_rpm_lyapunov": first_chaotic,
+               "chaos_at_155_lyapunov": chaos155, "first_aperiodic_rpm_upsweep": first_aperiodic_up,
                "class_at_155": at155, "coexisting_rpm": coexisting,
                "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r", "end_state")} for r in runs]}
     return StudyOutput(NAME, TITLE, md, numbers, [png])
@@ -165,6 +178,29 @@ def _figure(ctx: Context, by: dict, speeds: list):
     ax[1, 1].set_yticks([])
     ax[1, 1].legend(fontsize=8, loc="upper right")
     return save(fig, ctx.png("fig4-5"))
+
+
+def _lyapunov_checks(first_chaotic: dict, chaos155: dict, judged: dict) -> list[list[str]]:
+    """The statements of Sec. 4 on chaos judged by the largest Lyapunov exponent, for the
+    models that have one (judged[d])."""
+
+    def yes(ok):
+        return "yes" if ok else "**no**"
+
+    def first(d):
+        if not judged[d]:
+            return f"{d}: no exponent (n/a)"
+        return f"{d}: first chaotic (λ1 > 0) at {fmt(first_chaotic[d])} rev/min" if first_chaotic[d] \
+            else f"{d}: none chaotic"
+
+    bd = all(judged[d] and first_chaotic[d] is not None and first_chaotic[d] >= 155.0 for d in "BD")
+    ac = [d for d in "AC" if judged[d]]
+    return [
+        ["B and D chaotic above about 155 rev/min (by λ1)", ", ".join(first(d) for d in "BD"), yes(bd)],
+        ["A and C still periodic at 155 rev/min (by λ1)",
+         ", ".join(f"{d}: {chaos155.get(d)}" for d in ac) + ("; C: n/a" if "C" not in ac else ""),
+         yes(bool(ac) and all(chaos155.get(d) == "regular" for d in ac))],
+    ]
 
 
 def _checks(first_aperiodic: dict, at155: dict, speeds: list) -> list[list[str]]:

@@ -45,6 +45,12 @@ from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
 
 __all__ = ["tangent", "variational", "TangentResult", "TangentSettings", "TangentFailure"]
 
+#: a segment whose integration fails on an unbounded Jacobian at its end (damping B's impact law,
+#: c = beta k_lambda abs(psi_i), as psi_i -> 0 at separation: the step size fell to 7e-15 s short of
+#: it) is integrated to END_GAP before its end, and the Jacobian frozen over the last END_GAP
+#: (s): an integrable singularity's share of Phi over it vanishes with END_GAP (the engine locates
+#: the switch itself to ~1e-12 s)
+END_GAP = 1e-9
 #: rows of the augmented state: x, then Phi row by row, then the integral of the divergence
 _PHI = slice(2, 6)
 _DIVERGENCE = 6
@@ -132,19 +138,39 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
     if t1 <= t0:
         return np.asarray(x, dtype=float), phi, 0.0
     atol = settings.atol * np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(phi)))), [1.0]])
-    if compiled:
-        K = model.kernels
-        y, ok = integrate_segment(compiled_kernels(K).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
-                                  settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
-        message = "the step size fell below the spacing of t"
-    else:
-        sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
-        y, ok, message = sol.y[:, -1], sol.success, sol.message
+    y, ok, message = _integrate(model, m, t0, t1, y0, settings, atol, compiled)
+    if not ok and t1 - t0 > 2 * END_GAP:          # an unbounded Jacobian at the segment's end
+        y, ok, message = _integrate(model, m, t0, t1 - END_GAP, y0, settings, atol, compiled)
+        if ok:
+            y = _frozen_step(model, m, t1 - END_GAP, END_GAP, y)
     if not ok or not np.all(np.isfinite(y)):
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
                              f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
                              "first contact: use camdyn.section_map.finite_differences)")
     return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
+
+
+def _frozen_step(model: Model, m: int, t: float, h: float, y):
+    """y advanced over [t, t + h] with the Jacobian frozen at t (one Euler step of Phi and the
+    divergence; x is not used after a segment's end, where the engine's state restarts it)."""
+    jac = np.empty(2)
+    model.kernels.jacobian(m, t, float(y[0]), float(y[1]), model.p, *model._extra(t), jac)
+    J = np.array([[0.0, 1.0], [jac[0], jac[1]]])
+    out = y.copy()
+    out[_PHI] = ((np.eye(2) + h * J) @ y[_PHI].reshape(2, 2)).ravel()
+    out[_DIVERGENCE] += h * jac[1]
+    return out
+
+
+def _integrate(model: Model, m: int, t0: float, t1: float, y0, settings: TangentSettings, atol, compiled: bool):
+    """The augmented system from t0 to t1: (y, ok, message)."""
+    if compiled:
+        K = model.kernels
+        y, ok = integrate_segment(compiled_kernels(K).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
+                                  settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
+        return y, ok, "the step size fell below the spacing of t"
+    sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
+    return sol.y[:, -1], sol.success, sol.message
 
 
 #: with renormalisation, a segment is integrated in pieces over which Phi grows or shrinks by at

@@ -195,6 +195,26 @@ def test_a_user_cam_motion_gives_the_built_in_motions_tangent_dynamics():
     np.testing.assert_allclose(a.phi, b.phi, rtol=0, atol=1e-7 * np.max(np.abs(b.phi)))
 
 
+def test_damping_b_separation_with_its_unbounded_jacobian_agrees_with_finite_differences():
+    """Damping B's impact law c = beta_B k_lambda abs(psi_i) acts up to separation, where the 16 mm
+    line contact of the reference experiment makes the Jacobian unbounded as psi_i -> 0: the
+    segment's integration stalls 7e-15 s short of the switch, and the last END_GAP of it is
+    taken with the Jacobian frozen (camdyn.tangent.END_GAP).  Phi over one revolution with six
+    switches agrees with finite differences of the map to their own error, estimated by the
+    spread of two steps (FD steps 0.1 and 0.03 of the default), times 3."""
+    from camdyn.lyapunov import _start
+    rig = camdyn.load_rig("reference-experiment")
+    model = Model(rig, camdyn.Scene(contact="line", damping="B", friction="coulomb"), camdyn.ConstantSpeed(135.0))
+    x, mode = _start(model, 20, None, TIGHT, "compiled")
+    P = StroboscopicMap(model, 1, 0.0, mode, TIGHT)
+    r = tangent(model, P.t_span, x, mode=mode, options=TIGHT)
+    assert r.switches >= 2
+    scale = np.array([1e-3, 1e-1])                      # rad, rad/s: the motion's size here
+    coarse, fine = (finite_differences(P, scale, f)(x)[1] for f in (0.1, 0.03))
+    spread = np.max(np.abs(coarse - fine))
+    assert np.max(np.abs(r.phi - fine)) <= 3 * spread + 1e-6 * np.max(np.abs(fine))
+
+
 def test_damping_e_impact_law_is_refused_with_the_way_out():
     """Damping E's impact law c = beta_E abs(psi_i)^(1/4) has an unbounded Jacobian at first
     contact: the tangent dynamics raise, naming finite differences (camdyn.tangent's docstring)."""

@@ -39,6 +39,11 @@ SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = range(
 #: one switch: when, which transition (row of Tables), the modes before and after, the state after
 SWITCH = np.dtype([("t", np.float64), ("transition", np.int64), ("before", np.int64), ("after", np.int64),
                    ("alpha", np.float64), ("alpha_dot", np.float64)])
+#: inside the loop the switches are a float array with one row per field of SWITCH, in its order,
+#: and one column per switch (integers held exactly as floats): a record array costs the cold
+#: start the typing of its fields, its own allocation and its boxing
+SW_T, SW_TRANSITION, SW_BEFORE, SW_AFTER, SW_ALPHA, SW_ALPHA_DOT = range(len(SWITCH.names))
+SW_ROWS = len(SWITCH.names)
 
 
 class Start(NamedTuple):
@@ -80,15 +85,24 @@ class Run(NamedTuple):
 
 @jitable
 def _record(sw, n, t, w, before, after, a, ad):
-    """Append a switch, doubling the buffer when full; returns the buffer."""
-    if n == sw.shape[0]:
-        bigger = np.empty(2 * n, dtype=SWITCH)
-        for k in range(n):  # element by element: a slice assignment compiles numba's shape-error
-            bigger[k] = sw[k]  # message formatting, seconds of the cold start
+    """Append a switch as column n of sw (rows SW_*), doubling the buffer when full; returns it."""
+    if n == sw.shape[1]:
+        bigger = np.empty((sw.shape[0], 2 * n))
+        for r in range(sw.shape[0]):  # element by element: a slice assignment compiles numba's
+            for k in range(n):        # shape-error message formatting, seconds of the cold start
+                bigger[r, k] = sw[r, k]
         sw = bigger
-    sw["t"][n], sw["transition"][n], sw["before"][n], sw["after"][n] = t, w, before, after
-    sw["alpha"][n], sw["alpha_dot"][n] = a, ad
+    sw[SW_T, n], sw[SW_TRANSITION, n], sw[SW_BEFORE, n], sw[SW_AFTER, n] = t, w, before, after
+    sw[SW_ALPHA, n], sw[SW_ALPHA_DOT, n] = a, ad
     return sw
+
+
+def _switch_records(sw: np.ndarray, n: int) -> np.ndarray:
+    """The loop's first n switches (columns of sw) as SWITCH records."""
+    out = np.empty(n, dtype=SWITCH)
+    for k, name in enumerate(SWITCH.names):
+        out[name] = sw[k, :n]
+    return out
 
 
 @jitable
@@ -142,7 +156,9 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
 
 @jitable
 def run(prob, method, cfg, start, samples):
-    """Integrate the hybrid model from ``start`` (see the module docstring); a :class:`Run`."""
+    """Integrate the hybrid model from ``start`` (see the module docstring): the fields of a
+    :class:`Run` as a plain tuple, with the switch buffer (rows SW_*) and their count in
+    place of ``switches`` (:func:`_finish` makes the Run)."""
     tab = prob.tables
     rhs, p = prob.kernels.rhs, prob.p  # taken out once: a call passing prob pays a count per array it holds
     n = method.n_stages
@@ -154,7 +170,7 @@ def run(prob, method, cfg, start, samples):
     for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
         ledger_work[k] = 0.0
     ledger = samples.y.shape[0] > STATE_ROWS
-    sw = np.empty(16, dtype=SWITCH)
+    sw = np.empty((SW_ROWS, 16))
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
@@ -220,7 +236,7 @@ def run(prob, method, cfg, start, samples):
                 t, y0, y1, m = t_cross, c0, c1, m_new
                 if n_sw >= cfg.max_events:
                     outcome = MAX_EVENTS
-                elif chattering(sw["t"], n_sw, cfg.chatter_window, cfg.chatter_switches):
+                elif chattering(sw[SW_T], n_sw, cfg.chatter_window, cfg.chatter_switches):
                     outcome = CHATTER
                 break
             t, y0, y1, h_abs = t_new, n0, n1, h_next
@@ -230,15 +246,14 @@ def run(prob, method, cfg, start, samples):
             if abs(y0) > cfg.angle_limit:
                 outcome = ANGLE_LIMIT
                 break
-    return Run(outcome, i_sample, sw[:n_sw].copy(), nfev, steps, rejected, m, t, y0, y1)
+    # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
+    # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
+    return outcome, i_sample, sw, n_sw, nfev, steps, rejected, m, t, y0, y1
 
 
 @njit(cache=True, error_model="numpy")
 def _run_compiled(prob, method, cfg, start, samples):
-    r = run(prob, method, cfg, start, samples)
-    # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
-    # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
-    return (r.outcome, r.n_samples, r.switches, r.nfev, r.steps, r.rejected, r.mode, r.t, r.alpha, r.alpha_dot)
+    return run(prob, method, cfg, start, samples)
 
 
 def loop_loaded() -> bool:
@@ -248,10 +263,16 @@ def loop_loaded() -> bool:
 
 def run_compiled(prob, method, cfg, start, samples) -> Run:
     """:func:`run`, compiled; the kernels of ``prob`` must be numba cfuncs."""
-    return Run(*_run_compiled(prob, method, cfg, start, samples))
+    return _finish(_run_compiled(prob, method, cfg, start, samples))
 
 
 def run_interpreted(prob, method, cfg, start, samples) -> Run:
     """:func:`run` in Python, with Python kernels."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return run(prob, method, cfg, start, samples)
+        return _finish(run(prob, method, cfg, start, samples))
+
+
+def _finish(raw: tuple) -> Run:
+    """The :class:`Run` of :func:`run`'s tuple (switches as SWITCH records)."""
+    outcome, n_samples, sw, n_sw, *rest = raw
+    return Run(outcome, n_samples, _switch_records(sw, n_sw), *rest)

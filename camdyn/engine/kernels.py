@@ -42,8 +42,13 @@ def _no_fill(j, t, alpha, alpha_dot, p, out):
         out[k] = math.nan
 
 
-no_surface = numba.cfunc(SURFACE, cache=True)(_no_surface)
 no_fill = numba.cfunc(FILL, cache=True)(_no_fill)
+
+
+@lru_cache(maxsize=None)
+def no_surface():
+    """The cfunc of :func:`_no_surface`, compiled only for a scene that needs it."""
+    return numba.cfunc(SURFACE, cache=True)(_no_surface)
 
 
 def _check_compilable(K: ModuleType) -> None:
@@ -56,7 +61,7 @@ def _check_compilable(K: ModuleType) -> None:
 def _compiled(module_name: str) -> Kernels:
     """rhs, surface and reset of a scene as cfuncs; outputs is :func:`_compiled_outputs`'s."""
     K = importlib.import_module(module_name)
-    surface = numba.cfunc(SURFACE, cache=True)(K.surface) if hasattr(K, "surface") else no_surface
+    surface = numba.cfunc(SURFACE, cache=True)(K.surface) if hasattr(K, "surface") else no_surface()
     reset = numba.cfunc(FILL, cache=True)(K.reset) if hasattr(K, "reset") else no_fill
     return Kernels(numba.cfunc(RHS, cache=True)(K.rhs), surface, no_fill, reset)
 

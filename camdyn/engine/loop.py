@@ -143,15 +143,40 @@ ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
 
 
 @jitable
-def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
-    """The state at a crossing inside the step from (t, y): one step of the method to t_cross,
-    and whether it is ACROSS transition w's surface, NOT_YET (K[n] then holds f there, the next
-    step's first stage) or UNUSABLE (not finite).  K[0] must hold f(t, y)."""
+def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
+    """The state at a crossing inside the step [t, t + h] from (t, y): one step of the method to
+    t_cross, and whether it is ACROSS transition w's surface or NOT_YET (only when
+    ``may_retry``; K[n] then holds f there, the next step's first stage).  A state that is not
+    across (no retry left) or not finite is replaced by the interpolant's, across by
+    construction (verdict UNUSABLE).  K[0] must hold f(t, y)."""
     c0, c1 = step_impl(prob.kernels.rhs, prob.p, m, t, y0, y1, t_cross - t, method, K)
-    if not (math.isfinite(c0) and math.isfinite(c1)):
-        return c0, c1, UNUSABLE
-    g_ok = across(prob, m, w, t_cross, c0, c1)
-    return c0, c1, ACROSS if g_ok else NOT_YET
+    if math.isfinite(c0) and math.isfinite(c1):
+        if across(prob, m, w, t_cross, c0, c1):
+            return c0, c1, ACROSS
+        if may_retry:
+            return c0, c1, NOT_YET
+    c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
+    return c0, c1, UNUSABLE
+
+
+@jitable
+def _buffers(method, tab):
+    """The loop's work arrays: the stages K, the interpolant Q, first_crossing's work, the
+    kernels' output buffer, the ledger's works (0) and its scratch, the switches (rows SW_*)."""
+    K = np.empty((method.n_rows, 2))
+    Q = np.empty((2, method.degree))
+    work = scratch(tab.n_transitions, tab.n_surfaces)
+    buf = np.empty(tab.n_outputs if tab.n_outputs > 2 else 2)
+    ledger_work, ledger_tmp = np.empty(N_FLOWS), np.empty(N_FLOWS)
+    for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
+        ledger_work[k] = 0.0
+    return K, Q, work, buf, ledger_work, ledger_tmp, np.empty((SW_ROWS, 16))
+
+
+@jitable
+def _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work):
+    """The ledger's works over [t, t_cross] of the step [t, t + h]."""
+    accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
 
 
 @jitable
@@ -162,15 +187,8 @@ def run(prob, method, cfg, start, samples):
     tab = prob.tables
     rhs, p = prob.kernels.rhs, prob.p  # taken out once: a call passing prob pays a count per array it holds
     n = method.n_stages
-    K = np.empty((method.n_rows, 2))
-    Q = np.empty((2, method.degree))
-    work = scratch(tab.n_transitions, tab.n_surfaces)
-    buf = np.empty(tab.n_outputs if tab.n_outputs > 2 else 2)
-    ledger_work, ledger_tmp = np.empty(N_FLOWS), np.empty(N_FLOWS)
-    for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
-        ledger_work[k] = 0.0
+    K, Q, work, buf, ledger_work, ledger_tmp, sw = _buffers(method, tab)
     ledger = samples.y.shape[0] > STATE_ROWS
-    sw = np.empty((SW_ROWS, 16))
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
@@ -211,7 +229,7 @@ def run(prob, method, cfg, start, samples):
             if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
                 i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)
             if ledger:
-                accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
+                _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work)
             h_last = h
             if w >= 0:
                 if t_cross == t_new:
@@ -219,15 +237,14 @@ def run(prob, method, cfg, start, samples):
                 elif t_cross == t:
                     c0, c1 = y0, y1
                 else:
-                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K)
+                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K,
+                                                     retries < cfg.crossing_retries)
                     nfev += n
-                    if verdict == NOT_YET and retries < cfg.crossing_retries:  # on in this mode from there
+                    if verdict == NOT_YET:  # on in this mode from there
                         t, y0, y1, h_abs = t_cross, c0, c1, h
                         K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
                         have_start, retries = False, retries + 1
                         continue
-                    if verdict != ACROSS:  # the interpolant's state, across by construction
-                        c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
                 retries = 0
                 m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
                 capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
@@ -253,7 +270,11 @@ def run(prob, method, cfg, start, samples):
 
 #: run's own body compiled as the entry point, not a function calling it: numba optimizes and
 #: generates the machine code of a function together with everything it calls, once per
-#: compiled function, so one level less is one pass less over the whole loop on a cold start
+#: compiled function, so one level less is one pass less over the whole loop on a cold start.
+#: numba compiles a helper once per set of compile options of its callers, and the entry's
+#: differ from the helpers' (it has a Python wrapper): so run calls no helper that another
+#: helper also calls (allocations in _buffers, the ledger through _account, the interpolant's
+#: restart state in _restart_state), else that helper is compiled twice
 _run_compiled = njit(cache=True, error_model="numpy")(run)
 
 

@@ -96,7 +96,7 @@ def _notice_compile() -> None:
     """Say once, before it happens, that the loop is about to be compiled (a first run here)."""
     if loop_loaded() or cache.loop_cached():
         return
-    warnings.warn(f"camdyn compiles its integration loop on this first run (typically 10-20 s, once; later runs "
+    warnings.warn(f"camdyn compiles its integration loop on this first run (typically 5-15 s, once; later runs "
                   f"load it from {cache.cache_dir()}). Silence this with warnings.filterwarnings('ignore', "
                   "category=camdyn.CompileNotice).", CompileNotice, stacklevel=5)
 

@@ -1,12 +1,55 @@
 """The result of a simulation: time histories, regimes, switches, outcome."""
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .engine.driver import Switch
 from .outcome import Outcome
+
+
+class Outputs(Mapping):
+    """A run's output quantities by name, computed on first use, all at once.
+
+    The names are known at once; the values come from ``compute()`` (a dict of arrays) the
+    first time one is read.  A run whose outputs nobody reads never compiles the scene's
+    ``outputs`` kernel: about a second of a cold start (docs/performance.md, Start-up).
+    Pickled (a sweep's worker) or copied, it is the plain dict of its values."""
+
+    def __init__(self, names, compute: Callable[[], dict]):
+        self._names = tuple(names)
+        self._compute = compute
+        self._values: dict | None = None
+
+    def _all(self) -> dict:
+        if self._values is None:
+            values = self._compute()
+            self._values = {name: values[name] for name in self._names}
+            self._compute = None  # let go of the model and the samples it held
+        return self._values
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._names:
+            raise KeyError(name)
+        return self._all()[name]
+
+    def __contains__(self, name) -> bool:
+        return name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __reduce__(self):
+        return dict, (self._all(),)
+
+    def __repr__(self) -> str:
+        state = "computed" if self._values is not None else "not computed yet"
+        return f"Outputs({', '.join(self._names)}; {state})"
 
 
 @dataclass
@@ -25,7 +68,7 @@ class Result:
     alpha_dot: np.ndarray
     Theta: np.ndarray
     regime: np.ndarray
-    outputs: dict[str, np.ndarray]
+    outputs: Mapping[str, np.ndarray]    # a dict, or Outputs (computed when first read)
     switches: list[Switch]
     outcome: Outcome
     stats: dict

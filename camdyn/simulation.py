@@ -15,7 +15,7 @@ from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
 from .errors import ParameterError
 from .model import Model
 from .pieces import integrate_in_pieces
-from .result import Result
+from .result import Outputs, Result
 from .rig import Rig
 from .scene import Scene
 
@@ -125,20 +125,36 @@ def solver_options(method, rtol, atol, max_step, events, energy_ledger) -> Solve
 
 
 def _result(model: Model, traj, backend: str) -> Result:
-    """The output quantities at every sample (the generated ``outputs`` kernel, in each
-    sample's mode), and the ledger's works."""
-    from .engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
+    """The Result of a run: its output quantities (the generated ``outputs`` kernel, in each
+    sample's mode, computed when first read: :class:`~camdyn.result.Outputs`) and the ledger's
+    works."""
     K = model.kernels
     t, alpha, alpha_dot = traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT]
-    compiled = backend == "compiled"
-    kern = compiled_kernels(K) if compiled else python_kernels(K, model.cam if model.scene.motion == "user" else None)
-    values = outputs_on_samples(kern, compiled, traj.mode, t, alpha, alpha_dot, model.p, len(K.OUTPUTS))
-    outputs = dict(zip(K.OUTPUTS, values))
+    names = list(K.OUTPUTS)
     if traj.y.shape[0] == LEDGER_ROWS:  # the works of FLOWS (P_in, D_c, D_f), in that order
-        for i, name in enumerate(("work_in", "dissipated_contact", "dissipated_friction")):
-            outputs[name] = traj.y[WORK + i].copy()
+        names += list(LEDGER_OUTPUTS)
+    outputs = Outputs(names, functools.partial(_output_values, model, traj, backend))
     theta = np.broadcast_to(model.cam_state(t)[CAM_THETA], t.shape).astype(float) if t.size else t.copy()
     contact = dict(zip(K.MODES, map(bool, K.CONTACT_OF_MODE)))
     return Result(t, alpha, alpha_dot, theta, traj.regime.astype(str), outputs, traj.switches,
                   traj.outcome, traj.stats, model.period, model.scene.slug, model.equilibrium.alpha,
                   {"rig": model.rig.name, "cam": model.cam, "contact": contact})
+
+
+#: Result.outputs' names of the energy ledger's works of FLOWS (P_in, D_c, D_f), in that order
+LEDGER_OUTPUTS = ("work_in", "dissipated_contact", "dissipated_friction")
+
+
+def _output_values(model: Model, traj, backend: str) -> dict:
+    """The output quantities at every sample of ``traj`` and the ledger's works, by name."""
+    from .engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
+    K = model.kernels
+    compiled = backend == "compiled"
+    kern = compiled_kernels(K) if compiled else python_kernels(K, model.cam if model.scene.motion == "user" else None)
+    values = outputs_on_samples(kern, compiled, traj.mode, traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT], model.p,
+                                len(K.OUTPUTS))
+    outputs = dict(zip(K.OUTPUTS, values))
+    if traj.y.shape[0] == LEDGER_ROWS:
+        for i, name in enumerate(LEDGER_OUTPUTS):
+            outputs[name] = traj.y[WORK + i].copy()
+    return outputs

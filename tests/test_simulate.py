@@ -233,3 +233,27 @@ def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
         share(0.5)  # before the bar first draws (after 0.05 s), which it then does every 0.5 s
         time.sleep(1.2)
     assert "50 % done" in capsys.readouterr().err
+
+
+def test_outputs_are_computed_when_first_read_and_equal_the_kernel_at_the_samples():
+    """Result.outputs is computed on first use (a run nobody reads the outputs of does not
+    compile the outputs kernel); the values are the outputs kernel at each sample, bitwise
+    (the same compiled kernel on the same samples), and a pickled Result carries them."""
+    import pickle
+
+    from camdyn.engine.kernels import compiled_kernels, outputs_on_samples
+    from camdyn.model import Model
+
+    r = camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=1100, t_end=0.02, sample_rate_Hz=5_000)
+    assert r.ok and r.switches  # impacting: several modes among the samples
+    assert "not computed yet" in repr(r.outputs) and "F_n" in r.outputs and len(r.outputs) > 5
+    model = Model(RIG, camdyn.Scene(), camdyn.cam.cam_motion(None, 1100))
+    mode = np.array([model.kernels.MODES.index(name) for name in r.regime])
+    expected = outputs_on_samples(compiled_kernels(model.kernels), True, mode, r.t, r.alpha, r.alpha_dot, model.p,
+                                  len(model.kernels.OUTPUTS))
+    for name, row in zip(model.kernels.OUTPUTS, expected):
+        np.testing.assert_array_equal(r.outputs[name], row)
+    assert "not computed yet" not in repr(r.outputs)
+    again = pickle.loads(pickle.dumps(r))
+    assert type(again.outputs) is dict and again.outputs.keys() == r.outputs.keys()
+    np.testing.assert_array_equal(again.F_n, r.F_n)

@@ -14,7 +14,7 @@ import numpy as np
 
 from camdyn.derive.vocabulary import OUTPUTS
 from camdyn.engine.config import Settings
-from camdyn.engine.kernels import FILL, RHS, SURFACE, no_reset
+from camdyn.engine.kernels import FILL, RHS, SURFACE, no_fill
 from camdyn.engine.problem import Kernels, Problem
 from camdyn.engine.tables import tables
 
@@ -92,7 +92,7 @@ def bounce_problem(p, compiled: bool, rate: bool = False) -> Problem:
     if compiled:
         if _compiled_bounce is None:
             _compiled_bounce = Kernels(numba.cfunc(RHS)(_toy_rhs), numba.cfunc(SURFACE)(_toy_surface),
-                                       numba.cfunc(FILL)(_no_outputs), no_reset)
+                                       numba.cfunc(FILL)(_no_outputs), no_fill)
         kern = _compiled_bounce
     else:
         kern = Kernels(_toy_rhs, _toy_surface, _no_outputs, None)

@@ -168,4 +168,4 @@ def loop_cached() -> bool:
     try:
         return bool(_run_compiled._cache._cache_file._load_index())
     except (AttributeError, OSError):  # numba's internals moved: any index of the loop
-        return any((cache_dir() / "numba").rglob("loop._run_compiled-*.nbi"))
+        return any((cache_dir() / "numba").rglob("loop.run-*.nbi"))

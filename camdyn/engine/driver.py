@@ -58,10 +58,10 @@ class Trajectory:
         return np.asarray(self.modes, dtype=object)[self.mode] if self.mode.size else np.empty(0, dtype=object)
 
 
-def _problem(model, backend: str) -> Problem:
+def _problem(model, backend: str, ledger: bool) -> Problem:
     K = model.kernels
     if backend == "compiled":
-        kern = compiled_kernels(K)
+        kern = compiled_kernels(K, outputs=ledger)
     elif backend == "python":
         kern = python_kernels(K, model.cam if model.scene.motion == "user" else None)
     else:
@@ -76,7 +76,7 @@ def integrate(model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
 
     ``mode``: the mode to start in (a Trajectory's ``end_mode``, to continue a run); by default
     the automaton's initial rule chooses it from the state."""
-    prob = _problem(model, backend)
+    prob = _problem(model, backend, options.ledger)
     method = arrays(TABLEAUS[options.method])
     cfg = settings(options, model.equilibrium.vartheta)
     t0, t_end = map(float, t_span)
@@ -96,7 +96,7 @@ def _notice_compile() -> None:
     """Say once, before it happens, that the loop is about to be compiled (a first run here)."""
     if loop_loaded() or cache.loop_cached():
         return
-    warnings.warn(f"camdyn compiles its integration loop on this first run (typically 10-20 s, once; later runs "
+    warnings.warn(f"camdyn compiles its integration loop on this first run (typically 5-15 s, once; later runs "
                   f"load it from {cache.cache_dir()}). Silence this with warnings.filterwarnings('ignore', "
                   "category=camdyn.CompileNotice).", CompileNotice, stacklevel=5)
 

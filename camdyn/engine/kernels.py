@@ -8,6 +8,7 @@ once for every scene, and each scene's kernels once, both cached (:mod:`.cache`)
 from __future__ import annotations
 
 import math
+import importlib
 from functools import lru_cache
 from types import ModuleType
 
@@ -15,7 +16,6 @@ import numba
 import numpy as np
 from numba import njit, types
 
-from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from ..errors import SceneError
 from . import cache
 from .problem import Kernels
@@ -35,14 +35,20 @@ def _no_surface(m, s, t, alpha, alpha_dot, p):
     return math.nan
 
 
-def _no_reset(j, t, alpha, alpha_dot, p, out):
-    """A scene whose transitions all keep the state (identity resets): never called."""
-    out[STATE_ALPHA] = math.nan
-    out[STATE_ALPHA_DOT] = math.nan
+def _no_fill(j, t, alpha, alpha_dot, p, out):
+    """A kernel of FILL's signature that a run never calls (a scene whose transitions all keep
+    the state, identity resets; the outputs of a compiled run without the energy ledger): NaN."""
+    for k in range(out.shape[0]):
+        out[k] = math.nan
 
 
-no_surface = numba.cfunc(SURFACE, cache=True)(_no_surface)
-no_reset = numba.cfunc(FILL, cache=True)(_no_reset)
+no_fill = numba.cfunc(FILL, cache=True)(_no_fill)
+
+
+@lru_cache(maxsize=None)
+def no_surface():
+    """The cfunc of :func:`_no_surface`, compiled only for a scene that needs it."""
+    return numba.cfunc(SURFACE, cache=True)(_no_surface)
 
 
 def _check_compilable(K: ModuleType) -> None:
@@ -53,17 +59,28 @@ def _check_compilable(K: ModuleType) -> None:
 
 @lru_cache(maxsize=None)
 def _compiled(module_name: str) -> Kernels:
-    import importlib
+    """rhs, surface and reset of a scene as cfuncs; outputs is :func:`_compiled_outputs`'s."""
     K = importlib.import_module(module_name)
-    surface = numba.cfunc(SURFACE, cache=True)(K.surface) if hasattr(K, "surface") else no_surface
-    reset = numba.cfunc(FILL, cache=True)(K.reset) if hasattr(K, "reset") else no_reset
-    return Kernels(numba.cfunc(RHS, cache=True)(K.rhs), surface, numba.cfunc(FILL, cache=True)(K.outputs), reset)
+    surface = numba.cfunc(SURFACE, cache=True)(K.surface) if hasattr(K, "surface") else no_surface()
+    reset = numba.cfunc(FILL, cache=True)(K.reset) if hasattr(K, "reset") else no_fill
+    return Kernels(numba.cfunc(RHS, cache=True)(K.rhs), surface, no_fill, reset)
 
 
-def compiled_kernels(K: ModuleType) -> Kernels:
-    """The cfuncs of a generated scene module (compiled on first use, then from the disk cache)."""
+@lru_cache(maxsize=None)
+def _compiled_outputs(module_name: str):
+    return numba.cfunc(FILL, cache=True)(importlib.import_module(module_name).outputs)
+
+
+def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
+    """The cfuncs of a generated scene module (compiled on first use, then from the disk cache).
+
+    ``outputs=False``: the ``outputs`` kernel is a placeholder that is never called, for a loop
+    that does not integrate the energy ledger (the only use of outputs inside the loop); the
+    scene's outputs, the largest of its kernels, are then compiled only when a result's output
+    quantities are read (:class:`camdyn.result.Outputs`), about a second of a cold start."""
     _check_compilable(K)
-    return _compiled(K.__name__)
+    kernels = _compiled(K.__name__)
+    return kernels._replace(outputs=_compiled_outputs(K.__name__)) if outputs else kernels
 
 
 @lru_cache(maxsize=None)
@@ -110,7 +127,7 @@ def python_kernels(K: ModuleType, cam=None) -> Kernels:
         outputs = lambda m, t, a, ad, p, out: K.outputs(m, t, a, ad, p, cam(t), out)  # noqa: E731
     else:
         rhs, surface, outputs = K.rhs, getattr(K, "surface", _no_surface), K.outputs
-    reset = getattr(K, "reset", _no_reset)
+    reset = getattr(K, "reset", _no_fill)
     return Kernels(_guarded(rhs), _guarded(surface), _guarded_fill(outputs), _guarded_fill(reset))
 
 

@@ -39,6 +39,11 @@ SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = range(
 #: one switch: when, which transition (row of Tables), the modes before and after, the state after
 SWITCH = np.dtype([("t", np.float64), ("transition", np.int64), ("before", np.int64), ("after", np.int64),
                    ("alpha", np.float64), ("alpha_dot", np.float64)])
+#: inside the loop the switches are a float array with one row per field of SWITCH, in its order,
+#: and one column per switch (integers held exactly as floats): a record array costs the cold
+#: start the typing of its fields, its own allocation and its boxing
+SW_T, SW_TRANSITION, SW_BEFORE, SW_AFTER, SW_ALPHA, SW_ALPHA_DOT = range(len(SWITCH.names))
+SW_ROWS = len(SWITCH.names)
 
 
 class Start(NamedTuple):
@@ -80,15 +85,24 @@ class Run(NamedTuple):
 
 @jitable
 def _record(sw, n, t, w, before, after, a, ad):
-    """Append a switch, doubling the buffer when full; returns the buffer."""
-    if n == sw.shape[0]:
-        bigger = np.empty(2 * n, dtype=SWITCH)
-        for k in range(n):  # element by element: a slice assignment compiles numba's shape-error
-            bigger[k] = sw[k]  # message formatting, seconds of the cold start
+    """Append a switch as column n of sw (rows SW_*), doubling the buffer when full; returns it."""
+    if n == sw.shape[1]:
+        bigger = np.empty((sw.shape[0], 2 * n))
+        for r in range(sw.shape[0]):  # element by element: a slice assignment compiles numba's
+            for k in range(n):        # shape-error message formatting, seconds of the cold start
+                bigger[r, k] = sw[r, k]
         sw = bigger
-    sw["t"][n], sw["transition"][n], sw["before"][n], sw["after"][n] = t, w, before, after
-    sw["alpha"][n], sw["alpha_dot"][n] = a, ad
+    sw[SW_T, n], sw[SW_TRANSITION, n], sw[SW_BEFORE, n], sw[SW_AFTER, n] = t, w, before, after
+    sw[SW_ALPHA, n], sw[SW_ALPHA_DOT, n] = a, ad
     return sw
+
+
+def _switch_records(sw: np.ndarray, n: int) -> np.ndarray:
+    """The loop's first n switches (columns of sw) as SWITCH records."""
+    out = np.empty(n, dtype=SWITCH)
+    for k, name in enumerate(SWITCH.names):
+        out[name] = sw[k, :n]
+    return out
 
 
 @jitable
@@ -129,23 +143,26 @@ ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
 
 
 @jitable
-def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K):
-    """The state at a crossing inside the step from (t, y): one step of the method to t_cross,
-    and whether it is ACROSS transition w's surface, NOT_YET (K[n] then holds f there, the next
-    step's first stage) or UNUSABLE (not finite).  K[0] must hold f(t, y)."""
+def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
+    """The state at a crossing inside the step [t, t + h] from (t, y): one step of the method to
+    t_cross, and whether it is ACROSS transition w's surface or NOT_YET (only when
+    ``may_retry``; K[n] then holds f there, the next step's first stage).  A state that is not
+    across (no retry left) or not finite is replaced by the interpolant's, across by
+    construction (verdict UNUSABLE).  K[0] must hold f(t, y)."""
     c0, c1 = step_impl(prob.kernels.rhs, prob.p, m, t, y0, y1, t_cross - t, method, K)
-    if not (math.isfinite(c0) and math.isfinite(c1)):
-        return c0, c1, UNUSABLE
-    g_ok = across(prob, m, w, t_cross, c0, c1)
-    return c0, c1, ACROSS if g_ok else NOT_YET
+    if math.isfinite(c0) and math.isfinite(c1):
+        if across(prob, m, w, t_cross, c0, c1):
+            return c0, c1, ACROSS
+        if may_retry:
+            return c0, c1, NOT_YET
+    c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
+    return c0, c1, UNUSABLE
 
 
 @jitable
-def run(prob, method, cfg, start, samples):
-    """Integrate the hybrid model from ``start`` (see the module docstring); a :class:`Run`."""
-    tab = prob.tables
-    rhs, p = prob.kernels.rhs, prob.p  # taken out once: a call passing prob pays a count per array it holds
-    n = method.n_stages
+def _buffers(method, tab):
+    """The loop's work arrays: the stages K, the interpolant Q, first_crossing's work, the
+    kernels' output buffer, the ledger's works (0) and its scratch, the switches (rows SW_*)."""
     K = np.empty((method.n_rows, 2))
     Q = np.empty((2, method.degree))
     work = scratch(tab.n_transitions, tab.n_surfaces)
@@ -153,8 +170,25 @@ def run(prob, method, cfg, start, samples):
     ledger_work, ledger_tmp = np.empty(N_FLOWS), np.empty(N_FLOWS)
     for k in range(N_FLOWS):  # not np.zeros: one overload less to compile on a cold start
         ledger_work[k] = 0.0
+    return K, Q, work, buf, ledger_work, ledger_tmp, np.empty((SW_ROWS, 16))
+
+
+@jitable
+def _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work):
+    """The ledger's works over [t, t_cross] of the step [t, t + h]."""
+    accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
+
+
+@jitable
+def run(prob, method, cfg, start, samples):
+    """Integrate the hybrid model from ``start`` (see the module docstring): the fields of a
+    :class:`Run` as a plain tuple, with the switch buffer (rows SW_*) and their count in
+    place of ``switches`` (:func:`_finish` makes the Run)."""
+    tab = prob.tables
+    rhs, p = prob.kernels.rhs, prob.p  # taken out once: a call passing prob pays a count per array it holds
+    n = method.n_stages
+    K, Q, work, buf, ledger_work, ledger_tmp, sw = _buffers(method, tab)
     ledger = samples.y.shape[0] > STATE_ROWS
-    sw = np.empty(16, dtype=SWITCH)
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
@@ -195,7 +229,7 @@ def run(prob, method, cfg, start, samples):
             if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
                 i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)
             if ledger:
-                accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
+                _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work)
             h_last = h
             if w >= 0:
                 if t_cross == t_new:
@@ -203,15 +237,14 @@ def run(prob, method, cfg, start, samples):
                 elif t_cross == t:
                     c0, c1 = y0, y1
                 else:
-                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K)
+                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K,
+                                                     retries < cfg.crossing_retries)
                     nfev += n
-                    if verdict == NOT_YET and retries < cfg.crossing_retries:  # on in this mode from there
+                    if verdict == NOT_YET:  # on in this mode from there
                         t, y0, y1, h_abs = t_cross, c0, c1, h
                         K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
                         have_start, retries = False, retries + 1
                         continue
-                    if verdict != ACROSS:  # the interpolant's state, across by construction
-                        c0, c1 = dense_eval(t_cross, t, h, y0, y1, Q)
                 retries = 0
                 m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
                 capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
@@ -220,7 +253,7 @@ def run(prob, method, cfg, start, samples):
                 t, y0, y1, m = t_cross, c0, c1, m_new
                 if n_sw >= cfg.max_events:
                     outcome = MAX_EVENTS
-                elif chattering(sw["t"], n_sw, cfg.chatter_window, cfg.chatter_switches):
+                elif chattering(sw[SW_T], n_sw, cfg.chatter_window, cfg.chatter_switches):
                     outcome = CHATTER
                 break
             t, y0, y1, h_abs = t_new, n0, n1, h_next
@@ -230,15 +263,19 @@ def run(prob, method, cfg, start, samples):
             if abs(y0) > cfg.angle_limit:
                 outcome = ANGLE_LIMIT
                 break
-    return Run(outcome, i_sample, sw[:n_sw].copy(), nfev, steps, rejected, m, t, y0, y1)
-
-
-@njit(cache=True, error_model="numpy")
-def _run_compiled(prob, method, cfg, start, samples):
-    r = run(prob, method, cfg, start, samples)
     # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
     # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
-    return (r.outcome, r.n_samples, r.switches, r.nfev, r.steps, r.rejected, r.mode, r.t, r.alpha, r.alpha_dot)
+    return outcome, i_sample, sw, n_sw, nfev, steps, rejected, m, t, y0, y1
+
+
+#: run's own body compiled as the entry point, not a function calling it: numba optimizes and
+#: generates the machine code of a function together with everything it calls, once per
+#: compiled function, so one level less is one pass less over the whole loop on a cold start.
+#: numba compiles a helper once per set of compile options of its callers, and the entry's
+#: differ from the helpers' (it has a Python wrapper): so run calls no helper that another
+#: helper also calls (allocations in _buffers, the ledger through _account, the interpolant's
+#: restart state in _restart_state), else that helper is compiled twice
+_run_compiled = njit(cache=True, error_model="numpy")(run)
 
 
 def loop_loaded() -> bool:
@@ -248,10 +285,16 @@ def loop_loaded() -> bool:
 
 def run_compiled(prob, method, cfg, start, samples) -> Run:
     """:func:`run`, compiled; the kernels of ``prob`` must be numba cfuncs."""
-    return Run(*_run_compiled(prob, method, cfg, start, samples))
+    return _finish(_run_compiled(prob, method, cfg, start, samples))
 
 
 def run_interpreted(prob, method, cfg, start, samples) -> Run:
     """:func:`run` in Python, with Python kernels."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return run(prob, method, cfg, start, samples)
+        return _finish(run(prob, method, cfg, start, samples))
+
+
+def _finish(raw: tuple) -> Run:
+    """The :class:`Run` of :func:`run`'s tuple (switches as SWITCH records)."""
+    outcome, n_samples, sw, n_sw, *rest = raw
+    return Run(outcome, n_samples, _switch_records(sw, n_sw), *rest)

@@ -268,8 +268,9 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     n_int = cfg.interior_points
     best_w, best_t = -1, math.inf
     found = 0
+    tb = t0  # sample i - 1's time, i >= 1 (h * 0 / (n_int + 1) = 0: the same value, one division less)
     for i in range(1 if have_start else 0, n_int + 2):  # sample 0: the start, when not known yet
-        ta = t0 + h * (i - 1) / (n_int + 1)
+        ta = tb
         last = i == n_int + 1
         tb = t1 if last else t0 + h * i / (n_int + 1)
         if tb >= best_t:

@@ -166,7 +166,7 @@ def _integrate(model: Model, m: int, t0: float, t1: float, y0, settings: Tangent
     """The augmented system from t0 to t1: (y, ok, message)."""
     if compiled:
         K = model.kernels
-        y, ok = integrate_segment(compiled_kernels(K).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
+        y, ok = integrate_segment(compiled_kernels(K, outputs=False).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
                                   settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
         return y, ok, "the step size fell below the spacing of t"
     sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)

@@ -85,7 +85,6 @@ def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
 
 @lru_cache(maxsize=None)
 def _compiled_jacobian(module_name: str):
-    import importlib
     return numba.cfunc(FILL, cache=True)(importlib.import_module(module_name).jacobian)
 
 

@@ -22,7 +22,7 @@ import time
 
 from camdyn.analysis import contact_loss_speed
 
-from .common import Context, StudyOutput, fmt, impact_run, md_table, parallel_map
+from .common import Context, StudyOutput, chaos_by_lyapunov, fmt, impact_run, md_table, parallel_map
 
 NAME, TITLE = "chaos-scan", "Chaos onsets: geometry scan"
 
@@ -55,11 +55,11 @@ def settings(fast: bool) -> dict:
     if fast:
         return dict(grid=dict(r_c=[0.025], chi0=[0.10], dx_ratio=[1.0, 0.5], theta0_offset=[0.0]),
                     stage1=(("D", 155.0), ("E", 150.0)), dense=[150.0, 155.0], stage2=1,
-                    revolutions=6, transient=3, max_revolutions=6)
+                    revolutions=6, transient=3, max_revolutions=6, batches=3)
     return dict(grid=dict(r_c=[0.025, 0.020, 0.015], chi0=[0.07, 0.10, 0.14, 0.20],
                           dx_ratio=[0.3, 0.4, 0.5, 0.6, 1.0], theta0_offset=[0.0, math.pi]),
                 stage1=STAGE1_RUNS, dense=[140.0, 143.0, 145.0, 148.0, 150.0, 152.0, 155.0, 157.0, 159.0, 162.0],
-                stage2=3, revolutions=200, transient=100, max_revolutions=500)
+                stage2=3, revolutions=200, transient=100, max_revolutions=500, batches=10)
 
 
 def geometries(grid: dict) -> list[dict]:
@@ -111,12 +111,16 @@ def _stage1(args) -> dict:
 def _stage2(args) -> dict:
     g, speeds, s = args
     res, exp = _fit(g)
-    out = {"geometry": g, **_fit_summary(res), "classes": {}}
+    out = {"geometry": g, **_fit_summary(res), "classes": {}, "lyapunov": {}}
     for d in MODELS:
         for sp in speeds:
             r = impact_run(exp, d, sp, s["revolutions"], s["transient"], max_revolutions=s["max_revolutions"])
             out["classes"][f"{d}{sp:g}"] = r["class"]
+            ly = chaos_by_lyapunov(exp, d, sp, s["transient"], s["revolutions"] - s["transient"], s["batches"])
+            out["lyapunov"][f"{d}{sp:g}"] = {k: ly[k] for k in ("chaos", "lyapunov", "lyapunov_se")}
     out["onsets"] = onsets(out["classes"], speeds)
+    out["onsets_lyapunov"] = {d: next((sp for sp in speeds if out["lyapunov"][f"{d}{sp:g}"]["chaos"] == "chaotic"),
+                                      None) for d in MODELS}
     out["verdict"] = verdict(out["classes"], speeds)
     return out
 
@@ -237,6 +241,9 @@ def _stage1_lines(st1: list[dict], runs: list[str]) -> list[str]:
     return lines
 
 
+_LY_SHORT = {"chaotic": "ch", "regular": "reg", "undecided": "?", "n/a": "n/a"}
+
+
 def _stage2_lines(st2: list[dict], speeds) -> list[str]:
     """The best geometries and the shipped one on the dense speed grid."""
     lines = []
@@ -250,6 +257,14 @@ def _stage2_lines(st2: list[dict], speeds) -> list[str]:
         rows = [[f"model {d}"] + [_short(r["classes"][f"{d}{sp:g}"]) for sp in speeds]
                 + [fmt(r["onsets"][d]) if r["onsets"][d] else "none"] for d in MODELS]
         lines.append(md_table(["Ω_c (rev/min)"] + [f"{v:g}" for v in speeds] + ["first aperiodic"], rows))
+        if r.get("lyapunov"):
+            lines.append("")
+            lines.append("The same runs judged by the largest Lyapunov exponent (as in fig4-5: *ch* chaotic, *reg* "
+                         "regular, *?* undecided at 3 standard errors, *n/a* no tangent dynamics):")
+            lines.append("")
+            ly_rows = [[f"model {d}"] + [_LY_SHORT.get(r["lyapunov"][f"{d}{sp:g}"]["chaos"], "?") for sp in speeds]
+                       + [fmt(r["onsets_lyapunov"][d]) if r["onsets_lyapunov"][d] else "none"] for d in MODELS]
+            lines.append(md_table(["Ω_c (rev/min)"] + [f"{v:g}" for v in speeds] + ["first chaotic (λ1)"], ly_rows))
         lines.append("")
         lines.append("Paper's statements on this grid: " + "; ".join(
             f"{k}: {'yes' if v else '**no**'}" for k, v in verdict(r["classes"], speeds).items()) + ".")

@@ -30,6 +30,14 @@ SURFACE = types.float64(types.int64, types.int64, types.float64, types.float64, 
 FILL = types.void(types.int64, types.float64, types.float64, types.float64, types.float64[::1], types.float64[::1])
 
 
+def _cfunc(signature, kernel):
+    """``kernel`` compiled as a cfunc of ``signature`` (cached on disk) with NumPy's error model:
+    a division by zero gives inf or nan, which the loop and the tangent dynamics test for, as in
+    the compiled loop itself; with Python's model it raises inside the cfunc, where numba prints
+    the exception and returns an unset value (seen: damping C's impact law at psi_i = 0)."""
+    return numba.cfunc(signature, cache=True, error_model="numpy")(kernel)
+
+
 def _no_surface(m, s, t, alpha, alpha_dot, p):
     """A scene without switching surfaces (the linear models)."""
     return math.nan
@@ -42,13 +50,13 @@ def _no_fill(j, t, alpha, alpha_dot, p, out):
         out[k] = math.nan
 
 
-no_fill = numba.cfunc(FILL, cache=True)(_no_fill)
+no_fill = _cfunc(FILL, _no_fill)
 
 
 @lru_cache(maxsize=None)
 def no_surface():
     """The cfunc of :func:`_no_surface`, compiled only for a scene that needs it."""
-    return numba.cfunc(SURFACE, cache=True)(_no_surface)
+    return _cfunc(SURFACE, _no_surface)
 
 
 def _check_compilable(K: ModuleType) -> None:
@@ -61,14 +69,14 @@ def _check_compilable(K: ModuleType) -> None:
 def _compiled(module_name: str) -> Kernels:
     """rhs, surface and reset of a scene as cfuncs; outputs is :func:`_compiled_outputs`'s."""
     K = importlib.import_module(module_name)
-    surface = numba.cfunc(SURFACE, cache=True)(K.surface) if hasattr(K, "surface") else no_surface()
-    reset = numba.cfunc(FILL, cache=True)(K.reset) if hasattr(K, "reset") else no_fill
-    return Kernels(numba.cfunc(RHS, cache=True)(K.rhs), surface, no_fill, reset)
+    surface = _cfunc(SURFACE, K.surface) if hasattr(K, "surface") else no_surface()
+    reset = _cfunc(FILL, K.reset) if hasattr(K, "reset") else no_fill
+    return Kernels(_cfunc(RHS, K.rhs), surface, no_fill, reset)
 
 
 @lru_cache(maxsize=None)
 def _compiled_outputs(module_name: str):
-    return numba.cfunc(FILL, cache=True)(importlib.import_module(module_name).outputs)
+    return _cfunc(FILL, importlib.import_module(module_name).outputs)
 
 
 def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
@@ -85,7 +93,7 @@ def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
 
 @lru_cache(maxsize=None)
 def _compiled_jacobian(module_name: str):
-    return numba.cfunc(FILL, cache=True)(importlib.import_module(module_name).jacobian)
+    return _cfunc(FILL, importlib.import_module(module_name).jacobian)
 
 
 def compiled_jacobian(K: ModuleType):

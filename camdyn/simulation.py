@@ -12,6 +12,7 @@ from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
+from . import stopping
 from .errors import ParameterError
 from .model import Model
 from .pieces import integrate_in_pieces
@@ -38,7 +39,8 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              y0=None, t_start: float = 0.0, method: str = "DOP853", rtol: float = 1e-8,
              atol: float = 1e-12, max_step: float = math.inf,
              events: EventSettings | None = None, energy_ledger: bool = False,
-             backend: str = "compiled", progress: Callable[[float], None] | None = None) -> Result:
+             backend: str = "compiled", progress: Callable[[float], None] | None = None,
+             stop=None) -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -57,7 +59,10 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     same loop in Python, for a :class:`~camdyn.cam.UserMotion` (its callables are Python).
     ``progress``, if given, is called with the share of the run done (0 to 1], after each
     piece of a long run (:mod:`camdyn.pieces`: every 200 cam periods) and at its end; it
-    does not change the run.
+    does not change the run.  ``stop``, a :class:`camdyn.StopWhenPeriodic`, ends the run once its
+    once-per-revolution section repeats (needs a whole number of samples per revolution) and
+    completes the Result to the requested length by repeating the converged cycle
+    (:mod:`camdyn.stopping`; ``result.stats["revolutions_run"]``, ``["stop_period"]``).
     """
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")
@@ -73,8 +78,29 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     options = solver_options(method, rtol, atol, max_step, events, energy_ledger)
     run = functools.partial(integrate, backend=backend)
-    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress)
-    return _result(model, traj, backend)
+    watch = _watch(stop, sample_rate_Hz, model.period)
+    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress, watch)
+    result = _result(model, traj, backend)
+    if watch is None:
+        return result
+    result.stats["revolutions_run"] = round((result.t[-1] - t_start) / model.period, 6) if result.t.size else 0.0
+    result.stats["stop_period"] = watch.period if traj.stats.get("stopped") else 0
+    if traj.stats.get("stopped"):
+        # the samples the full run would have: the engine gives none past t_end (one rounded beyond it)
+        t_eval = t_eval[t_eval <= t_start + duration]
+        return stopping.extend(result, t_eval, watch.period, watch.per_revolution)
+    return result
+
+
+def _watch(stop, sample_rate_Hz, period: float):
+    """The stopping check of one run (None without ``stop``)."""
+    if stop is None:
+        return None
+    if not isinstance(stop, stopping.StopWhenPeriodic):
+        raise ParameterError("stop", stop, "None or a camdyn.StopWhenPeriodic")
+    if not math.isfinite(period):
+        raise ParameterError("stop", stop, "None for a cam without a period")
+    return stopping.Watch(stop, stopping.per_revolution(sample_rate_Hz, period))
 
 
 # --- simulate's checks, also run on every point of a sweep before any work (camdyn.sweep_check) ---

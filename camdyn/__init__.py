@@ -44,6 +44,10 @@ _EXPORTS = {
     "OrbitOutcome": "camdyn.orbits",
     "StroboscopicMap": "camdyn.section_map",
     "zero_one_test": "camdyn.chaos01",
+    "StopWhenPeriodic": "camdyn.stopping",
+    "quasi_static_orbit": "camdyn.quasistatic",
+    "QuasiStaticOrbit": "camdyn.quasistatic",
+    "QuasiStaticOutcome": "camdyn.quasistatic",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

@@ -88,7 +88,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     if traj.stats.get("stopped"):
         # the samples the full run would have: the engine gives none past t_end (one rounded beyond it)
         t_eval = t_eval[t_eval <= t_start + duration]
-        return stopping.extend(result, t_eval, watch.period, watch.per_revolution)
+        return stopping.extend(result, t_eval, watch.period, watch.per_revolution, t_start + duration)
     return result
 
 

@@ -110,9 +110,10 @@ def per_revolution(sample_rate_Hz: float, period: float) -> int:
     return int(round(n))
 
 
-def extend(result, t_eval: np.ndarray, period: int, per_rev: int):
+def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
     """``result`` (a run stopped after a cycle of ``period`` revolutions) completed to the
-    samples ``t_eval`` by repeating its last cycle (see the module doc)."""
+    samples ``t_eval`` and the switches up to ``t_end`` by repeating its last cycle (see the
+    module doc)."""
     run, total, L = result.t.size, t_eval.size, period * per_rev
     if total <= run:
         return result
@@ -127,8 +128,9 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int):
     cycle, end = result.t[run - 1] - result.t[run - 1 - L], result.t[run - 1]
     kept = [s for s in result.switches if s.t <= end]    # the run's last piece may go on past its last sample
     last = [s for s in kept if s.t > end - cycle]
-    more = [dataclasses.replace(s, t=s.t + m * cycle) for m in range(1, int(shifts.max()) + 1) for s in last]
-    more = [s for s in more if s.t <= t_eval[-1]]
+    cycles = int(math.ceil((t_end - end) / cycle))
+    more = [dataclasses.replace(s, t=s.t + m * cycle) for m in range(1, cycles + 1) for s in last]
+    more = [s for s in more if s.t <= t_end]
     outputs = {k: grown(v, k in ACCUMULATED) for k, v in result.outputs.items()}
     return dataclasses.replace(result, t=t_eval.copy(), alpha=grown(result.alpha), alpha_dot=grown(result.alpha_dot),
                                Theta=grown(result.Theta, True), regime=grown(result.regime), outputs=outputs,

@@ -46,7 +46,7 @@ class QuasiStaticOutcome(enum.Enum):
 
     SUCCESS = "the quasi-static contact orbit holds at every time asked (F_n > 0 throughout)"
     TENSILE = ("the contact force F_n would turn tensile (<= 0): the follower leaves the cam there and the "
-               "quasi-static orbit does not exist; use the full model (camdyn.simulate)")
+               "quasi-static orbit does not exist; use the full model (follower='dynamic')")
     NEWTON_FAILED = ("Newton's method found no contact deformation that carries the inertia (no convergence): "
                      "the contact is too soft or the speed too high for a quasi-static contact; use the full model")
 
@@ -138,10 +138,11 @@ def quasi_static_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, 
     t = np.atleast_1d(np.asarray(t, dtype=float))
     if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
         raise ParameterError("t", t, "a non-empty 1-D array of finite times (s)")
-    return _orbit(model, t)
+    return orbit_at(model, t)
 
 
-def _orbit(model: Model, t: np.ndarray) -> QuasiStaticOrbit:
+def orbit_at(model: Model, t: np.ndarray) -> QuasiStaticOrbit:
+    """The quasi-static orbit of a model at the times ``t`` (checked by the caller)."""
     K = model.kernels
     rows, modes = [], []
     outcome, where = QuasiStaticOutcome.SUCCESS, math.nan
@@ -186,10 +187,14 @@ def warm_start(model: Model, phase: float):
     from .section_map import MapFailure
 
     T = model.period
-    orbit = _orbit(model, phase + T * np.arange(64) / 64)
+    orbit = orbit_at(model, phase + T * np.arange(64) / 64)
     if not orbit.ok:
         raise MapFailure(f"no quasi-static warm start: {orbit.message}")
     x0, mode = section_state(model, phase)
     scale = np.array([np.max(np.abs(orbit.alpha - model.equilibrium.alpha)), np.max(np.abs(orbit.alpha_dot))])
     tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])   # a motion at rest: rad, rad/s
     return x0, mode, np.maximum(scale, tiny)
+
+
+__all__ = ["quasi_static_orbit", "QuasiStaticOrbit", "QuasiStaticOutcome", "orbit_at", "solve_at",
+           "rigid_kinematics", "contact_mode", "section_state", "warm_start"]

@@ -10,11 +10,12 @@ import numpy as np
 from .cam import CamMotion, cam_motion
 from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
-from .engine.driver import BACKENDS, integrate
+from .engine.driver import BACKENDS, Trajectory, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
-from . import stopping
+from . import quasistatic, stopping
 from .errors import ParameterError
 from .model import Model
+from .outcome import Outcome
 from .pieces import integrate_in_pieces
 from .result import Result
 from .rig import Rig
@@ -75,8 +76,10 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     duration = run_duration(cam, model.equilibrium.vartheta, t_end, revolutions)
     check_start(t_start, y0)
     t_eval = t_start + np.arange(sample_count(duration, sample_rate_Hz)) / float(sample_rate_Hz)
-    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     options = solver_options(method, rtol, atol, max_step, events, energy_ledger)
+    if scene.follower == "quasistatic":
+        return _quasi_static(model, t_eval, backend, y0=y0, energy_ledger=energy_ledger, stop=stop)
+    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     run = functools.partial(integrate, backend=backend)
     watch = _watch(stop, sample_rate_Hz, model.period)
     traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress, watch)
@@ -90,6 +93,26 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
         t_eval = t_eval[t_eval <= t_start + duration]
         return stopping.extend(result, t_eval, watch.period, watch.per_revolution, t_start + duration)
     return result
+
+
+def _quasi_static(model: Model, t_eval: np.ndarray, backend: str, **refused) -> Result:
+    """The scene option follower="quasistatic": the quasi-static contact orbit at the samples
+    (:mod:`camdyn.quasistatic`, no integration), its outputs from the generated kernel; the
+    samples end before a time where it does not exist (the outcome says why, stats["where"] where)."""
+    for name, value in refused.items():
+        if value is not None and value is not False:
+            raise ParameterError(name, value, "not given with follower='quasistatic' (no integration: the orbit "
+                                 "has no start, ledger or stop)")
+    orbit = quasistatic.orbit_at(model, t_eval)
+    K = model.kernels
+    mode = np.array([K.MODES.index(m) for m in orbit.mode], dtype=np.int64)
+    outcome = {"SUCCESS": Outcome.SUCCESS, "TENSILE": Outcome.CONTACT_TENSILE,
+               "NEWTON_FAILED": Outcome.NO_QUASI_STATIC}[orbit.outcome.name]
+    stats = {"nfev": 0, "steps": 0, "rejected_steps": 0, "njev": 0, "switches": 0, "backend": backend,
+             "follower": "quasistatic", "where": "" if orbit.ok else orbit.message}
+    traj = Trajectory(orbit.t, np.vstack([orbit.alpha, orbit.alpha_dot]), mode, tuple(K.MODES), [], outcome,
+                      stats, int(mode[-1]) if mode.size else 0)
+    return _result(model, traj, backend)
 
 
 def _watch(stop, sample_rate_Hz, period: float):

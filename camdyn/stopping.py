@@ -135,3 +135,6 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
     return dataclasses.replace(result, t=t_eval.copy(), alpha=grown(result.alpha), alpha_dot=grown(result.alpha_dot),
                                Theta=grown(result.Theta, True), regime=grown(result.regime), outputs=outputs,
                                switches=kept + more)
+
+
+__all__ = ["StopWhenPeriodic", "Watch", "per_revolution", "extend"]

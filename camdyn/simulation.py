@@ -81,7 +81,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
         return _quasi_static(model, t_eval, backend, y0=y0, energy_ledger=energy_ledger, stop=stop)
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     run = functools.partial(integrate, backend=backend)
-    watch = _watch(stop, sample_rate_Hz, model.period)
+    watch = _watch(stop, sample_rate_Hz, model.period, options)
     traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress, watch)
     result = _result(model, traj, backend)
     if watch is None:
@@ -115,7 +115,7 @@ def _quasi_static(model: Model, t_eval: np.ndarray, backend: str, **refused) -> 
     return _result(model, traj, backend)
 
 
-def _watch(stop, sample_rate_Hz, period: float):
+def _watch(stop, sample_rate_Hz, period: float, options: SolverOptions):
     """The stopping check of one run (None without ``stop``)."""
     if stop is None:
         return None
@@ -123,7 +123,7 @@ def _watch(stop, sample_rate_Hz, period: float):
         raise ParameterError("stop", stop, "None or a camdyn.StopWhenPeriodic")
     if not math.isfinite(period):
         raise ParameterError("stop", stop, "None for a cam without a period")
-    return stopping.Watch(stop, stopping.per_revolution(sample_rate_Hz, period))
+    return stopping.Watch(stop, stopping.per_revolution(sample_rate_Hz, period), options.rtol, options.atol)
 
 
 # --- simulate's checks, also run on every point of a sweep before any work (camdyn.sweep_check) ---

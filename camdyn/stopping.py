@@ -5,13 +5,17 @@ on by default in :func:`camdyn.sweep.bifurcation`) is integrated in pieces of
 ``check_every`` revolutions (:func:`camdyn.pieces.integrate_in_pieces`); after each piece the
 once-per-revolution section (the samples at t = t_start + j T) is checked, and the run stops
 when its last ``revolutions`` section values repeat with a period p <= ``max_period``
-revolutions: |alpha_j - alpha_{j-p}| <= tol * max |alpha| and the same mode, for each of them.
+revolutions: |alpha_j - alpha_{j-p}| <= tol (rtol max |alpha| + atol), rtol and atol the run's
+own, and the same mode, for each of them.
 The Result is then completed to the requested length by repeating its last p revolutions
 (samples, outputs, regimes and switches shifted by whole multiples of p T; the cam angle and the
 energy ledger's works grow by their increment over the cycle), so that every measure sees a
 full-length run.  ``result.stats`` says what happened: ``revolutions_run`` (integrated) and
 ``stop_period`` (p, 0 where the run did not converge and ran to its end).  A run that has not
-converged is never stopped.
+converged is never stopped.  It ran in pieces of ``check_every`` revolutions, each restarting
+the step size: its values differ from a run in one piece at the level of the solver's error,
+and at a chaotic speed, after that difference has grown, by as much as the attractor's size
+(as a change of rtol would make them).
 """
 from __future__ import annotations
 
@@ -32,23 +36,26 @@ ACCUMULATED = ("work_in", "dissipated_contact", "dissipated_friction")
 @dataclass(frozen=True)
 class StopWhenPeriodic:
     """Stop a run once its section repeats with period <= ``max_period`` revolutions over its last
-    ``revolutions`` revolutions, to ``tol`` relative to the size of alpha (max |alpha| over
-    those section values); checked every ``check_every`` revolutions (an even number: a piece of
-    the run is a whole number of the kernels' period 2 T, :mod:`camdyn.pieces`).
+    ``revolutions`` revolutions, to ``tol`` times the solver's tolerance at the section,
+    rtol max |alpha| + atol (the run's rtol and atol; max |alpha| over those section values);
+    checked every ``check_every`` revolutions (an even number: a piece of the run is a whole
+    number of the kernels' period 2 T, :mod:`camdyn.pieces`).
 
-    Why ``tol`` = 1e-5 relative by default: the solver holds each step's error to
-    rtol |alpha| + atol, and a converged run's section still scatters at that level from revolution
-    to revolution (measured on ``example_rig(l_lambda=0.016)``, damping D, Coulomb, rtol 1e-7,
-    atol 1e-11: 1e-7 |alpha| when impacting, 1.5e-6 |alpha| in permanent contact, where atol
-    dominates the 1.4e-7 rad motion); a tolerance below that scatter would never stop, one far
-    above it would stop transients.  A stopped run's section values differ from the full run's
-    by at most about tol max|alpha| / (1 - |mu|) (mu the orbit's largest Floquet multiplier per
-    period: the transient still left) plus the full run's own scatter.  ``revolutions`` >=
-    2 ``max_period`` makes every value of a cycle repeat at least twice before the run stops.
+    Why a multiple of the solver's tolerance, and why 10: a converged run's section still
+    scatters from revolution to revolution, and two runs with other steps differ, at the level
+    of the solver's error (measured on ``example_rig(l_lambda=0.016)``, damping D, Coulomb, rtol
+    1e-7, atol 1e-11: up to 7e-9 rad = 1.2 rtol |alpha| when impacting, up to 3.4e-12 rad = 0.34
+    atol in permanent contact, where alpha at the section is 1e-8 rad and atol dominates); below
+    that scatter the check would never hold, and a size of the motion alone cannot say where
+    that is (relative to |alpha| at the section, the permanent-contact scatter is 1e-4).  A
+    stopped run's section values differ from the full run's by at most about
+    tol (rtol |alpha| + atol) / (1 - |mu|) (mu the orbit's largest Floquet multiplier per period:
+    the transient still left) plus the full run's own scatter.  ``revolutions`` >= 2
+    ``max_period`` makes every value of a cycle repeat at least twice before the run stops.
     """
 
     max_period: int = 8
-    tol: float = 1e-5
+    tol: float = 10.0
     revolutions: int = 16
     check_every: int = 4
 
@@ -63,18 +70,23 @@ class StopWhenPeriodic:
         r = self.revolutions
         if isinstance(r, bool) or not isinstance(r, (int, np.integer)) or r < 2 * self.max_period:
             raise ParameterError("revolutions", r, f"an integer >= 2 max_period ({2 * self.max_period})")
-        if isinstance(self.tol, bool) or not isinstance(self.tol, (int, float)) or not 0 < self.tol < 1:
-            raise ParameterError("tol", self.tol, "0 < tol < 1 (relative to max |alpha| at the section)")
+        if isinstance(self.tol, bool) or not isinstance(self.tol, (int, float)) or not 1 <= self.tol <= 1e6:
+            raise ParameterError("tol", self.tol, "1 <= tol <= 1e6 (times the solver's tolerance rtol |alpha| + atol: "
+                                 "below 1 the check would ask for more than the solver gives)")
 
-    def period_of(self, section: np.ndarray, modes: np.ndarray) -> int:
+    def threshold(self, section: np.ndarray, rtol: float, atol: float) -> float:
+        """The largest difference (rad) of two section values that count as equal."""
+        return self.tol * (rtol * float(np.max(np.abs(section))) + atol)
+
+    def period_of(self, section: np.ndarray, modes: np.ndarray, rtol: float, atol: float) -> int:
         """The smallest p <= max_period with which the last ``revolutions`` section values repeat
-        (alpha to tol * max |alpha|, the mode exactly); 0 when none does."""
+        (alpha to :meth:`threshold`, the mode exactly); 0 when none does."""
         k = self.revolutions
         for p in range(1, self.max_period + 1):
             if section.size < k + p:
                 return 0
             a, m = section[-k - p:], modes[-k - p:]
-            limit = self.tol * np.max(np.abs(a))
+            limit = self.threshold(a, rtol, atol)
             if np.all(np.abs(a[p:] - a[:-p]) <= limit) and np.all(m[p:] == m[:-p]):
                 return p
         return 0
@@ -82,10 +94,11 @@ class StopWhenPeriodic:
 
 class Watch:
     """One run's check (stateful): told each piece of the run in absolute time, it keeps the
-    section samples (every ``per_revolution``-th sample from the first) and says when to stop."""
+    section samples (every ``per_revolution``-th sample from the first) and says when to stop
+    (with the run's ``rtol`` and ``atol``)."""
 
-    def __init__(self, stop: StopWhenPeriodic, per_revolution: int):
-        self.stop, self.per_revolution = stop, per_revolution
+    def __init__(self, stop: StopWhenPeriodic, per_revolution: int, rtol: float, atol: float):
+        self.stop, self.per_revolution, self.rtol, self.atol = stop, per_revolution, rtol, atol
         self.piece_revolutions = stop.check_every
         self.alpha: list[float] = []
         self.modes: list[int] = []
@@ -97,7 +110,7 @@ class Watch:
         self.alpha.extend(piece.y[ALPHA, first::self.per_revolution].tolist())
         self.modes.extend(piece.mode[first::self.per_revolution].tolist())
         self.seen += piece.t.size
-        self.period = self.stop.period_of(np.asarray(self.alpha), np.asarray(self.modes))
+        self.period = self.stop.period_of(np.asarray(self.alpha), np.asarray(self.modes), self.rtol, self.atol)
         return self.period > 0
 
 

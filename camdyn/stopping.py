@@ -5,7 +5,7 @@ on by default in :func:`camdyn.sweep.bifurcation`) is integrated in pieces of
 ``check_every`` revolutions (:func:`camdyn.pieces.integrate_in_pieces`); after each piece the
 once-per-revolution section (the samples at t = t_start + j T) is checked, and the run stops
 when its last ``revolutions`` section values repeat with a period p <= ``max_period``
-revolutions: |alpha_j - alpha_{j-p}| <= tol (rtol max |alpha| + atol), rtol and atol the run's
+revolutions: ``abs(alpha_j - alpha_{j-p}) <= tol (rtol max abs(alpha) + atol)``, rtol and atol the run's
 own, and the same mode, for each of them.
 The Result is then completed to the requested length by repeating its last p revolutions
 (samples, outputs, regimes and switches shifted by whole multiples of p T; the cam angle and the
@@ -37,19 +37,19 @@ ACCUMULATED = ("work_in", "dissipated_contact", "dissipated_friction")
 class StopWhenPeriodic:
     """Stop a run once its section repeats with period <= ``max_period`` revolutions over its last
     ``revolutions`` revolutions, to ``tol`` times the solver's tolerance at the section,
-    rtol max |alpha| + atol (the run's rtol and atol; max |alpha| over those section values);
+    ``rtol max abs(alpha) + atol`` (the run's rtol and atol; alpha over those section values);
     checked every ``check_every`` revolutions (an even number: a piece of the run is a whole
     number of the kernels' period 2 T, :mod:`camdyn.pieces`).
 
     Why a multiple of the solver's tolerance, and why 10: a converged run's section still
     scatters from revolution to revolution, and two runs with other steps differ, at the level
     of the solver's error (measured on ``example_rig(l_lambda=0.016)``, damping D, Coulomb, rtol
-    1e-7, atol 1e-11: up to 7e-9 rad = 1.2 rtol |alpha| when impacting, up to 3.4e-12 rad = 0.34
+    1e-7, atol 1e-11: up to 7e-9 rad = 1.2 rtol abs(alpha) when impacting, up to 3.4e-12 rad = 0.34
     atol in permanent contact, where alpha at the section is 1e-8 rad and atol dominates); below
     that scatter the check would never hold, and a size of the motion alone cannot say where
-    that is (relative to |alpha| at the section, the permanent-contact scatter is 1e-4).  A
+    that is (relative to abs(alpha) at the section, the permanent-contact scatter is 1e-4).  A
     stopped run's section values differ from the full run's by at most about
-    tol (rtol |alpha| + atol) / (1 - |mu|) (mu the orbit's largest Floquet multiplier per period:
+    ``tol (rtol abs(alpha) + atol) / (1 - abs(mu))`` (mu the orbit's largest Floquet multiplier per period:
     the transient still left) plus the full run's own scatter.  ``revolutions`` >= 2
     ``max_period`` makes every value of a cycle repeat at least twice before the run stops.
     """
@@ -71,7 +71,7 @@ class StopWhenPeriodic:
         if isinstance(r, bool) or not isinstance(r, (int, np.integer)) or r < 2 * self.max_period:
             raise ParameterError("revolutions", r, f"an integer >= 2 max_period ({2 * self.max_period})")
         if isinstance(self.tol, bool) or not isinstance(self.tol, (int, float)) or not 1 <= self.tol <= 1e6:
-            raise ParameterError("tol", self.tol, "1 <= tol <= 1e6 (times the solver's tolerance rtol |alpha| + atol: "
+            raise ParameterError("tol", self.tol, "1 <= tol <= 1e6 (times the solver's tolerance rtol abs(alpha) + atol: "
                                  "below 1 the check would ask for more than the solver gives)")
 
     def threshold(self, section: np.ndarray, rtol: float, atol: float) -> float:

@@ -14,8 +14,10 @@ scene's viscous one after maximum compression (damping D, E: a follower that sta
 has passed t_b of Eqs. 27-28) with the friction direction of the rigid sliding velocity.
 
 It is exact for the orbit only to the extent that the deformation's own rates are negligible
-against the rigid ones: the error against the full model's converged run is stated in
-docs/guide.md and checked in tests/test_quasistatic.py.  Where F_n would turn tensile (<= 0)
+against the rigid ones.  Against the full model's converged run (``example_rig()`` with a 16 mm
+line contact, damping D, Coulomb, 0.85 x the contact-loss speed, rtol 1e-10): 5.0e-13 rad at the
+section, at most 3.2e-12 rad over a period, 2e-5 of the residual response max abs(alpha - alpha_i)
+(the README; checked in tests/test_stopping.py).  Where F_n would turn tensile (<= 0)
 the follower would leave the cam and the quasi-static orbit does not exist: the outcome says
 where, and the full model must be used.
 """

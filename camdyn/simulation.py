@@ -64,6 +64,9 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     once-per-revolution section repeats (needs a whole number of samples per revolution) and
     completes the Result to the requested length by repeating the converged cycle
     (:mod:`camdyn.stopping`; ``result.stats["revolutions_run"]``, ``["stop_period"]``).
+    A scene with ``follower="quasistatic"`` is not integrated: the Result holds the quasi-static
+    contact orbit at the samples (:mod:`camdyn.quasistatic`; alpha_dot the rigid rate), up to
+    where it does not exist (``Outcome.CONTACT_TENSILE``, ``result.stats["where"]``).
     """
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")

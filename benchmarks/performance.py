@@ -18,7 +18,8 @@ C B A, ...) so that a busy spell of the machine falls on all of them alike.
   automaton without event location (a mode register in the RHS, moved on whenever the state is
   across one of the mode's surfaces; see :func:`peer_field`).
 * Start-up: cold (empty numba cache) and warm, each in fresh processes.
-* Sweeps (optional): the bifurcation diagram and contact-loss map timed with camdyn.sweep.
+* Sweeps (optional): the bifurcation diagram and contact-loss map timed with camdyn.sweep; the
+  diagram stopping once periodic and shooting from the quasi-static warm start (sweep_stop.py).
 """
 from __future__ import annotations
 
@@ -43,6 +44,7 @@ from numba.extending import register_jitable
 
 import camdyn
 import floor
+import sweep_stop
 from camdyn.engine import rules, stepper
 from camdyn.engine.config import SolverOptions
 from camdyn.engine.driver import integrate
@@ -564,14 +566,15 @@ def _bifurcation_parts(rig, scene, grid, loss, revolutions) -> tuple[list, dict]
         with ProcessPoolExecutor(2) as pool:
             parts.append(S.bifurcation(rig, scene, part, revolutions=revolutions,
                                        transient_revolutions=revolutions // 2, executor=pool, progress=False,
-                                       rtol=SWEEP_RTOL, atol=SWEEP_RTOL * ATOL_PER_RTOL))
+                                       rtol=SWEEP_RTOL, atol=SWEEP_RTOL * ATOL_PER_RTOL, stop=None))
         seconds[name] = (part.size, time.perf_counter() - t0, float(np.sum(revolutions * 60.0 / part)))
     return parts, seconds
 
 
 def sweep_timing(cfg: Config) -> dict:
     """The bifurcation sweep timed in two parts, below the contact-loss speed (permanent contact)
-    and above it (impacting); the contact-loss map; the tolerance study of one point."""
+    and above it (impacting), every point to the end (stop=None); the contact-loss map; the
+    tolerance study of one point; the same diagram stopping once periodic (benchmarks/sweep_stop.py)."""
     import xarray as xr
     from camdyn import analysis
     from camdyn import sweep as S
@@ -587,7 +590,7 @@ def sweep_timing(cfg: Config) -> dict:
     return {"bif": xr.concat(parts, dim="speed_rpm"), "seconds": sum(v[1] for v in seconds.values()),
             "parts": seconds, "cmap": cmap, "map_seconds": time.perf_counter() - t0, "loss": loss,
             "frequency_Hz": analysis.natural_frequency(rig, scene, camdyn.ConstantSpeed(loss)).Hz,
-            "tolerance": permanent_contact_tolerance(cfg.revolutions)}
+            "tolerance": permanent_contact_tolerance(cfg.revolutions), "stopping": sweep_stop.measure(cfg.quick)}
 
 
 # --- the report ----------------------------------------------------------------------------------------
@@ -832,7 +835,8 @@ def sweep_lines(sw: dict | None, cfg: Config) -> list[str]:
               "| rtol | wall time (s) | steps | switches | section error (rad) |", "|---|---|---|---|---|"]
     lines += [f"| {r:.0e} | {s:.2f} | {n} | {k} | {e:.1e} |" for r, s, n, k, e in tol["rows"]]
     return lines + ["", f"Contact-loss map: 9 k_s x 17 speeds x 6 revolutions: {sw['map_seconds']:.1f} s.", "",
-                    "![bifurcation](img/perf_bifurcation.png)", "", "![contact loss](img/perf_contact_loss.png)", ""]
+                    "![bifurcation](img/perf_bifurcation.png)", "", "![contact loss](img/perf_contact_loss.png)", ""] + \
+        ["#" + line if line.startswith("## ") else line for line in sweep_stop.lines(sw["stopping"])]
 
 
 def write_report(parts: dict, cfg: Config) -> str:

@@ -47,6 +47,10 @@ _EXPORTS = {
     "LyapunovExponents": "camdyn.lyapunov",
     "LyapunovSettings": "camdyn.lyapunov",
     "zero_one_test": "camdyn.chaos01",
+    "StopWhenPeriodic": "camdyn.stopping",
+    "quasi_static_orbit": "camdyn.quasistatic",
+    "QuasiStaticOrbit": "camdyn.quasistatic",
+    "QuasiStaticOutcome": "camdyn.quasistatic",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

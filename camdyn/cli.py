@@ -169,7 +169,8 @@ def _scene(args, motion: str = "constant"):
                  motion=motion, model=getattr(args, "model", "nonlinear"),
                  sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
                  damping_sign=getattr(args, "damping_sign", "dissipative"),
-                 damping_switch=getattr(args, "damping_switch", "episode"))
+                 damping_switch=getattr(args, "damping_switch", "episode"),
+                 follower=getattr(args, "follower", "dynamic"))
 
 
 # --- solvers: the one place the command learns the engine's backend and method names -----------
@@ -619,8 +620,9 @@ def _new_sweep(sweeps, args, rig, scene, speeds, values, common):
         revolutions, transient = args.revolutions, args.transient_revolutions
         if revolutions != int(revolutions) or transient != int(transient):
             raise UsageError("a bifurcation sweep needs whole --revolutions and --transient-revolutions")
+        stop = None if args.no_stop else sweeps.StopWhenPeriodic()
         return sweeps.bifurcation(rig, scene, speeds, revolutions=int(revolutions),
-                                  transient_revolutions=int(transient), **common)
+                                  transient_revolutions=int(transient), stop=stop, **common)
     if param == "k_s":
         return sweeps.contact_loss_map(rig, scene, values, speeds, revolutions=args.revolutions,
                                        transient_revolutions=args.transient_revolutions,
@@ -978,6 +980,9 @@ def _add_physics(p, contact: bool = True, full: bool = True):
         g.add_argument("--damping-switch", default="episode", choices=opts["damping_switch"], dest="damping_switch",
                        help="D/E: the impact law once per contact, until maximum compression (episode, Sec. 3.4), "
                             "or whenever the gap closes (memoryless) (default: episode)")
+        g.add_argument("--follower", default="dynamic", choices=opts["follower"],
+                       help="the hybrid model (dynamic), or the quasi-static contact orbit with no integration "
+                            "(quasistatic: a follower that never leaves the cam) (default: dynamic)")
 
 
 def _add_cam(p, required_speed: bool = False):
@@ -1139,6 +1144,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="revolutions dropped before the statistics and the section (default: 20)")
     g.add_argument("--samples-per-revolution", type=int, default=64, dest="samples_per_revolution", metavar="N",
                    help="output samples per revolution for the maps (default: 64; the bifurcation uses 1)")
+    g.add_argument("--no-stop", action="store_true", dest="no_stop",
+                   help="bifurcation: run every point to the end (by default a run stops once its section "
+                        "repeats: camdyn.StopWhenPeriodic)")
     g.add_argument("--jobs", type=int, default=1, help="local worker processes (default: 1)")
     g.add_argument("--dask", metavar="ADDRESS", help="run on this dask scheduler (tcp://host:port)")
     _add_solver(g)

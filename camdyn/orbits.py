@@ -26,6 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import quasistatic
 from .cam import CamMotion, cam_motion
 from .engine.config import SolverOptions
 from .engine.driver import integrate
@@ -223,7 +224,7 @@ def newton(section_map: StroboscopicMap, jacobian, x0, scale,
 def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, speed_rpm: float | None = None,
                    periods: int = 1, phase: float = 0.0, warmup_revolutions: int = 20, y0=None,
                    settings: ShootingSettings = ShootingSettings(), options: SolverOptions = DEFAULT_OPTIONS,
-                   jacobian=finite_differences, backend: str = "compiled") -> PeriodicOrbit:
+                   jacobian=finite_differences, backend: str = "compiled", start: str = "run") -> PeriodicOrbit:
     """A periodic orbit of period ``periods`` cam periods, by Newton shooting on P_n.
 
     The warm start is the state and mode at the section time ``phase + warmup_revolutions T``
@@ -233,15 +234,22 @@ def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, spee
     for the tangent dynamics).  ``settings`` holds
     Newton's tolerance and iteration limit, ``options`` the solver's (default rtol 1e-10,
     atol 1e-13).  The result says how the search ended (:class:`OrbitOutcome`); it raises
-    only on bad input.
+    only on bad input.  ``start="quasistatic"`` warms up with no run: the quasi-static contact
+    orbit's state at the section (:mod:`camdyn.quasistatic`), for an orbit in permanent contact
+    (RUN_FAILED, saying where, when the contact force would turn tensile).
     """
     cam = cam_motion(cam, speed_rpm)
     if not isinstance(settings, ShootingSettings):
         raise ParameterError("settings", settings, "a camdyn.orbits.ShootingSettings")
     model = Model(rig, scene, cam)
     StroboscopicMap(model, periods, phase, None, options, backend)       # checks periods, phase, options
+    if start not in ("run", "quasistatic"):
+        raise ParameterError("start", start, "'run' (a warm-up run) or 'quasistatic' (the quasi-static contact orbit)")
     try:
-        x0, mode, scale = warm_start(model, warmup_revolutions, phase, y0, options, backend)
+        if start == "quasistatic":
+            x0, mode, scale = quasistatic.warm_start(model, phase)
+        else:
+            x0, mode, scale = warm_start(model, warmup_revolutions, phase, y0, options, backend)
     except MapFailure as failure:
         return _failed(model, np.full(2, np.nan), periods, phase, str(failure))
     section_map = StroboscopicMap(model, periods, phase, mode, options, backend)

@@ -37,15 +37,19 @@ def kernel_period(model: Model) -> float:
 
 def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, float], y0,
                         t_eval: np.ndarray, options: SolverOptions,
-                        progress: Callable[[float], None] | None = None) -> Trajectory:
+                        progress: Callable[[float], None] | None = None, watch=None) -> Trajectory:
     """``integrate`` (the engine's integrate(model, t_span, y0, t_eval, options, mode=...), its
     backend chosen) over t_span in phase-wrapped pieces; a short run, or a cam without a
     period, in one call.  ``progress(fraction)`` is told the share of t_span done after each
-    piece (the pieces do not depend on it: a run with a progress report is the same run)."""
+    piece (the pieces do not depend on it: a run with a progress report is the same run).
+    ``watch`` (a :class:`camdyn.stopping.Watch`) makes the pieces ``watch.piece_revolutions``
+    cam periods long and is told each piece in absolute time: when it answers True the run
+    ends there (``stats["stopped"]``)."""
     t0, t_end = map(float, t_span)
     P = kernel_period(model)
-    length = PIECE_PERIODS * P
-    if not (math.isfinite(P) and P > 0) or (t_end <= length and t0 >= 0.0 and t_end - t0 <= length):
+    length = PIECE_PERIODS * P if watch is None else watch.piece_revolutions * model.period
+    periodic = math.isfinite(P) and P > 0
+    if not periodic or (watch is None and t_end <= length and t0 >= 0.0 and t_end - t0 <= length):
         tr = integrate(model, (t0, t_end), y0, t_eval, options)
         if progress is not None:
             progress(1.0)
@@ -71,6 +75,8 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
         budget -= len(tr.switches)
         if progress is not None:
             progress((end - t0) / (t_end - t0))
+        if watch is not None and tr.outcome is Outcome.SUCCESS and end < t_end and watch(parts[-1]):
+            return _joined(parts, stopped=True)
         if tr.outcome is not Outcome.SUCCESS or tr.t.size < local.size or budget <= 0:
             break
         y = tr.y[:STATE_ROWS, -1].copy()
@@ -90,13 +96,14 @@ def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.n
     return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches)
 
 
-def _joined(parts: list[Trajectory]) -> Trajectory:
+def _joined(parts: list[Trajectory], stopped: bool = False) -> Trajectory:
     last = parts[-1]
     stats = {}
     for p in parts:
         for name, value in p.stats.items():
             stats[name] = stats.get(name, 0) + value if isinstance(value, (int, float)) else value
     stats["pieces"] = len(parts)
+    stats["stopped"] = stopped
     return dataclasses.replace(last, t=np.concatenate([p.t for p in parts]),
                                y=np.concatenate([p.y for p in parts], axis=1),
                                mode=np.concatenate([p.mode for p in parts]),

@@ -34,6 +34,8 @@ class Scene(SceneSpec):
         damping_sign:     "dissipative" (derived) or "printed" (misprint 2; B and D only)
         damping_switch:   "episode" (Sec. 3.4: the impact law from contact to maximum compression,
                           then the viscous law until separation) or "memoryless" (D and E only)
+        follower: "dynamic" (the hybrid model) or "quasistatic" (the quasi-static contact orbit,
+                  :mod:`camdyn.quasistatic`: no integration, for a follower that never leaves the cam)
     """
 
     def __post_init__(self):
@@ -41,20 +43,21 @@ class Scene(SceneSpec):
             super().__post_init__()
         except SceneOptionError as exc:
             raise SceneError(str(exc)) from None
-        if self.slug not in generated.SCENES:
-            ondemand.check_derivable(self)
+        if self.derived.slug not in generated.SCENES:
+            ondemand.check_derivable(self.derived)
 
     @property
     def in_catalog(self) -> bool:
         """Whether the scene is in the catalog (``camdyn.generated``) rather than derived on demand."""
-        return self.slug in generated.SCENES
+        return self.derived.slug in generated.SCENES
 
     def kernels(self) -> ModuleType:
-        """The generated module of this scene: from ``camdyn.generated``, else from the per-user
-        cache, derived there on first use (:mod:`camdyn.ondemand`)."""
+        """The generated module of this scene (of its ``derived`` spec: ``follower`` has no kernels
+        of its own): from ``camdyn.generated``, else from the per-user cache, derived there on
+        first use (:mod:`camdyn.ondemand`)."""
         if self.in_catalog:
-            return importlib.import_module(f"camdyn.generated.{generated.SCENES[self.slug]}")
-        return ondemand.load(self)
+            return importlib.import_module(f"camdyn.generated.{generated.SCENES[self.derived.slug]}")
+        return ondemand.load(self.derived)
 
     @staticmethod
     def available() -> list[str]:

@@ -10,10 +10,12 @@ import numpy as np
 from .cam import CamMotion, cam_motion
 from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
-from .engine.driver import BACKENDS, integrate
+from .engine.driver import BACKENDS, Trajectory, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
+from . import quasistatic, stopping
 from .errors import ParameterError
 from .model import Model
+from .outcome import Outcome
 from .pieces import integrate_in_pieces
 from .result import Outputs, Result
 from .rig import Rig
@@ -38,7 +40,8 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              y0=None, t_start: float = 0.0, method: str = "DOP853", rtol: float = 1e-8,
              atol: float = 1e-12, max_step: float = math.inf,
              events: EventSettings | None = None, energy_ledger: bool = False,
-             backend: str = "compiled", progress: Callable[[float], None] | None = None) -> Result:
+             backend: str = "compiled", progress: Callable[[float], None] | None = None,
+             stop=None) -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -57,7 +60,13 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     same loop in Python, for a :class:`~camdyn.cam.UserMotion` (its callables are Python).
     ``progress``, if given, is called with the share of the run done (0 to 1], after each
     piece of a long run (:mod:`camdyn.pieces`: every 200 cam periods) and at its end; it
-    does not change the run.
+    does not change the run.  ``stop``, a :class:`camdyn.StopWhenPeriodic`, ends the run once its
+    once-per-revolution section repeats (needs a whole number of samples per revolution) and
+    completes the Result to the requested length by repeating the converged cycle
+    (:mod:`camdyn.stopping`; ``result.stats["revolutions_run"]``, ``["stop_period"]``).
+    A scene with ``follower="quasistatic"`` is not integrated: the Result holds the quasi-static
+    contact orbit at the samples (:mod:`camdyn.quasistatic`; alpha_dot the rigid rate), up to
+    where it does not exist (``Outcome.CONTACT_TENSILE``, ``result.stats["where"]``).
     """
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")
@@ -70,11 +79,54 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     duration = run_duration(cam, model.equilibrium.vartheta, t_end, revolutions)
     check_start(t_start, y0)
     t_eval = t_start + np.arange(sample_count(duration, sample_rate_Hz)) / float(sample_rate_Hz)
-    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     options = solver_options(method, rtol, atol, max_step, events, energy_ledger)
+    if scene.follower == "quasistatic":
+        return _quasi_static(model, t_eval, backend, y0=y0, energy_ledger=energy_ledger, stop=stop)
+    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     run = functools.partial(integrate, backend=backend)
-    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress)
+    watch = _watch(stop, sample_rate_Hz, model.period, options)
+    traj = integrate_in_pieces(run, model, (t_start, t_start + duration), y0, t_eval, options, progress, watch)
+    result = _result(model, traj, backend)
+    if watch is None:
+        return result
+    result.stats["revolutions_run"] = round((result.t[-1] - t_start) / model.period, 6) if result.t.size else 0.0
+    result.stats["stop_period"] = watch.period if traj.stats.get("stopped") else 0
+    if traj.stats.get("stopped"):
+        # the samples the full run would have: the engine gives none past t_end (one rounded beyond it)
+        t_eval = t_eval[t_eval <= t_start + duration]
+        return stopping.extend(result, t_eval, watch.period, watch.per_revolution, t_start + duration)
+    return result
+
+
+def _quasi_static(model: Model, t_eval: np.ndarray, backend: str, **refused) -> Result:
+    """The scene option follower="quasistatic": the quasi-static contact orbit at the samples
+    (:mod:`camdyn.quasistatic`, no integration), its outputs from the generated kernel; the
+    samples end before a time where it does not exist (the outcome says why, stats["where"] where)."""
+    for name, value in refused.items():
+        if value is not None and value is not False:
+            raise ParameterError(name, value, "not given with follower='quasistatic' (no integration: the orbit "
+                                 "has no start, ledger or stop)")
+    orbit = quasistatic.orbit_at(model, t_eval)
+    K = model.kernels
+    mode = np.array([K.MODES.index(m) for m in orbit.mode], dtype=np.int64)
+    outcome = {"SUCCESS": Outcome.SUCCESS, "TENSILE": Outcome.CONTACT_TENSILE,
+               "NEWTON_FAILED": Outcome.NO_QUASI_STATIC}[orbit.outcome.name]
+    stats = {"nfev": 0, "steps": 0, "rejected_steps": 0, "njev": 0, "switches": 0, "backend": backend,
+             "follower": "quasistatic", "where": "" if orbit.ok else orbit.message}
+    traj = Trajectory(orbit.t, np.vstack([orbit.alpha, orbit.alpha_dot]), mode, tuple(K.MODES), [], outcome,
+                      stats, int(mode[-1]) if mode.size else 0)
     return _result(model, traj, backend)
+
+
+def _watch(stop, sample_rate_Hz, period: float, options: SolverOptions):
+    """The stopping check of one run (None without ``stop``)."""
+    if stop is None:
+        return None
+    if not isinstance(stop, stopping.StopWhenPeriodic):
+        raise ParameterError("stop", stop, "None or a camdyn.StopWhenPeriodic")
+    if not math.isfinite(period):
+        raise ParameterError("stop", stop, "None for a cam without a period")
+    return stopping.Watch(stop, stopping.per_revolution(sample_rate_Hz, period), options.rtol, options.atol)
 
 
 # --- simulate's checks, also run on every point of a sweep before any work (camdyn.sweep_check) ---

@@ -51,6 +51,7 @@ from .result import Result
 from .rig import Rig
 from .scene import Scene
 from .simulation import BACKENDS
+from .stopping import StopWhenPeriodic
 from .sweep_check import InvalidGridError, check_by_running, check_grid, check_settings
 from .sweep_run import Dispatch, chunks_of, run_serial, worker_count
 from .sweep_spec import ALL_CODES, ERROR, INVALID, NOT_RUN, OUTCOME_CODES, SweepSpec, chunk_of, grid_axes
@@ -125,7 +126,7 @@ def _whole(value, least: int) -> bool:
 def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: Callable = Summary(), *,
           executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
           samples_per_revolution: int | None = None, out=None, invalid: str = "raise", retries: int = 2,
-          **simulate_kwargs):
+          stop: StopWhenPeriodic | None = None, **simulate_kwargs):
     """Simulate every point of ``grid`` and measure it (see the module doc).
 
     Parameters
@@ -154,6 +155,14 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
         (:class:`InvalidGridError`); "skip" records them as INVALID and runs the others.
     retries : int
         Times a chunk whose worker died (or whose task failed) is submitted again.
+    stop : camdyn.StopWhenPeriodic, optional
+        End each point's run once its once-per-revolution section repeats (period <=
+        ``stop.max_period``, to ``stop.tol``), its Result completed by repeating the converged
+        cycle (:mod:`camdyn.stopping`; needs ``samples_per_revolution``).  The Dataset then
+        also has ``revolutions_run`` and ``stop_period`` (0: not converged, run to the end) per
+        point, and the attributes ``revolutions_requested_total``, ``revolutions_run_total`` and
+        ``points_stopped_converged``; the saving is logged.  A run that has not converged is
+        never stopped.  Default off (on in :func:`bifurcation`).
     **simulate_kwargs
         Given to :func:`camdyn.simulate` at every point (``revolutions``, ``rtol``,
         ``backend`` -- "compiled" unless given -- ``cam`` or ``speed_rpm`` when the speed is
@@ -164,6 +173,11 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
     xarray.Dataset
         One dimension per grid name, the measured variables, ``outcome`` and ``message``.
     """
+    if stop is not None:
+        if samples_per_revolution is None:
+            raise ParameterError("samples_per_revolution", None, "an integer >= 1 with stop= (the section is "
+                                 "every samples_per_revolution-th sample)")
+        simulate_kwargs = {**simulate_kwargs, "stop": stop}
     spec = _spec(rig, scene, grid, measure, samples_per_revolution, simulate_kwargs)
     return _start(spec, out, invalid, _RunOptions(executor, progress, chunksize, retries))
 
@@ -285,6 +299,11 @@ class _Progress:
 def _report(ds, store) -> None:
     codes = ds["outcome"].values
     errors, not_run = int(np.sum(codes == ERROR)), int(np.sum(codes == NOT_RUN))
+    if "revolutions_run_total" in ds.attrs:
+        a = ds.attrs
+        log.info("stopped once periodic: %d of %d points; %.6g of %.6g revolutions run (%.1f %%)",
+                 a["points_stopped_converged"], codes.size, a["revolutions_run_total"],
+                 a["revolutions_requested_total"], 100 * a["revolutions_run_total"] / a["revolutions_requested_total"])
     if errors:
         log.warning("%d of %d points raised: recorded as ERROR (the message variable says why)", errors, codes.size)
     if not_run:
@@ -294,16 +313,19 @@ def _report(ds, store) -> None:
 
 
 def bifurcation(rig: Rig, scene: Scene, speeds_rpm: Sequence[float], *, revolutions: int = 200,
-                transient_revolutions: int = 50, **kwargs):
+                transient_revolutions: int = 50, stop: StopWhenPeriodic | None = StopWhenPeriodic(), **kwargs):
     """Poincare section of alpha once per revolution against cam speed: ``alpha_section``
-    (speed_rpm, revolution) for the revolutions after the transient.  ``kwargs`` go to
-    :func:`sweep` (``executor``, ``out``, ``rtol``...)."""
+    (speed_rpm, revolution) for the revolutions after the transient.  By default each run stops
+    once its section repeats (``stop``, see :func:`sweep`): the section values over the
+    remaining revolutions are its converged cycle, repeated (``stop_period`` says which
+    points stopped, ``revolutions_run`` how far each ran); ``stop=None`` runs every point to
+    the end.  ``kwargs`` go to :func:`sweep` (``executor``, ``out``, ``rtol``...)."""
     if isinstance(revolutions, bool) or not isinstance(revolutions, int) or revolutions < 1:
         raise ParameterError("revolutions", revolutions, "an integer >= 1")
     if not 0 <= transient_revolutions < revolutions:
         raise ParameterError("transient_revolutions", transient_revolutions, f"0 <= it < revolutions ({revolutions})")
     return sweep(rig, scene, {"speed_rpm": speeds_rpm}, PoincareSection(transient_revolutions),
-                 revolutions=revolutions, samples_per_revolution=1, **kwargs)
+                 revolutions=revolutions, samples_per_revolution=1, stop=stop, **kwargs)
 
 
 def contact_loss_map(rig: Rig, scene: Scene, k_s: Sequence[float], speeds_rpm: Sequence[float], *,
@@ -339,5 +361,5 @@ def _loss_speed(rig: Rig, k_s: float) -> float:
         return math.nan
 
 
-__all__ = ["sweep", "resume", "load_partial", "Summary", "PoincareSection", "bifurcation", "contact_loss_map",
+__all__ = ["sweep", "resume", "StopWhenPeriodic", "load_partial", "Summary", "PoincareSection", "bifurcation", "contact_loss_map",
            "InvalidGridError", "StoreError", "ALL_CODES", "rig_of", "scene_of"]

@@ -31,8 +31,10 @@ OUTCOME_CODES = {o.name: i for i, o in enumerate(Outcome)}
 INVALID, ERROR, NOT_RUN = -1, -2, -3
 SWEEP_CODES = {"INVALID": INVALID, "ERROR": ERROR, "NOT_RUN": NOT_RUN}
 ALL_CODES = {**OUTCOME_CODES, **SWEEP_CODES}
-#: variable names a measure may not use: the sweep's own, and the chunk files' point axis
-RESERVED = ("outcome", "message", "point", "point_index")
+#: variable names a measure may not use: the sweep's own (with stop=: what the convergence check
+#: did), and the chunk files' point axis
+OWN = ("outcome", "message", "point", "point_index")
+RESERVED = OWN + ("revolutions_run", "stop_period")
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,6 +139,9 @@ def run_point(spec: SweepSpec, index: int) -> tuple[int, str, dict]:
         if _interrupted(exc):
             raise KeyboardInterrupt from exc
         return ERROR, f"{type(exc).__name__}: {exc}", {}
+    if kwargs.get("stop") is not None:        # what the convergence check did (camdyn.stopping)
+        values["revolutions_run"] = float(result.stats.get("revolutions_run", math.nan))
+        values["stop_period"] = float(result.stats.get("stop_period", 0))
     return OUTCOME_CODES[result.outcome.name], "" if result.ok else result.outcome.message, values
 
 

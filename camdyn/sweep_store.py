@@ -39,7 +39,7 @@ import numpy as np
 from . import __version__
 from .errors import CamdynError
 from .rig import PARAMETERS
-from .sweep_spec import ALL_CODES, NOT_RUN, RESERVED, ChunkResult, SweepSpec
+from .sweep_spec import ALL_CODES, NOT_RUN, OWN, ChunkResult, SweepSpec
 
 FORMAT = "camdyn sweep folder 1"
 PENDING = "not run yet: resume the sweep to run it"
@@ -124,7 +124,7 @@ class FolderStore:
                 out.append(ChunkResult(ds["point_index"].values.astype(np.int64), ds["outcome"].values.astype(np.int32),
                                        [str(m) for m in ds["message"].values],
                                        {name: (v.dims[1:], v.values.astype(float)) for name, v in ds.data_vars.items()
-                                        if name not in RESERVED}))
+                                        if name not in OWN}))
             except Exception as exc:  # a damaged file: its points run again
                 log.warning("%s cannot be read (%s); its points will run again", path, exc)
                 path.unlink()
@@ -196,6 +196,8 @@ def assemble(spec: SweepSpec, chunks: Iterable[ChunkResult], not_run: dict[int, 
     data["message"] = (grid, message.reshape(shape), described["message"])
     coords = {name: (name, a, described[name]) for name, a in spec.axes.items()}
     ds = xr.Dataset(data, coords=coords, attrs=attributes(spec))
+    if "revolutions_run" in ds:
+        ds.attrs.update(stop_saving(ds, spec))
     return spec.finish(ds, spec) if spec.finish is not None else ds
 
 
@@ -231,9 +233,25 @@ def variable_attributes(spec: SweepSpec) -> dict[str, dict]:
                        "flag_meanings": " ".join(ALL_CODES)},
            "message": {"long_name": "why the point's run did not succeed (empty on success)"}}
     out.update({p.name: {"units": _unit(p.unit), "long_name": p.description} for p in PARAMETERS})
+    out["revolutions_run"] = {"units": "1", "long_name": "cam revolutions integrated (fewer than requested where "
+                                                         "the run stopped once periodic: see stop_period)"}
+    out["stop_period"] = {"units": "1", "long_name": "period (revolutions) of the cycle the run converged to and "
+                                                     "stopped on, repeated to the requested length; 0: not converged, "
+                                                     "run to its end"}
     for name, (long_name, units) in getattr(spec.measure, "variables", {}).items():
         out[name] = {"units": units, "long_name": long_name}
     return out
+
+
+def stop_saving(ds, spec: SweepSpec) -> dict:
+    """The attributes that say what stopping converged runs saved: revolutions requested and run
+    (summed over the points that ran) and the points that stopped."""
+    ran = np.isfinite(ds["revolutions_run"].values)
+    requested = spec.settings.get("revolutions")
+    total = float(requested) * int(np.sum(ran)) if requested is not None else math.nan
+    return {"revolutions_requested_total": total,
+            "revolutions_run_total": float(np.nansum(ds["revolutions_run"].values)),
+            "points_stopped_converged": int(np.sum(ds["stop_period"].values > 0))}
 
 
 def rig_of(attrs: dict):

@@ -19,6 +19,7 @@ MODELS = ("nonlinear", "linear_paper", "linear_exact")  # Eq. 10; Eqs. 36-38 as 
 SLIDING_VELOCITY_FORMS = ("kinematic", "printed")       # misprint 8
 DAMPING_SIGNS = ("dissipative", "printed")              # misprint 2
 DAMPING_SWITCHES = ("episode", "memoryless")            # Sec. 3.4, models D and E (see SceneSpec)
+FOLLOWERS = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
 
 OPTIONS: dict[str, tuple[str, ...]] = {
     "contact": CONTACT_LAWS,
@@ -29,13 +30,19 @@ OPTIONS: dict[str, tuple[str, ...]] = {
     "sliding_velocity": SLIDING_VELOCITY_FORMS,
     "damping_sign": DAMPING_SIGNS,
     "damping_switch": DAMPING_SWITCHES,
+    "follower": FOLLOWERS,
 }
+
+#: options that say how the runtime uses a derived model rather than what is derived: they have
+#: no kernels of their own (the scene's kernels are those of its ``derived`` spec)
+RUNTIME_OPTIONS = ("follower",)
 
 #: the slug's suffix word of each non-default misprint or switch option
 SLUG_SUFFIXES: dict[str, tuple[str, str]] = {
     "vrprinted": ("sliding_velocity", "printed"),
     "printedsign": ("damping_sign", "printed"),
     "memoryless": ("damping_switch", "memoryless"),
+    "quasistatic": ("follower", "quasistatic"),
 }
 
 #: damping models with an impact law until maximum compression, then a viscous one (Eqs. 27-28)
@@ -64,6 +71,9 @@ class SceneSpec:
                           until separation t_c: one switch per contact episode) or "memoryless"
                           (the law follows the sign of psi_i_dot at every instant: loading while
                           psi_i_dot < 0, viscous otherwise)
+        follower: "dynamic" (the hybrid model: free flight, impacts, contact) or "quasistatic"
+                  (no integration: Eq. 10 solved for alpha with alpha_dot, alpha_ddot of the rigid
+                  kinematics, Eq. 29, for a follower that never leaves the cam; camdyn.quasistatic)
     """
 
     contact: str = "line"
@@ -74,6 +84,7 @@ class SceneSpec:
     sliding_velocity: str = "kinematic"
     damping_sign: str = "dissipative"
     damping_switch: str = "episode"
+    follower: str = "dynamic"
 
     def __post_init__(self):
         for f in fields(self):
@@ -106,6 +117,15 @@ class SceneSpec:
 
     def as_dict(self) -> dict[str, str]:
         return asdict(self)
+
+    def derived_options(self) -> dict[str, str]:
+        """The options that choose what is derived (all but RUNTIME_OPTIONS)."""
+        return {k: v for k, v in asdict(self).items() if k not in RUNTIME_OPTIONS}
+
+    @property
+    def derived(self) -> "SceneSpec":
+        """The spec whose generated module this scene runs: RUNTIME_OPTIONS at their defaults."""
+        return SceneSpec(**self.derived_options())
 
     def options_text(self) -> str:
         """The options that differ from the defaults, as keyword arguments (for messages)."""

@@ -192,6 +192,7 @@ class Event(NamedTuple):
     branch: int
     point: int            # the branch point just before the event (index into the Dataset's point)
     multipliers: np.ndarray
+    alpha_revolutions: np.ndarray
 
 
 class _Scaled(NamedTuple):
@@ -344,7 +345,8 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
         if kind == "branch_point" and _changed(f0["fold"], f1["fold"]):
             continue                                   # the +1 multiplier of the fold itself
         e = _locate(problem, p, ds, kind, periods, scale, settings)
-        events.append((Event(kind, e.lam, e.x, where[0], where[1], _multipliers(e.jacobian)), e, p, q))
+        events.append((Event(kind, e.lam, e.x, where[0], where[1], _multipliers(e.jacobian), e.alpha_revolutions),
+                       e, p, q))
     return events
 
 
@@ -579,9 +581,7 @@ def branch_dataset(problem: Problem, branches: list, events: list):
     offsets = np.cumsum([0] + [len(b.points) for b in branches])
     n_rev = max([b.periods for b in branches] + [1])
     mu = np.array([_multipliers(p.jacobian) for p in points]).reshape(len(points), 2)
-    revs = np.full((len(points), n_rev), np.nan)
-    for i, p in enumerate(points):
-        revs[i, :p.alpha_revolutions.size] = p.alpha_revolutions
+    revs = _padded([p.alpha_revolutions for p in points], n_rev)
     unit, P = _unit(problem.parameter), ("point",)
     outcomes = list(ContinuationOutcome)
     modes = problem.model(problem.start).kernels.MODES
@@ -614,6 +614,8 @@ def branch_dataset(problem: Problem, branches: list, events: list):
         "event_branch": (("event",), np.array([e.branch for e in events], dtype=int), {"long_name": "branch index"}),
         "event_point": (("event",), np.array([offsets[e.branch] + e.point for e in events], dtype=int),
                         {"long_name": "index of the point just before the event"}),
+        "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),
+                                   {"units": "rad", "long_name": "alpha at the starts of the revolutions at the event"}),
         "event_multiplier_real": (("event", "multiplier"), np.array([e.multipliers.real for e in events]).reshape(-1, 2),
                                   {"units": "1"}),
         "event_multiplier_imag": (("event", "multiplier"), np.array([e.multipliers.imag for e in events]).reshape(-1, 2),
@@ -632,6 +634,13 @@ def branch_dataset(problem: Problem, branches: list, events: list):
     for i, b in enumerate(branches):
         attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
     return xr.Dataset(data, attrs=attrs)
+
+
+def _padded(rows, width: int) -> np.ndarray:
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        out[i, :row.size] = row
+    return out
 
 
 def events_table(ds) -> list[tuple[str, float, int, int]]:

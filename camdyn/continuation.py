@@ -551,15 +551,15 @@ def continuation(rig: Rig, scene: Scene, parameter: str, start: float, end: floa
                       options, jacobian, backend)
     problem.model(problem.start)                 # a rig value the rig refuses raises here
     problem.model(problem.end)
-    branches, events, _ = _run(problem, settings, warmup_revolutions)
-    return branch_dataset(problem, branches, events)
+    branches, events, scale = _run(problem, settings, warmup_revolutions)
+    return branch_dataset(problem, branches, events, scale)
 
 
 def _unit(parameter: str) -> str:
     return "rev/min" if parameter == SPEED else next(p.unit for p in PARAMETERS if p.name == parameter)
 
 
-def branch_dataset(problem: Problem, branches: list, events: list):
+def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     """The branches and events as an ``xarray.Dataset``.
 
     Dims: ``point`` (every orbit of every branch, branch by branch, in the order continued),
@@ -573,7 +573,8 @@ def branch_dataset(problem: Problem, branches: list, events: list):
     ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``, ``event_point``
     (the point just before it), ``event_multiplier_real``/``_imag``; the branches'
     ``branch_periods``, ``branch_parent`` (-1: none), ``branch_outcome`` (code into
-    ``outcomes``), and the messages as attrs ``branch_<i>_message``.
+    ``outcomes``), and the messages as attrs ``branch_<i>_message``; attrs ``scale_alpha`` (rad)
+    and ``scale_alpha_dot`` (rad/s): the size of the motion at the start, the residual's scale.
     """
     import xarray as xr
 
@@ -631,6 +632,8 @@ def branch_dataset(problem: Problem, branches: list, events: list):
              "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
              "modes": " ".join(modes), "event_kinds": " ".join(EVENTS),
              "outcomes": " ".join(o.name for o in outcomes)}
+    s = np.full(2, np.nan) if scale is None else np.asarray(scale, dtype=float)
+    attrs.update(scale_alpha=float(s[0]), scale_alpha_dot=float(s[1]))
     for i, b in enumerate(branches):
         attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
     return xr.Dataset(data, attrs=attrs)

@@ -43,6 +43,9 @@ _EXPORTS = {
     "PeriodicOrbit": "camdyn.orbits",
     "OrbitOutcome": "camdyn.orbits",
     "StroboscopicMap": "camdyn.section_map",
+    "continue_orbit": "camdyn.continuation",
+    "ContinuationSettings": "camdyn.continuation",
+    "ContinuationOutcome": "camdyn.continuation",
     "zero_one_test": "camdyn.chaos01",
 }
 

@@ -498,7 +498,7 @@ def cmd_contact_loss(args) -> int:
 
 # --- continue --------------------------------------------------------------------------
 def cmd_continue(args) -> int:
-    from .continuation import SPEED, ContinuationOutcome, ContinuationSettings, continuation, events_table
+    from .continuation import SPEED, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
     from .engine.config import SolverOptions
 
     rig, scene = _rig(args), _scene(args)
@@ -514,7 +514,7 @@ def cmd_continue(args) -> int:
     if args.backend:
         kwargs["backend"] = args.backend
     with _busy("continuing the branch", args):
-        ds = continuation(rig, scene, args.param, args.start, args.end, **kwargs)
+        ds = continue_orbit(rig, scene, args.param, args.start, args.end, **kwargs)
     unit = ds.attrs["parameter_units"]
     print(f"continuation of {scene.slug} on rig {rig.name!r} in {args.param} ({unit}): {ds.sizes['point']} orbits "
           f"on {ds.sizes['branch']} branch(es)")

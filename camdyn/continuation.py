@@ -4,7 +4,7 @@ A periodic orbit of period n T is a fixed point of the stroboscopic map P_n
 (:mod:`camdyn.orbits`).  As a parameter lambda (the cam speed ``speed_rpm``, or any rig
 parameter by name: ``k_s``, ``e``, ...) changes, the fixed points form branches
 ``G(x, lambda) = P_n(x; lambda) - x = 0`` that may turn back at folds, where a search at fixed
-lambda fails.  :func:`continuation` follows a branch in the unknowns z = (x, lambda), scaled
+lambda fails.  :func:`continue_orbit` follows a branch in the unknowns z = (x, lambda), scaled
 as ``(x / s, lambda / |end - start|)`` (s the size of the motion, as in :mod:`camdyn.orbits`):
 
 * **predictor**: z_pred = z_k + ds t_k, with t_k the unit tangent, the null vector of the
@@ -43,7 +43,7 @@ At a period doubling the branch of period 2 n T is switched to: Newton's method 
 x* +/- eps v (v the eigenvector of the multiplier near -1) on the side where P_n is unstable,
 then on the other side, and that branch is continued too.
 
-The result is an ``xarray.Dataset`` (:func:`continuation`): dims ``point`` (every orbit on
+The result is an ``xarray.Dataset`` (:func:`continue_orbit`): dims ``point`` (every orbit on
 every branch), ``multiplier``, ``revolution`` and ``event``.
 """
 from __future__ import annotations
@@ -526,7 +526,7 @@ def _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction
         raise ParameterError("settings", settings, "a camdyn.continuation.ContinuationSettings")
 
 
-def continuation(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *,
+def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *,
                  speed_rpm: float | None = None, periods: int = 1, phase_fraction: float = 0.0,
                  warmup_revolutions: int = 20, settings: ContinuationSettings = ContinuationSettings(),
                  options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
@@ -647,12 +647,12 @@ def _padded(rows, width: int) -> np.ndarray:
 
 
 def events_table(ds) -> list[tuple[str, float, int, int]]:
-    """The events of a :func:`continuation` Dataset as (kind, lambda, branch, point) rows."""
+    """The events of a :func:`continue_orbit` Dataset as (kind, lambda, branch, point) rows."""
     kinds = ds.attrs["event_kinds"].split()
     return [(kinds[int(k)], float(lam), int(b), int(p)) for k, lam, b, p in
             zip(ds["event_kind"].values, ds["event_lambda"].values, ds["event_branch"].values,
                 ds["event_point"].values)]
 
 
-__all__ = ["continuation", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
+__all__ = ["continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
            "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES"]

@@ -424,7 +424,7 @@ def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: floa
     return fig
 
 
-#: the marker of each event kind of :func:`camdyn.continuation.continuation`
+#: the marker of each event kind of :func:`camdyn.continuation.continue_orbit`
 EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neimark_sacker": "o", "grazing": "v"}
 
 
@@ -435,7 +435,7 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:
 
 
 def branches(ds, *, diagram=None, contact_loss_rpm: float | None = None, ax=None, title: str | None = None):
-    """Continued branches (:func:`camdyn.continuation.continuation`) against their parameter: alpha
+    """Continued branches (:func:`camdyn.continuation.continue_orbit`) against their parameter: alpha
     at the starts of the orbit's revolutions (the brute-force diagram's sections), solid where
     the orbit is stable, dashed where not, one colour per period; the events marked and named.
 

@@ -34,6 +34,9 @@ arclength:
   through +1 at a crossing of branches);
 * ``period_doubling``: det(M + I) changes sign (a real multiplier through -1);
 * ``neimark_sacker``: det M - 1 changes sign between points with a complex pair (|mu|^2 = det M);
+* ``multiplier_jump``: one of the above test functions changed sign but the located orbit's
+  multipliers are not at the critical value (within ``CRITICAL``): they jumped, the map is not
+  smooth there (no branch is switched to);
 * ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
   over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
   generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
@@ -69,8 +72,14 @@ from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_di
 SPEED = "speed_rpm"
 #: samples of psi_i per cam period for the orbit's largest gap (refined by a parabola)
 GAP_SAMPLES = 256
-#: event kinds, in the order the test functions are evaluated
-EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing")
+#: event kinds, in the order the test functions are evaluated; ``multiplier_jump``: a test
+#: function changed sign but the located orbit's multipliers are not critical (the map is not
+#: smooth there: the multipliers jump, e.g. where the orbit meets a new switching surface)
+EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing", "multiplier_jump")
+#: a located bifurcation's critical multiplier (+1, -1, |mu| = 1) is within this of its value:
+#: bisection to locate_tol puts it within ~|d mu / ds| locate_tol (~1e-5) of it, unless the
+#: multipliers jump across the bracket
+CRITICAL = 1e-2
 #: bisection in arclength stops after this many halvings of the bracket
 MAX_BISECTIONS = 40
 #: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
@@ -339,15 +348,23 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
     """The events between consecutive points p and q (ds apart), located; ``where``: (branch, index of p)."""
     f0, f1 = _tests(p), _tests(q)
     events = []
-    for kind in EVENTS:
+    for kind in f0:
         if not _changed(f0[kind], f1[kind]):
             continue
         if kind == "branch_point" and _changed(f0["fold"], f1["fold"]):
             continue                                   # the +1 multiplier of the fold itself
         e = _locate(problem, p, ds, kind, periods, scale, settings)
-        events.append((Event(kind, e.lam, e.x, where[0], where[1], _multipliers(e.jacobian), e.alpha_revolutions),
-                       e, p, q))
+        mu = _multipliers(e.jacobian)
+        named = kind if _critical(kind, mu) else "multiplier_jump"
+        events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions), e, p, q))
     return events
+
+
+def _critical(kind: str, mu: np.ndarray) -> bool:
+    """Whether the multipliers at a located event have the kind's critical value (CRITICAL)."""
+    distance = {"fold": np.abs(mu - 1.0), "branch_point": np.abs(mu - 1.0), "period_doubling": np.abs(mu + 1.0),
+                "neimark_sacker": np.abs(np.abs(mu) - 1.0)}.get(kind)
+    return distance is None or float(np.min(distance)) < CRITICAL
 
 
 def _multipliers(J: np.ndarray) -> np.ndarray:

@@ -425,7 +425,8 @@ def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: floa
 
 
 #: the marker of each event kind of :func:`camdyn.continuation.continue_orbit`
-EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neimark_sacker": "o", "grazing": "v"}
+EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neimark_sacker": "o", "grazing": "v",
+                 "multiplier_jump": "x"}
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:

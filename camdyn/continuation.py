@@ -33,7 +33,7 @@ arclength:
 * ``branch_point``: det(M - I) changes sign while the branch does not turn (a multiplier
   through +1 at a crossing of branches);
 * ``period_doubling``: det(M + I) changes sign (a real multiplier through -1);
-* ``neimark_sacker``: det M - 1 changes sign between points with a complex pair (|mu|^2 = det M);
+* ``neimark_sacker``: det M - 1 changes sign between points with a complex pair (``|mu|^2 = det M``);
 * ``multiplier_jump``: one of the above test functions changed sign but the located orbit's
   multipliers are not at the critical value (within ``CRITICAL``): they jumped, the map is not
   smooth there (no branch is switched to);
@@ -76,8 +76,8 @@ GAP_SAMPLES = 256
 #: function changed sign but the located orbit's multipliers are not critical (the map is not
 #: smooth there: the multipliers jump, e.g. where the orbit meets a new switching surface)
 EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing", "multiplier_jump")
-#: a located bifurcation's critical multiplier (+1, -1, |mu| = 1) is within this of its value:
-#: bisection to locate_tol puts it within ~|d mu / ds| locate_tol (~1e-5) of it, unless the
+#: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value:
+#: bisection to locate_tol puts it within ~``|d mu / ds| locate_tol`` (~1e-5) of it, unless the
 #: multipliers jump across the bracket
 CRITICAL = 1e-2
 #: bisection in arclength stops after this many halvings of the bracket
@@ -583,7 +583,7 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     ``multiplier`` (2, by decreasing modulus), ``revolution`` (n of the longest period, NaN
     beyond a point's own), ``event``, ``branch``.  Variables: ``lambda`` (the parameter, its
     unit), ``alpha`` and ``alpha_dot`` at the section, ``multiplier_real``/``_imag``/``_modulus``,
-    ``stable`` (every |mu| < 1), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
+    ``stable`` (every ``|mu| < 1``), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
     permanent contact), ``branch``, ``periods``, ``mode`` (code into attrs ``modes``),
     ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's revolutions: the
     points of the brute-force diagram); the events' ``event_kind`` (code into ``event_kinds``),

@@ -90,8 +90,8 @@ class ContinuationOutcome(enum.Enum):
     """How a branch ended (an actionable message each)."""
 
     END_REACHED = "the branch reached the end value of the parameter"
-    LEFT_RANGE = ("the branch turned back (a fold) and left the range at the start value; continue from "
-                  "another start value to follow it further")
+    LEFT_RANGE = ("the branch left the range at the start value (it turned back at a fold, or a switched "
+                  "branch ran toward the start); continue from another start value to follow it further")
     MAX_POINTS = "max_points orbits were computed before the end value: raise max_points or max_step"
     STEP_TOO_SMALL = ("the corrector failed at the minimum step (a non-smooth point such as grazing or a "
                       "sliding bifurcation, or a failed run, see the message): the branch ends here; "
@@ -240,7 +240,7 @@ def _correct(problem, z_pred, direction, mode, periods, scale, settings):
         lam, x = z[2] * problem.span, z[:2] * scale
         try:
             ev = _evaluate(problem, lam, x, mode, periods, scale)
-        except (MapFailure, CamdynError):
+        except CamdynError:            # a failed run, or a rig value the rig refuses
             return None
         r = float(np.max(np.abs(ev.G)))
         if not math.isfinite(r) or (it >= 2 and r > last):
@@ -595,65 +595,72 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     """
     import xarray as xr
 
-    points = [p for b in branches for p in b.points]
-    offsets = np.cumsum([0] + [len(b.points) for b in branches])
+    unit, outcomes = _unit(problem.parameter), list(ContinuationOutcome)
     n_rev = max([b.periods for b in branches] + [1])
+    data = {**_point_variables(problem, branches, unit, n_rev), **_event_variables(problem, branches, events, unit, n_rev),
+            "branch_periods": (("branch",), np.array([b.periods for b in branches], dtype=int), {}),
+            "branch_parent": (("branch",), np.array([b.parent for b in branches], dtype=int),
+                              {"long_name": "the branch it was switched from (-1: none)"}),
+            "branch_outcome": (("branch",), np.array([outcomes.index(b.outcome) for b in branches], dtype=int),
+                               {"long_name": "how the branch ended (index into the attribute outcomes)"})}
+    s = np.full(2, np.nan) if scale is None else np.asarray(scale, dtype=float)
+    attrs = {"parameter": problem.parameter, "parameter_units": unit, "start": problem.start, "end": problem.end,
+             "speed_rpm": problem.speed_rpm if problem.speed_rpm is not None else math.nan,
+             "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
+             "modes": " ".join(problem.model(problem.start).kernels.MODES), "event_kinds": " ".join(EVENTS),
+             "outcomes": " ".join(o.name for o in outcomes), "scale_alpha": float(s[0]), "scale_alpha_dot": float(s[1])}
+    for i, b in enumerate(branches):
+        attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
+    return xr.Dataset(data, attrs=attrs)
+
+
+def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int) -> dict:
+    points = [p for b in branches for p in b.points]
     mu = np.array([_multipliers(p.jacobian) for p in points]).reshape(len(points), 2)
-    revs = _padded([p.alpha_revolutions for p in points], n_rev)
-    unit, P = _unit(problem.parameter), ("point",)
-    outcomes = list(ContinuationOutcome)
-    modes = problem.model(problem.start).kernels.MODES
-    data = {
+    counts = [len(b.points) for b in branches]
+    P, PM = ("point",), ("point", "multiplier")
+    return {
         "lambda": (P, np.array([p.lam for p in points]), {"units": unit, "long_name": problem.parameter}),
         "alpha": (P, np.array([p.x[0] for p in points]), {"units": "rad", "long_name": "alpha at the section"}),
         "alpha_dot": (P, np.array([p.x[1] for p in points]), {"units": "rad/s",
                                                               "long_name": "alpha_dot at the section"}),
-        "multiplier_real": (P + ("multiplier",), mu.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
-        "multiplier_imag": (P + ("multiplier",), mu.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
-        "multiplier_modulus": (P + ("multiplier",), np.abs(mu), {"units": "1", "long_name": "|Floquet multiplier|"}),
+        "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
+        "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
+        "multiplier_modulus": (PM, np.abs(mu), {"units": "1", "long_name": "|Floquet multiplier|"}),
         "stable": (P, np.all(np.abs(mu) < 1.0, axis=1), {"long_name": "every |multiplier| < 1"}),
         "max_gap": (P, np.array([p.max_gap for p in points]),
                     {"units": "m", "long_name": "largest gap psi_i over the orbit (Eq. 6); < 0: deflection, "
                                                 "the follower never leaves the cam"}),
-        "branch": (P, np.repeat(np.arange(len(branches)), [len(b.points) for b in branches]),
-                   {"long_name": "branch index"}),
-        "periods": (P, np.repeat([b.periods for b in branches], [len(b.points) for b in branches]),
+        "branch": (P, np.repeat(np.arange(len(branches)), counts), {"long_name": "branch index"}),
+        "periods": (P, np.repeat([b.periods for b in branches], counts),
                     {"long_name": "period n of the orbit, in cam periods"}),
-        "mode": (P, np.array([p.mode for p in points], dtype=int), {"long_name": "mode at the section (index into "
-                                                                              "the attribute modes)"}),
+        "mode": (P, np.array([p.mode for p in points], dtype=int),
+                 {"long_name": "mode at the section (index into the attribute modes)"}),
         "residual": (P, np.array([p.residual for p in points]), {"units": "1", "long_name": "scaled residual"}),
-        "alpha_revolution": (P + ("revolution",), revs, {"units": "rad", "long_name": "alpha at the starts of the "
-                                                         "orbit's revolutions (the brute-force diagram's sections)"}),
-        "event_kind": (("event",), np.array([EVENTS.index(e.kind) for e in events], dtype=int),
+        "alpha_revolution": (("point", "revolution"), _padded([p.alpha_revolutions for p in points], n_rev),
+                             {"units": "rad", "long_name": "alpha at the starts of the orbit's revolutions "
+                                                           "(the brute-force diagram's sections)"}),
+    }
+
+
+def _event_variables(problem: Problem, branches: list, events: list, unit: str, n_rev: int) -> dict:
+    offsets = np.cumsum([0] + [len(b.points) for b in branches])
+    E, EM = ("event",), ("event", "multiplier")
+    mu = np.array([e.multipliers for e in events], dtype=complex).reshape(-1, 2)
+    return {
+        "event_kind": (E, np.array([EVENTS.index(e.kind) for e in events], dtype=int),
                        {"long_name": "event kind (index into the attribute event_kinds)"}),
-        "event_lambda": (("event",), np.array([e.lam for e in events]), {"units": unit, "long_name": problem.parameter}),
-        "event_alpha": (("event",), np.array([e.x[0] for e in events]), {"units": "rad"}),
-        "event_alpha_dot": (("event",), np.array([e.x[1] for e in events]), {"units": "rad/s"}),
-        "event_branch": (("event",), np.array([e.branch for e in events], dtype=int), {"long_name": "branch index"}),
-        "event_point": (("event",), np.array([offsets[e.branch] + e.point for e in events], dtype=int),
+        "event_lambda": (E, np.array([e.lam for e in events]), {"units": unit, "long_name": problem.parameter}),
+        "event_alpha": (E, np.array([e.x[0] for e in events]), {"units": "rad"}),
+        "event_alpha_dot": (E, np.array([e.x[1] for e in events]), {"units": "rad/s"}),
+        "event_branch": (E, np.array([e.branch for e in events], dtype=int), {"long_name": "branch index"}),
+        "event_point": (E, np.array([offsets[e.branch] + e.point for e in events], dtype=int),
                         {"long_name": "index of the point just before the event"}),
         "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),
                                    {"units": "rad", "long_name": "alpha at the starts of the revolutions at the event"}),
-        "event_multiplier_real": (("event", "multiplier"), np.array([e.multipliers.real for e in events]).reshape(-1, 2),
-                                  {"units": "1"}),
-        "event_multiplier_imag": (("event", "multiplier"), np.array([e.multipliers.imag for e in events]).reshape(-1, 2),
-                                  {"units": "1"}),
-        "branch_periods": (("branch",), np.array([b.periods for b in branches], dtype=int), {}),
-        "branch_parent": (("branch",), np.array([b.parent for b in branches], dtype=int),
-                          {"long_name": "the branch it was switched from (-1: none)"}),
-        "branch_outcome": (("branch",), np.array([outcomes.index(b.outcome) for b in branches], dtype=int),
-                           {"long_name": "how the branch ended (index into the attribute outcomes)"}),
+        "event_multiplier_real": (EM, mu.real, {"units": "1"}),
+        "event_multiplier_imag": (EM, mu.imag, {"units": "1"}),
     }
-    attrs = {"parameter": problem.parameter, "parameter_units": unit, "start": problem.start, "end": problem.end,
-             "speed_rpm": problem.speed_rpm if problem.speed_rpm is not None else math.nan,
-             "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
-             "modes": " ".join(modes), "event_kinds": " ".join(EVENTS),
-             "outcomes": " ".join(o.name for o in outcomes)}
-    s = np.full(2, np.nan) if scale is None else np.asarray(scale, dtype=float)
-    attrs.update(scale_alpha=float(s[0]), scale_alpha_dot=float(s[1]))
-    for i, b in enumerate(branches):
-        attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
-    return xr.Dataset(data, attrs=attrs)
 
 
 def _padded(rows, width: int) -> np.ndarray:

@@ -202,6 +202,7 @@ class Event(NamedTuple):
     point: int            # the branch point just before the event (index into the Dataset's point)
     multipliers: np.ndarray
     alpha_revolutions: np.ndarray
+    max_gap: float
 
 
 class _Scaled(NamedTuple):
@@ -326,7 +327,9 @@ def _changed(a: float, b: float) -> bool:
 
 def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings) -> Point:
     """Bisection in arclength over [0, ds] from p on the sign of ``kind``'s test function: the
-    point just past the event (within ``locate_tol`` of it), or the last one reached before it."""
+    point just past the event, within ``locate_tol`` of it.  A step whose corrector fails counts
+    as past the event (the map is not smooth beyond a grazing); when the bracket's far end is
+    such a failure, the point just before it is returned."""
     sign0 = math.copysign(1.0, _tests(p)[kind])
     lo, hi, before, after = 0.0, ds, p, None
     for _ in range(MAX_BISECTIONS):
@@ -334,9 +337,7 @@ def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings) -
             break
         mid = 0.5 * (lo + hi)
         q = _step(problem, p, mid, periods, scale, settings)
-        if q is None:
-            break
-        f = _tests(q)[kind]
+        f = math.nan if q is None else _tests(q)[kind]
         if math.isfinite(f) and math.copysign(1.0, f) == sign0:
             lo, before = mid, q
         else:
@@ -356,7 +357,7 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
         e = _locate(problem, p, ds, kind, periods, scale, settings)
         mu = _multipliers(e.jacobian)
         named = kind if _critical(kind, mu) else "multiplier_jump"
-        events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions), e, p, q))
+        events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap), e, p, q))
     return events
 
 
@@ -588,7 +589,7 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's revolutions: the
     points of the brute-force diagram); the events' ``event_kind`` (code into ``event_kinds``),
     ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``, ``event_point``
-    (the point just before it), ``event_multiplier_real``/``_imag``; the branches'
+    (the point just before it), ``event_max_gap``, ``event_multiplier_real``/``_imag``; the branches'
     ``branch_periods``, ``branch_parent`` (-1: none), ``branch_outcome`` (code into
     ``outcomes``), and the messages as attrs ``branch_<i>_message``; attrs ``scale_alpha`` (rad)
     and ``scale_alpha_dot`` (rad/s): the size of the motion at the start, the residual's scale.
@@ -658,6 +659,8 @@ def _event_variables(problem: Problem, branches: list, events: list, unit: str, 
                         {"long_name": "index of the point just before the event"}),
         "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),
                                    {"units": "rad", "long_name": "alpha at the starts of the revolutions at the event"}),
+        "event_max_gap": (E, np.array([e.max_gap for e in events]),
+                          {"units": "m", "long_name": "largest gap psi_i over the orbit at the event (0 at grazing)"}),
         "event_multiplier_real": (EM, mu.real, {"units": "1"}),
         "event_multiplier_imag": (EM, mu.imag, {"units": "1"}),
     }

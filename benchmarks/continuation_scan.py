@@ -15,20 +15,17 @@ speed L, in two runs (the two period-1 branches the brute-force diagram shows):
 
 It prints the wall time of each (the compiled loop is loaded before the first timing), the
 outcome, the events, and the grazing speed against L with the first-order compliance shift
-(tests/test_continuation.py::_compliance_shift).
+(camdyn.analysis.compliance_shift).
 """
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
-from pathlib import Path
 
 import camdyn
+from camdyn.analysis import compliance_shift
 from camdyn.continuation import continue_orbit, events_table
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 
 def main(argv=None):
@@ -36,7 +33,6 @@ def main(argv=None):
     ap.add_argument("--l-lambda", type=float, nargs="+", default=[0.016, 0.0016], dest="l_lambda")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
-    from test_continuation import _compliance_shift
     scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
     camdyn.periodic_orbit(camdyn.example_rig(), scene, speed_rpm=1500.0)          # load the compiled loop
     for length in args.l_lambda:
@@ -54,7 +50,7 @@ def main(argv=None):
             for kind, lam, branch, point in events_table(ds):
                 print(f"    {kind} at {lam:.6f} rev/min (branch {branch}, after point {point})")
                 if kind == "grazing":
-                    shift = _compliance_shift(rig)
+                    shift = compliance_shift(rig, scene)
                     print(f"      (grazing - L) / L = {(lam - loss) / loss:.3e}; first-order compliance shift "
                           f"{shift:.3e}: L (1 + shift) = {loss * (1 + shift):.6f} rev/min")
 

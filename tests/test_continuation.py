@@ -15,18 +15,17 @@ writing this module (see the module's docstring in camdyn.continuation):
 """
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
 import pytest
 
 import camdyn
-from camdyn.analysis import _static_scene
+from camdyn.analysis import compliance_shift
 from camdyn.continuation import (EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit,
                                  events_table)
 from camdyn.errors import ParameterError
-from camdyn.model import Model, static_parameters
+from camdyn.model import Model
 from camdyn.section_map import StroboscopicMap
 from camdyn.sweep import bifurcation
 
@@ -126,31 +125,6 @@ def test_the_switched_branch_is_period_two_and_stable_where_the_diagram_shows_p2
     assert not ds["stable"].values[ds["branch"].values == 0][-1]      # P1 beyond the doubling: unstable
 
 
-def _compliance_shift(rig: camdyn.Rig, samples: int = 20000) -> float:
-    """The relative shift of the contact-loss speed by the contact's compliance, to first order.
-
-    Rigid contact needs the moment M_c(Theta) = I alpha_i''(Theta) Omega^2 + M_s(Theta) >= 0
-    (camdyn.analysis.contact_loss_speed); it vanishes first at Theta*, its minimum, at Omega_ik.
-    A compliant contact deflects by delta = -M_c / K into the cam (quasi-static, K = I vartheta^2
-    the linearized stiffness, Eq. 23, dominated by the contact's), so the follower accelerates by
-    delta'' = -Omega^2 M_c''(Theta) / K more, and needs I delta'' more moment: at Theta* that is
-    -I Omega^2 M_c'' / K < 0, the contact lets go already at Omega_ik.  With dM_c/d(Omega^2) =
-    I alpha_i''(Theta*) < 0 the loss speed moves by
-        (Omega - Omega_ik) / Omega_ik = -M_c''(Theta*) / (2 K |alpha_i''(Theta*)|) = -(1/2) (Omega/vartheta)^2 m
-    with m = M_c'' / (I |alpha_i''| Omega^2), a number of the cam's profile.
-    """
-    kernels = _static_scene("line").kernels()
-    p = static_parameters(rig, kernels)
-    omega = camdyn.contact_loss_speed(rig) * 2 * math.pi / 60
-    theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
-    _, _, curvature, spring = np.array([kernels.rigid_contact(th, p) for th in theta]).T
-    M = rig.I_Pb * curvature * omega ** 2 + spring
-    k, h = int(np.argmin(M)), theta[1] - theta[0]
-    M2 = (M[k - 1] - 2 * M[k] + M[(k + 1) % samples]) / h ** 2
-    vartheta = Model(rig, SCENE, camdyn.ConstantSpeed(0.0)).equilibrium.vartheta
-    return -0.5 * M2 / (rig.I_Pb * vartheta ** 2 * abs(curvature[k]))
-
-
 @pytest.mark.parametrize("preset, phase_fraction", [("example", 0.5), ("reference", 0.75)])
 def test_grazing_is_the_inverse_kinematics_speed_less_the_contact_compliance(preset, phase_fraction):
     """The permanent-contact branch over 0.9-1.1 x the contact-loss speed L; the section where
@@ -161,7 +135,7 @@ def test_grazing_is_the_inverse_kinematics_speed_less_the_contact_compliance(pre
     ds = continue_orbit(rig, SCENE, "speed_rpm", 0.9 * loss, 1.1 * loss, phase_fraction=phase_fraction)
     grazing = _events(ds, "grazing")
     assert len(grazing) == 1
-    shift = _compliance_shift(rig)          # example: -2.30e-5 (-0.023 rev/min); reference: -1.19e-4 (-0.24)
+    shift = compliance_shift(rig, SCENE)          # example: -2.30e-5 (-0.023 rev/min); reference: -1.19e-4 (-0.24)
     assert shift < 0
     speed = grazing[0][1]
     # measured (speed - L) / L: example -2.15e-5, reference -1.235e-4: the first-order shift to 7 % and 4 %;

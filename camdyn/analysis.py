@@ -147,7 +147,7 @@ def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 200
     accelerates by delta'' = -Omega^2 M_c''(Theta) / K more and needs I_Pb delta'' more moment:
     at Theta* that is -I_Pb Omega^2 M_c'' / K < 0.  With dM_c/d(Omega^2) = I_Pb alpha_i''(Theta*) < 0,
     the loss speed moves by ``-M_c''(Theta*) / (2 K |alpha_i''(Theta*)|)``, that is
-    -(1/2) (Omega/vartheta)^2 m with m = M_c'' / (I_Pb |alpha_i''| Omega^2), a number of the
+    ``-(1/2) (Omega/vartheta)^2 m`` with ``m = M_c'' / (I_Pb |alpha_i''| Omega^2)``, a number of the
     cam's profile.  ``scene`` gives vartheta (default: line contact, damping D, Coulomb).
     Returns 0 when the follower never leaves the cam (no decelerating cam angle).
     """

@@ -34,9 +34,9 @@ arclength:
   through +1 at a crossing of branches);
 * ``period_doubling``: det(M + I) changes sign (a real multiplier through -1);
 * ``neimark_sacker``: det M - 1 changes sign between points with a complex pair (``|mu|^2 = det M``);
-* ``multiplier_jump``: one of the above test functions changed sign but the located orbit's
-  multipliers are not at the critical value (within ``CRITICAL``): they jumped, the map is not
-  smooth there (no branch is switched to);
+* ``multiplier_jump``: one of the above test functions changed sign but the multipliers jump
+  across the located bracket, or are not at the critical value there (``CRITICAL``): the map
+  is not smooth there (no branch is switched to);
 * ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
   over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
   generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
@@ -76,9 +76,9 @@ GAP_SAMPLES = 256
 #: function changed sign but the located orbit's multipliers are not critical (the map is not
 #: smooth there: the multipliers jump, e.g. where the orbit meets a new switching surface)
 EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing", "multiplier_jump")
-#: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value:
-#: bisection to locate_tol puts it within ~``|d mu / ds| locate_tol`` (~1e-5) of it, unless the
-#: multipliers jump across the bracket
+#: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value,
+#: and the multipliers on both sides of the bracket differ by less: bisection to locate_tol puts
+#: them within ~``|d mu / ds| locate_tol`` (~1e-5) of each other, unless they jump
 CRITICAL = 1e-2
 #: bisection in arclength stops after this many halvings of the bracket
 MAX_BISECTIONS = 40
@@ -325,11 +325,11 @@ def _changed(a: float, b: float) -> bool:
     return math.isfinite(a) and math.isfinite(b) and a * b < 0
 
 
-def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings) -> Point:
+def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings):
     """Bisection in arclength over [0, ds] from p on the sign of ``kind``'s test function: the
-    point just past the event, within ``locate_tol`` of it.  A step whose corrector fails counts
-    as past the event (the map is not smooth beyond a grazing); when the bracket's far end is
-    such a failure, the point just before it is returned."""
+    points on both sides of the event, ``locate_tol`` apart (after: None when the far end is a
+    failure).  A step whose corrector fails counts as past the event (the map is not smooth
+    beyond a grazing)."""
     sign0 = math.copysign(1.0, _tests(p)[kind])
     lo, hi, before, after = 0.0, ds, p, None
     for _ in range(MAX_BISECTIONS):
@@ -342,7 +342,7 @@ def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings) -
             lo, before = mid, q
         else:
             hi, after = mid, q
-    return after or before
+    return before, after
 
 
 def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], periods, scale, settings):
@@ -354,18 +354,26 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
             continue
         if kind == "branch_point" and _changed(f0["fold"], f1["fold"]):
             continue                                   # the +1 multiplier of the fold itself
-        e = _locate(problem, p, ds, kind, periods, scale, settings)
+        before, after = _locate(problem, p, ds, kind, periods, scale, settings)
+        e = after or before
         mu = _multipliers(e.jacobian)
-        named = kind if _critical(kind, mu) else "multiplier_jump"
+        named = kind if _smooth(kind, before, after) else "multiplier_jump"
         events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap), e, p, q))
     return events
 
 
-def _critical(kind: str, mu: np.ndarray) -> bool:
-    """Whether the multipliers at a located event have the kind's critical value (CRITICAL)."""
+def _smooth(kind: str, before: Point, after: Point | None) -> bool:
+    """Whether an event of the multipliers is a bifurcation: at the located orbit the kind's
+    critical multiplier (+1, -1, modulus 1) is within CRITICAL, and the multipliers on both
+    sides of the bracket (``locate_tol`` apart) differ by less than CRITICAL (they do not jump)."""
+    if kind == "grazing":
+        return True
+    e = after or before
+    mu = _multipliers(e.jacobian)
     distance = {"fold": np.abs(mu - 1.0), "branch_point": np.abs(mu - 1.0), "period_doubling": np.abs(mu + 1.0),
-                "neimark_sacker": np.abs(np.abs(mu) - 1.0)}.get(kind)
-    return distance is None or float(np.min(distance)) < CRITICAL
+                "neimark_sacker": np.abs(np.abs(mu) - 1.0)}[kind]
+    jump = 0.0 if after is None else float(np.max(np.abs(mu - _multipliers(before.jacobian))))
+    return float(np.min(distance)) < CRITICAL and jump < CRITICAL
 
 
 def _multipliers(J: np.ndarray) -> np.ndarray:

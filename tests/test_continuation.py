@@ -26,7 +26,7 @@ from camdyn.continuation import (EVENTS, ContinuationOutcome, ContinuationSettin
                                  events_table)
 from camdyn.errors import ParameterError
 from camdyn.model import Model
-from camdyn.section_map import StroboscopicMap
+from camdyn.section_map import StroboscopicMap, finite_differences
 from camdyn.sweep import bifurcation
 
 RIG = camdyn.example_rig()
@@ -169,6 +169,27 @@ def test_a_fold_turns_the_branch_back_and_a_jump_of_the_multipliers_is_not_a_bif
     # the fold's multiplier is +1: located by bisection to 1e-6 of the range in arclength
     assert np.min(np.abs(ds["event_multiplier_real"].values[0] - 1.0)) < 1e-3
     assert ds["stable"].values[:fold].all() and not ds["stable"].values[fold + 1:].any()
+
+
+def test_any_jacobian_provider_plugs_in(pd_branch):
+    """A provider factory (map, scale) -> (x -> (P(x), dP/dx)) replaces the default, as the
+    variational one with saltation matrices will: here finite differences with a step 10 times
+    smaller, counted."""
+    calls = []
+
+    def counted(section_map, scale):
+        provider = finite_differences(section_map, scale, step_factor=0.1)
+
+        def call(x):
+            calls.append(1)
+            return provider(x)
+        return call
+
+    ds = continue_orbit(RIG, SCENE, "speed_rpm", 1650.0, 1700.0, jacobian=counted)
+    assert calls and ds.attrs["branch_0_message"] == ContinuationOutcome.END_REACHED.message
+    i = int(np.argmin(np.abs(pd_branch["lambda"].values - 1650.0)))        # the common first orbit
+    # the noise part of a central difference grows as 1/h: ~10 rtol^(2/3) = 2e-6 here; 1e-4 is 50 x that
+    assert ds["multiplier_real"].values[0] == pytest.approx(pd_branch["multiplier_real"].values[i], abs=1e-4)
 
 
 def test_a_rig_parameter_is_continued_at_a_fixed_speed():

@@ -136,6 +136,37 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     return math.sqrt(omega2) / RPM
 
 
+def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 20000) -> float:
+    """The relative shift of the contact-loss speed by the contact's compliance, to first order:
+    ``(Omega_loss - Omega_ik) / Omega_ik`` (negative: a compliant contact lets go earlier).
+
+    Rigid contact needs the moment M_c(Theta) = I_Pb alpha_i''(Theta) Omega^2 + F_s d_x >= 0
+    (:func:`contact_loss_speed`); it vanishes first at Theta*, its minimum, at Omega_ik.  A
+    compliant contact deflects by delta = -M_c / K into the cam (quasi-static; K = I_Pb vartheta^2,
+    the linearized stiffness of Eq. 23, which the contact's dominates), so the follower
+    accelerates by delta'' = -Omega^2 M_c''(Theta) / K more and needs I_Pb delta'' more moment:
+    at Theta* that is -I_Pb Omega^2 M_c'' / K < 0.  With dM_c/d(Omega^2) = I_Pb alpha_i''(Theta*) < 0,
+    the loss speed moves by ``-M_c''(Theta*) / (2 K |alpha_i''(Theta*)|)``, that is
+    ``-(1/2) (Omega/vartheta)^2 m`` with ``m = M_c'' / (I_Pb |alpha_i''| Omega^2)``, a number of the
+    cam's profile.  ``scene`` gives vartheta (default: line contact, damping D, Coulomb).
+    Returns 0 when the follower never leaves the cam (no decelerating cam angle).
+    """
+    loss = contact_loss_speed(rig)
+    if not math.isfinite(loss) or loss == 0:
+        return 0.0
+    scene = scene or Scene(contact="line", damping="D", friction="coulomb")
+    K = _static_scene(scene.contact).kernels()
+    p = static_parameters(rig, K)
+    omega = loss * RPM
+    theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
+    _, _, curvature, spring = np.array([K.rigid_contact(th, p) for th in theta]).T
+    M = rig.I_Pb * curvature * omega ** 2 + spring
+    k, h = int(np.argmin(M)), theta[1] - theta[0]
+    M2 = (M[k - 1] - 2 * M[k] + M[(k + 1) % samples]) / h ** 2
+    vartheta = Model(rig, scene, ConstantSpeed(0.0)).equilibrium.vartheta
+    return float(-0.5 * M2 / (rig.I_Pb * vartheta ** 2 * abs(curvature[k])))
+
+
 def energy_balance_peak(rig: Rig, speed_rpm: float, xi: float, *, potential: str = "printed",
                         contact: str = "line") -> float:
     """alpha_rp from the approximate energy balance of Section 5 (Eqs. 30-33).

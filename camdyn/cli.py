@@ -523,6 +523,42 @@ def cmd_lyapunov(args) -> int:
     return EXIT_OK
 
 
+# --- continue --------------------------------------------------------------------------
+def cmd_continue(args) -> int:
+    from .continuation import SPEED, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
+    from .engine.config import SolverOptions
+
+    rig, scene = _rig(args), _scene(args)
+    if args.param != SPEED and args.speed_rpm is None:
+        raise UsageError(f"--param {args.param} is continued at a constant cam speed: give --speed-rpm")
+    if args.param == SPEED and args.speed_rpm is not None:
+        raise UsageError("--speed-rpm is for a rig parameter's continuation; the speed itself runs from --start "
+                         "to --end")
+    _check_outputs(args, "netcdf", "plot")
+    kwargs = dict(speed_rpm=args.speed_rpm, periods=args.periods, phase_fraction=args.phase_fraction,
+                  warmup_revolutions=args.warmup, settings=ContinuationSettings(max_points=args.max_points),
+                  options=SolverOptions(rtol=args.rtol, atol=args.atol))
+    if args.backend:
+        kwargs["backend"] = args.backend
+    with _busy("continuing the branch", args):
+        ds = continue_orbit(rig, scene, args.param, args.start, args.end, **kwargs)
+    unit = ds.attrs["parameter_units"]
+    print(f"continuation of {scene.slug} on rig {rig.name!r} in {args.param} ({unit}): {ds.sizes['point']} orbits "
+          f"on {ds.sizes['branch']} branch(es)")
+    for i in range(ds.sizes["branch"]):
+        print(f"  branch {i} (period {int(ds['branch_periods'][i])} T): {ds.attrs[f'branch_{i}_message']}")
+    print("event,parameter,branch,point" if ds.sizes["event"] else "no events")
+    for kind, lam, branch, point in events_table(ds):
+        print(f"{kind},{lam:.8g},{branch},{point}")
+    if args.netcdf:
+        ds.to_netcdf(args.netcdf, engine="scipy")
+        print(f"  wrote {args.netcdf}")
+    if args.plot:
+        _save_figure(_plot_modules().branches(ds), args.plot)
+    started = int(ds["branch_outcome"][0]) != list(ContinuationOutcome).index(ContinuationOutcome.START_FAILED)
+    return EXIT_OK if started else EXIT_INCOMPLETE
+
+
 # --- sweep ---------------------------------------------------------------------------
 def _sweep_module():
     try:
@@ -1156,6 +1192,40 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--skip-invalid", action="store_true", dest="skip_invalid",
                    help="record invalid grid points (outcome INVALID) and run the others")
     _add_file(g, "--plot", "plot", "save the bifurcation diagram or contact map (.png, .pdf, .svg...)")
+
+    p = command("continue", "follow a branch of periodic orbits in cam speed or a rig parameter, with its bifurcations",
+                "examples:\n"
+                "  camdyn continue --start 1650 --end 1850 --netcdf branch.nc --plot branch.png\n"
+                "  camdyn continue --start 900 --end 1050 --phase-fraction 0.5     # up to grazing\n"
+                "  camdyn continue --param k_s --start 2000 --end 4000 --speed-rpm 1500\n\n"
+                "Pseudo-arclength continuation of the fixed points of the stroboscopic map\n"
+                "(camdyn.continuation), from the orbit found by shooting at --start after --warmup\n"
+                "revolutions. Prints how each branch ended and the events (fold, branch_point,\n"
+                "period_doubling, neimark_sacker, grazing) with their parameter values, as CSV. At a period\n"
+                "doubling the doubled branch is continued too. The section is at --phase-fraction of the\n"
+                "cam period (0: the sections of 'camdyn sweep'; where the orbit sits on a switching surface\n"
+                "there, e.g. in permanent contact at the 0-state, choose another).", cmd_continue)
+    _add_physics(p)
+    g = p.add_argument_group("continuation")
+    g.add_argument("--param", default="speed_rpm", metavar="NAME",
+                   help="speed_rpm (rev/min) or a rig parameter (SI), e.g. k_s, e (default: speed_rpm)")
+    g.add_argument("--start", type=float, required=True, help="the parameter's start value")
+    g.add_argument("--end", type=float, required=True, help="the parameter's end value")
+    g.add_argument("--speed-rpm", type=float, dest="speed_rpm", metavar="S",
+                   help="the constant cam speed (rev/min) when --param is a rig parameter")
+    g.add_argument("--periods", type=int, default=1, help="period of the orbit in cam periods (default: 1)")
+    g.add_argument("--phase-fraction", type=float, default=0.0, dest="phase_fraction", metavar="F",
+                   help="the section's time after each revolution's start, a fraction of T (default: 0)")
+    g.add_argument("--warmup", type=int, default=20, metavar="N",
+                   help="revolutions from the static equilibrium before the first orbit's search (default: 20)")
+    g.add_argument("--max-points", type=int, default=400, dest="max_points", metavar="N",
+                   help="at most this many orbits per branch (default: 400)")
+    g.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default: 1e-10)")
+    g.add_argument("--atol", type=float, default=1e-13, help="absolute tolerance (default: 1e-13)")
+    g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
+                   help="who runs the engine's loop: %(choices)s")
+    _add_file(g, "--netcdf", "netcdf", "save the branches and events as NetCDF (.nc)")
+    _add_file(g, "--plot", "plot", "save the branches with their events (.png, .pdf, .svg...)")
 
     p = command("regenerate", "regenerate the model code from derive/ (needs camdyn[derive])",
                 "examples:\n"

@@ -10,6 +10,8 @@ without it, and a call says how to install it.
 * :func:`spectrum`      amplitude spectra with the harmonics of Omega_c marked (Figs. 6b, 10, 16)
 * :func:`poincare`      phase plane with the once-per-revolution Poincare section
 * :func:`bifurcation`   Poincare section against cam speed
+* :func:`branches`      continued branches (stable solid, unstable dashed) and their events,
+                        over a brute-force bifurcation diagram
 * :func:`contact_map`   sliding / impacting regimes over (cam speed, k_s) (Fig. 9)
 * :func:`work_precision` error against run time, one line per solver set-up
 
@@ -28,7 +30,7 @@ from .metadata import units as _units
 
 __all__ = ["PAPER_STYLE", "QUANTITIES", "MIN_FONT_PT", "REGIME_CODES", "style", "run_title", "time_history",
            "overview", "spectrum", "whole_period_samples", "poincare_section", "poincare", "bifurcation",
-           "contact_map", "work_precision"]
+           "branches", "contact_map", "work_precision"]
 
 #: rcParams of the paper-like look: thin lines, inward ticks on all sides, no frame on legends.
 PAPER_STYLE = {
@@ -417,6 +419,60 @@ def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: floa
             ax.axvline(contact_loss_rpm, color="#c0392b", lw=1.0, ls="--",
                        label=f"contact loss (inverse kinematics): {contact_loss_rpm:.4g} rev/min")
             ax.legend(loc="best", frameon=True, framealpha=0.9)
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+#: the marker of each event kind of :func:`camdyn.continuation.continue_orbit`
+EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neimark_sacker": "o", "grazing": "v",
+                 "multiplier_jump": "x"}
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:
+    """Maximal runs [i, j] of equal flags, each sharing its last index with the next run's first."""
+    cuts = [0] + [k for k in range(1, flags.size) if flags[k] != flags[k - 1]] + [flags.size]
+    return [(a, min(b, flags.size - 1), bool(flags[a])) for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+def branches(ds, *, diagram=None, contact_loss_rpm: float | None = None, ax=None, title: str | None = None):
+    """Continued branches (:func:`camdyn.continuation.continue_orbit`) against their parameter: alpha
+    at the starts of the orbit's revolutions (the brute-force diagram's sections), solid where
+    the orbit is stable, dashed where not, one colour per period; the events marked and named.
+
+    ``diagram``: the Dataset of :func:`camdyn.sweep.bifurcation` drawn underneath (points), for
+    a continuation in speed_rpm.  ``contact_loss_rpm`` as in :func:`bifurcation`.
+    """
+    scale, unit_label = _prefix(ds["alpha_revolution"].values, "rad")
+    if diagram is not None:
+        fig = bifurcation(diagram["speed_rpm"].values, diagram["alpha_section"], ax=ax,
+                          contact_loss_rpm=contact_loss_rpm, title=title)
+        ax = fig.axes[0]
+        scale, unit_label = _prefix(diagram["alpha_section"].values, "rad")     # the diagram's axis
+    kinds = ds.attrs["event_kinds"].split()
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(6.4, 3.4))
+        lam, stable = ds["lambda"].values, ds["stable"].values.astype(bool)
+        alphas = ds["alpha_revolution"].values / scale
+        colours = ["k", "#2e75b6", "#548235", "#7030a0"]
+        for b in np.unique(ds["branch"].values):
+            idx = np.flatnonzero(ds["branch"].values == b)
+            n = int(ds["periods"].values[idx[0]])
+            colour = colours[min(n.bit_length() - 1, len(colours) - 1)]
+            for i, j, ok in _runs(stable[idx]):
+                rows = idx[i:j + 1]
+                ax.plot(lam[rows], alphas[rows, :n], color=colour, lw=1.0, ls="-" if ok else "--")
+            ax.plot([], [], color=colour, lw=1.0, ls="-", label=f"period {n} T (dashed: unstable)")
+        for k, kind in enumerate(kinds):
+            sel = ds["event_kind"].values == k
+            if np.any(sel):
+                y = ds["event_alpha_revolution"].values[sel] / scale
+                x = np.repeat(ds["event_lambda"].values[sel][:, None], y.shape[1], axis=1)
+                ax.plot(x.ravel(), y.ravel(), EVENT_MARKERS.get(kind, "x"), mfc="none", color="#c0392b", ms=6,
+                        label=kind.replace("_", " "))
+        unit = ds["lambda"].attrs.get("units", "")
+        ax.set(xlabel=f"{ds.attrs['parameter']} ({unit})", ylabel=rf"$\alpha$ once per revolution ({unit_label})")
+        ax.legend(loc="best", frameon=True, framealpha=0.9)
         if title:
             ax.set_title(title)
     return fig

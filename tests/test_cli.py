@@ -145,6 +145,20 @@ def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
     assert "whole --revolutions" in capsys.readouterr().err
 
 
+def test_continue_prints_the_events_and_writes_netcdf(tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    nc = tmp_path / "branch.nc"
+    assert main(["continue", "--start", "1650", "--end", "1750", "--netcdf", str(nc)]) == 0
+    out = capsys.readouterr().out
+    # the example rig's period doubling (tests/test_continuation.py: 1710.2 rev/min)
+    rows = [line.split(",") for line in out.splitlines() if line.startswith("period_doubling,")]
+    assert rows and 1700 < float(rows[0][1]) < 1720
+    assert "branch 1 (period 2 T)" in out and str(nc) in out
+    with xr.open_dataset(nc, engine="scipy") as ds:
+        assert ds.attrs["parameter"] == "speed_rpm" and ds["lambda"].attrs["units"] == "rev/min"
+        assert ds.sizes["event"] == len(rows)
+
+
 def test_scenes_lists_generated_scenes(capsys):
     assert main(["scenes", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
@@ -152,7 +166,7 @@ def test_scenes_lists_generated_scenes(capsys):
     assert "friction" in data["options"]
 
 
-COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "lyapunov", "sweep",
+COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "lyapunov", "sweep", "continue",
             "regenerate", "reproduce", "scenes"]
 
 
@@ -196,6 +210,8 @@ def test_errors_are_one_line_with_exit_code_2(tmp_path, capsys):
     (["sweep", "--speeds", "1000", "--param", "k_x", "--values", "1,2"], "not a rig parameter"),
     (["sweep", "--speeds", "1000", "--values", "1,2"], "needs --param"),
     (["spectrum", "--input", "nothere.csv"], "no such file"),
+    (["continue", "--start", "1000", "--end", "1000"], "other than start"),
+    (["continue", "--param", "k_s", "--start", "1000", "--end", "2000"], "give --speed-rpm"),
     (["regenerate", "--derive", "."], "not a camdyn derive/ folder"),
 ])
 def test_bad_input_is_one_line_and_exit_code_2(argv, words, capsys):

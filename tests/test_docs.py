@@ -16,7 +16,7 @@ import camdyn
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 #: the public modules the reference must cover (the engine's modules join after its rewrite)
-MODULES = ["analysis", "orbits", "quasistatic", "stopping", "section_map", "tangent", "lyapunov", "chaos01", "sweep", "ondemand", "plots", "signal", "cam", "rig", "result", "outcome", "errors", "metadata", "files"]
+MODULES = ["analysis", "orbits", "quasistatic", "stopping", "section_map", "tangent", "lyapunov", "continuation", "chaos01", "sweep", "ondemand", "plots", "signal", "cam", "rig", "result", "outcome", "errors", "metadata", "files"]
 
 
 @pytest.fixture(scope="module")

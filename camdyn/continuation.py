@@ -1,0 +1,693 @@
+"""Pseudo-arclength continuation of periodic orbits, with bifurcation and grazing detection.
+
+A periodic orbit of period n T is a fixed point of the stroboscopic map P_n
+(:mod:`camdyn.orbits`).  As a parameter lambda (the cam speed ``speed_rpm``, or any rig
+parameter by name: ``k_s``, ``e``, ...) changes, the fixed points form branches
+``G(x, lambda) = P_n(x; lambda) - x = 0`` that may turn back at folds, where a search at fixed
+lambda fails.  :func:`continue_orbit` follows a branch in the unknowns z = (x, lambda), scaled
+as ``(x / s, lambda / |end - start|)`` (s the size of the motion, as in :mod:`camdyn.orbits`):
+
+* **predictor**: z_pred = z_k + ds t_k, with t_k the unit tangent, the null vector of the
+  scaled Jacobian [dP/dx - I, dP/dlambda] (from its SVD), oriented along the previous one;
+* **corrector**: Newton's method on ``G(z) = 0, t_k . (z - z_pred) = 0`` (the arclength
+  condition: the correction is orthogonal to the tangent), stopping at the scaled residual
+  ``max_j |P_j(x) - x_j| / s_j <= tol``;
+* **derivatives**: dP/dx from any Jacobian provider (:func:`camdyn.section_map.finite_differences`
+  by default; the variational equations can replace it); dP/dlambda by central differences in
+  lambda with the step ``h = rtol^(1/3) max(|lambda|, |end - start|)``, the rule of
+  :func:`camdyn.section_map.finite_difference_steps` (truncation error h^2 against the map's
+  noise rtol / h);
+* **step size**: halved when the corrector fails, grown by 1.5 when it converges in at most
+  ``easy_iterations`` steps, kept within [min_step, max_step] (scaled arclength).
+
+The map is rebuilt for each lambda (T = 60 / speed_rpm changes with the speed); the section
+is at ``phase_fraction`` T after each revolution's start, so that it stays at the same cam
+angle along the branch.
+
+**Detection.**  At every point the Floquet multipliers mu (eigenvalues of dP_n/dx) give test
+functions whose sign change between two points marks an event, located by bisection in
+arclength:
+
+* ``fold``: the lambda-component of the tangent changes sign (a multiplier passes +1 and the
+  branch turns back);
+* ``branch_point``: det(M - I) changes sign while the branch does not turn (a multiplier
+  through +1 at a crossing of branches);
+* ``period_doubling``: det(M + I) changes sign (a real multiplier through -1);
+* ``neimark_sacker``: det M - 1 changes sign between points with a complex pair (``|mu|^2 = det M``);
+* ``multiplier_jump``: one of the above test functions changed sign but the multipliers jump
+  across the located bracket, or are not at the critical value there (``CRITICAL``): the map
+  is not smooth there (no branch is switched to);
+* ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
+  over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
+  generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
+  parabola through the largest sample and its neighbours.
+
+At a period doubling the branch of period 2 n T is switched to: Newton's method on P_2n from
+x* +/- eps v (v the eigenvector of the multiplier near -1) on the side where P_n is unstable,
+then on the other side, and that branch is continued too.
+
+The result is an ``xarray.Dataset`` (:func:`continue_orbit`): dims ``point`` (every orbit on
+every branch), ``multiplier``, ``revolution`` and ``event``.
+"""
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from .cam import ConstantSpeed
+from .engine.config import SolverOptions
+from .engine.driver import integrate
+from .errors import CamdynError, ParameterError
+from .model import Model
+from .orbits import ShootingSettings, newton, periodic_orbit
+from .rig import PARAMETERS, Rig
+from .scene import Scene
+from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
+
+#: the parameter name of the cam speed (rev/min); any other is a rig parameter (SI)
+SPEED = "speed_rpm"
+#: samples of psi_i per cam period for the orbit's largest gap (refined by a parabola)
+GAP_SAMPLES = 256
+#: event kinds, in the order the test functions are evaluated; ``multiplier_jump``: a test
+#: function changed sign but the located orbit's multipliers are not critical (the map is not
+#: smooth there: the multipliers jump, e.g. where the orbit meets a new switching surface)
+EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing", "multiplier_jump")
+#: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value,
+#: and the multipliers on both sides of the bracket differ by less: bisection to locate_tol puts
+#: them within ~``|d mu / ds| locate_tol`` (~1e-5) of each other, unless they jump
+CRITICAL = 1e-2
+#: bisection in arclength stops after this many halvings of the bracket
+MAX_BISECTIONS = 40
+#: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
+SWITCH_OFFSETS = (1e-3, 1e-2, 3e-2, 1e-1)
+
+
+class ContinuationOutcome(enum.Enum):
+    """How a branch ended (an actionable message each)."""
+
+    END_REACHED = "the branch reached the end value of the parameter"
+    LEFT_RANGE = ("the branch left the range at the start value (it turned back at a fold, or a switched "
+                  "branch ran toward the start); continue from another start value to follow it further")
+    MAX_POINTS = "max_points orbits were computed before the end value: raise max_points or max_step"
+    STEP_TOO_SMALL = ("the corrector failed at the minimum step (a non-smooth point such as grazing or a "
+                      "sliding bifurcation, or a failed run, see the message): the branch ends here; "
+                      "try another phase_fraction, a smaller min_step, or continue from beyond it")
+    START_FAILED = ("no periodic orbit at the start value (see the message): try another start value, "
+                    "phase_fraction or warmup_revolutions")
+
+    @property
+    def message(self) -> str:
+        return self.value
+
+
+@dataclass(frozen=True)
+class ContinuationSettings:
+    """Step control (in scaled arclength: the whole parameter range is 1) and the corrector's
+    tolerance; ``locate_tol``: events are bracketed to this arclength; ``switch_depth``: how many
+    period doublings deep branches are switched (0: none)."""
+
+    step: float = 0.01
+    min_step: float = 1e-5
+    max_step: float = 0.05
+    max_points: int = 400
+    tol: float = 1e-8
+    max_corrector: int = 8
+    easy_iterations: int = 3
+    locate_tol: float = 1e-6
+    switch_depth: int = 1
+
+    def __post_init__(self):
+        for name in ("step", "min_step", "max_step", "locate_tol"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 1:
+                raise ParameterError(name, v, "0 < value <= 1 (scaled arclength: the parameter range is 1)")
+        if not self.min_step <= self.step <= self.max_step:
+            raise ParameterError("step", self.step, f"min_step ({self.min_step}) <= step <= max_step ({self.max_step})")
+        ShootingSettings(self.tol, self.max_corrector)          # checks tol and max_corrector
+        for name, lo in (("max_points", 2), ("easy_iterations", 1), ("switch_depth", 0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= 100_000:
+                raise ParameterError(name, v, f"an integer, {lo} <= {name} <= 100000")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What is continued: the rig, scene, parameter and its range, the speed when the parameter
+    is a rig's, the period n and the section's phase (a fraction of T)."""
+
+    rig: Rig
+    scene: Scene
+    parameter: str
+    start: float
+    end: float
+    speed_rpm: float | None = None
+    periods: int = 1
+    phase_fraction: float = 0.0
+    options: SolverOptions = DEFAULT_OPTIONS
+    jacobian: object = finite_differences
+    backend: str = "compiled"
+
+    @property
+    def span(self) -> float:
+        return abs(self.end - self.start)
+
+    def model(self, lam: float) -> Model:
+        if self.parameter == SPEED:
+            return Model(self.rig, self.scene, ConstantSpeed(lam))
+        return Model(self.rig.replace(**{self.parameter: lam}), self.scene, ConstantSpeed(self.speed_rpm))
+
+    def section_map(self, lam: float, mode: int | None, periods: int | None = None) -> StroboscopicMap:
+        model = self.model(lam)
+        return StroboscopicMap(model, periods or self.periods, self.phase_fraction * model.period, mode,
+                               self.options, self.backend)
+
+
+class Point(NamedTuple):
+    """One orbit on a branch: lambda, x at the section, dP_n/dx, the unit tangent (scaled), the
+    largest gap (m), alpha at the revolutions' starts (the brute-force diagram's section), the
+    mode at the section, the scaled residual, the corrector's steps, and the arclength step that
+    reached it."""
+
+    lam: float
+    x: np.ndarray
+    jacobian: np.ndarray
+    tangent: np.ndarray
+    max_gap: float
+    alpha_revolutions: np.ndarray
+    mode: int
+    residual: float
+    iterations: int
+
+
+@dataclass
+class Branch:
+    """A continued branch: its points (in order), period, parent (-1: none), and outcome."""
+
+    periods: int
+    points: list = field(default_factory=list)
+    outcome: ContinuationOutcome | None = None
+    message: str = ""
+    parent: int = -1
+
+
+class Event(NamedTuple):
+    kind: str
+    lam: float
+    x: np.ndarray
+    branch: int
+    point: int            # the branch point just before the event (index into the Dataset's point)
+    multipliers: np.ndarray
+    alpha_revolutions: np.ndarray
+    max_gap: float
+
+
+class _Scaled(NamedTuple):
+    """G(z) scaled, the scaled Jacobian [dG/dx, dG/dlambda] (2 x 3), and dP/dx unscaled."""
+
+    G: np.ndarray
+    A: np.ndarray
+    J: np.ndarray
+
+
+def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale) -> _Scaled:
+    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure)."""
+    section_map = problem.section_map(lam, mode, periods)
+    P, J = problem.jacobian(section_map, scale)(x)
+    h = problem.options.rtol ** (1.0 / 3.0) * max(abs(lam), problem.span)
+    plus = problem.section_map(lam + h, mode, periods)(x)
+    minus = problem.section_map(lam - h, mode, periods)(x)
+    dP_dlam = (plus - minus) / (2.0 * h)
+    A = np.empty((2, 3))
+    A[:, :2] = (J - np.eye(2)) * scale[None, :] / scale[:, None]
+    A[:, 2] = dP_dlam * problem.span / scale
+    return _Scaled((P - x) / scale, A, J)
+
+
+def _tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
+    """The unit null vector of the 2 x 3 scaled Jacobian, oriented along ``previous``."""
+    t = np.linalg.svd(A)[2][-1]
+    return t if float(t @ previous) >= 0 else -t
+
+
+def _correct(problem, z_pred, direction, mode, periods, scale, settings):
+    """Newton's method on G(z) = 0, direction . (z - z_pred) = 0: (z, evaluation, iterations),
+    or None when it fails (a run fails, the residual grows, or max_corrector is reached)."""
+    z, last = z_pred.copy(), math.inf
+    for it in range(settings.max_corrector + 1):
+        lam, x = z[2] * problem.span, z[:2] * scale
+        try:
+            ev = _evaluate(problem, lam, x, mode, periods, scale)
+        except CamdynError:            # a failed run, or a rig value the rig refuses
+            return None
+        r = float(np.max(np.abs(ev.G)))
+        if not math.isfinite(r) or (it >= 2 and r > last):
+            return None
+        if r <= settings.tol:
+            return z, ev, it
+        last = r
+        H = np.vstack([ev.A, direction])
+        rhs = np.concatenate([ev.G, [direction @ (z - z_pred)]])
+        try:
+            z = z - np.linalg.solve(H, rhs)
+        except np.linalg.LinAlgError:
+            return None
+    return None
+
+
+def _gap(problem: Problem, lam: float, x, mode: int, periods: int):
+    """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end mode."""
+    model = problem.model(lam)
+    T = model.period
+    t0 = problem.phase_fraction * T
+    t1 = t0 + periods * T
+    samples = np.linspace(t0, t1, GAP_SAMPLES * periods + 1)
+    starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
+    t_eval = np.unique(np.concatenate([samples, starts]))
+    tr = integrate(model, (t0, t1), x, t_eval, problem.options, mode=mode, backend=problem.backend)
+    if not tr.outcome.ok or tr.t.size != t_eval.size:
+        raise MapFailure(f"the run along the orbit failed: {tr.outcome.message}", tr.outcome)
+    K = model.kernels
+    out = np.empty(len(K.OUTPUTS))
+    psi = np.empty(t_eval.size)
+    for i in range(t_eval.size):
+        K.outputs(int(tr.mode[i]), float(tr.t[i]), float(tr.y[0, i]), float(tr.y[1, i]), model.p, out)
+        psi[i] = out[K.OUT_PSI_I]
+    alpha_revs = tr.y[0, np.searchsorted(t_eval, starts)]
+    return _refined_max(psi), alpha_revs, int(tr.end_mode)
+
+
+def _refined_max(v: np.ndarray) -> float:
+    """The largest value of a periodic sampled curve, refined by a parabola through its neighbours."""
+    v = v[:-1]                              # the last sample repeats the first (one period)
+    k = int(np.argmax(v))
+    a, b, c = v[k - 1], v[k], v[(k + 1) % v.size]
+    curvature = a - 2 * b + c
+    return float(b - (a - c) ** 2 / (8 * curvature)) if curvature < 0 else float(b)
+
+
+def _point(problem, z, ev, tangent, mode, periods, scale, iterations) -> Point:
+    lam, x = float(z[2] * problem.span), z[:2] * scale
+    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
+    return Point(lam, x.copy(), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))), iterations)
+
+
+def _z(problem, p: Point, scale) -> np.ndarray:
+    return np.concatenate([p.x / scale, [p.lam / problem.span]])
+
+
+def _step(problem, p: Point, ds, periods, scale, settings) -> Point | None:
+    """The point at arclength ds from p along its tangent, corrected; None when it fails."""
+    z_pred = _z(problem, p, scale) + ds * p.tangent
+    found = _correct(problem, z_pred, p.tangent, p.mode, periods, scale, settings)
+    if found is None:
+        return None
+    z, ev, it = found
+    try:
+        return _point(problem, z, ev, _tangent(ev.A, p.tangent), p.mode, periods, scale, it)
+    except MapFailure:
+        return None
+
+
+# --- detection -----------------------------------------------------------------------------------
+def _tests(p: Point) -> dict[str, float]:
+    """The test functions at a point (2 x 2 monodromy: det(M -+ I) = det M -+ tr M + 1)."""
+    M = p.jacobian
+    det, tr = float(np.linalg.det(M)), float(np.trace(M))
+    return {"fold": float(p.tangent[2]), "branch_point": det - tr + 1.0, "period_doubling": det + tr + 1.0,
+            "neimark_sacker": det - 1.0 if tr * tr - 4.0 * det < 0 else math.nan, "grazing": p.max_gap}
+
+
+def _changed(a: float, b: float) -> bool:
+    return math.isfinite(a) and math.isfinite(b) and a * b < 0
+
+
+def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings):
+    """Bisection in arclength over [0, ds] from p on the sign of ``kind``'s test function: the
+    points on both sides of the event, ``locate_tol`` apart (after: None when the far end is a
+    failure).  A step whose corrector fails counts as past the event (the map is not smooth
+    beyond a grazing)."""
+    sign0 = math.copysign(1.0, _tests(p)[kind])
+    lo, hi, before, after = 0.0, ds, p, None
+    for _ in range(MAX_BISECTIONS):
+        if hi - lo <= settings.locate_tol:
+            break
+        mid = 0.5 * (lo + hi)
+        q = _step(problem, p, mid, periods, scale, settings)
+        f = math.nan if q is None else _tests(q)[kind]
+        if math.isfinite(f) and math.copysign(1.0, f) == sign0:
+            lo, before = mid, q
+        else:
+            hi, after = mid, q
+    return before, after
+
+
+def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], periods, scale, settings):
+    """The events between consecutive points p and q (ds apart), located; ``where``: (branch, index of p)."""
+    f0, f1 = _tests(p), _tests(q)
+    events = []
+    for kind in f0:
+        if not _changed(f0[kind], f1[kind]):
+            continue
+        if kind == "branch_point" and _changed(f0["fold"], f1["fold"]):
+            continue                                   # the +1 multiplier of the fold itself
+        before, after = _locate(problem, p, ds, kind, periods, scale, settings)
+        e = after or before
+        mu = _multipliers(e.jacobian)
+        named = kind if _smooth(kind, before, after) else "multiplier_jump"
+        events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap), e, p, q))
+    return events
+
+
+def _smooth(kind: str, before: Point, after: Point | None) -> bool:
+    """Whether an event of the multipliers is a bifurcation: at the located orbit the kind's
+    critical multiplier (+1, -1, modulus 1) is within CRITICAL, and the multipliers on both
+    sides of the bracket (``locate_tol`` apart) differ by less than CRITICAL (they do not jump)."""
+    if kind == "grazing":
+        return True
+    e = after or before
+    mu = _multipliers(e.jacobian)
+    distance = {"fold": np.abs(mu - 1.0), "branch_point": np.abs(mu - 1.0), "period_doubling": np.abs(mu + 1.0),
+                "neimark_sacker": np.abs(np.abs(mu) - 1.0)}[kind]
+    jump = 0.0 if after is None else float(np.max(np.abs(mu - _multipliers(before.jacobian))))
+    return float(np.min(distance)) < CRITICAL and jump < CRITICAL
+
+
+def _multipliers(J: np.ndarray) -> np.ndarray:
+    mu = np.linalg.eigvals(J).astype(complex)
+    return mu[np.argsort(-np.abs(mu))]
+
+
+# --- following a branch ----------------------------------------------------------------------------
+def _clipped(problem, p: Point, ds: float) -> float:
+    """ds shortened so that the predictor stops at the end of the range it moves toward."""
+    t_lam = p.tangent[2]
+    if abs(t_lam) < 1e-12:
+        return ds
+    bound = max(problem.start, problem.end) if t_lam > 0 else min(problem.start, problem.end)
+    reach = (bound - p.lam) / problem.span / t_lam
+    return min(ds, reach) if reach > 0 else ds
+
+
+def _left(problem, lam: float) -> ContinuationOutcome | None:
+    """END_REACHED or LEFT_RANGE once lambda is at or past an end of the range (1e-9 of it)."""
+    slack = 1e-9 * problem.span
+    for bound, outcome in ((problem.end, ContinuationOutcome.END_REACHED),
+                           (problem.start, ContinuationOutcome.LEFT_RANGE)):
+        other = problem.start if bound == problem.end else problem.end
+        if (lam - bound) * math.copysign(1.0, bound - other) >= -slack:
+            return outcome
+    return None
+
+
+def _follow(problem, branch: Branch, index: int, first: Point, scale, settings, events: list):
+    """Continue ``branch`` from ``first`` until it leaves the range, fails, or max_points."""
+    p, ds = first, settings.step
+    branch.points.append(p)
+    while True:
+        if len(branch.points) >= settings.max_points:
+            branch.outcome = ContinuationOutcome.MAX_POINTS
+            return
+        step = _clipped(problem, p, ds)
+        q = _step(problem, p, step, branch.periods, scale, settings)
+        if q is None:
+            if ds <= settings.min_step:
+                branch.outcome = ContinuationOutcome.STEP_TOO_SMALL
+                branch.message = f"at {problem.parameter} = {p.lam:.8g}"
+                return
+            ds = max(ds / 2.0, settings.min_step)
+            continue
+        where = (index, len(branch.points) - 1)
+        events += _detect(problem, p, q, step, where, branch.periods, scale, settings)
+        branch.points.append(q)
+        done = _left(problem, q.lam)
+        if done is not None:
+            branch.outcome = done
+            return
+        if q.iterations <= settings.easy_iterations:
+            ds = min(1.5 * ds, settings.max_step)
+        p = q
+
+
+def _first_point(problem, lam, x, mode, periods, scale, direction: float) -> Point:
+    """The point (lam, x) with its tangent oriented toward increasing lambda times ``direction``."""
+    ev = _evaluate(problem, lam, x, mode, periods, scale)
+    tangent = _tangent(ev.A, np.array([0.0, 0.0, direction]))
+    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
+    return Point(lam, np.asarray(x, dtype=float).copy(), ev.J, tangent, gap, alphas, end_mode,
+                 float(np.max(np.abs(ev.G))), 0)
+
+
+def _switch(problem, e: Point, p: Point, q: Point, periods: int, scale, settings):
+    """The period-2n orbit next to a period doubling located at ``e`` between p and q: Newton on
+    P_2n from the P_n orbit +/- eps v (v the eigenvector of the multiplier near -1, eps in
+    SWITCH_OFFSETS times the motion's scale), on the side where P_n is unstable first.  Accepted
+    when P_n(x) differs from x by more than 1000 tol (scaled): not the P_n orbit itself.
+    Returns (lambda, x, mode) or None."""
+    mu, V = np.linalg.eig(e.jacobian)
+    v = V[:, int(np.argmin(np.abs(mu + 1.0)))].real
+    v = v / np.max(np.abs(v / scale))
+    for side in sorted((p, q), key=lambda r: -np.max(np.abs(_multipliers(r.jacobian)))):
+        try:
+            doubled = problem.section_map(side.lam, side.mode, 2 * periods)
+            single = problem.section_map(side.lam, side.mode, periods)
+        except CamdynError:
+            continue
+        provider = problem.jacobian(doubled, scale)
+        for eps in SWITCH_OFFSETS:
+            for sign in (1.0, -1.0):
+                found = newton(doubled, provider, side.x + sign * eps * v, scale, ShootingSettings(settings.tol, 20))
+                if not found.outcome.ok:
+                    continue
+                try:
+                    apart = np.max(np.abs(single(found.x) - found.x) / scale)
+                except MapFailure:
+                    continue
+                if apart > 1e3 * settings.tol:
+                    return side.lam, found.x, side.mode
+    return None
+
+
+def _start(problem: Problem, warmup_revolutions: int, settings):
+    """The first orbit, by shooting at the start value: (point, scale) or (None, message)."""
+    model = problem.model(problem.start)
+    rig = model.rig
+    orbit = periodic_orbit(rig, problem.scene, model.cam, periods=problem.periods,
+                           phase=problem.phase_fraction * model.period, warmup_revolutions=warmup_revolutions,
+                           settings=ShootingSettings(settings.tol, 20), options=problem.options,
+                           jacobian=problem.jacobian, backend=problem.backend)
+    if not orbit.ok:
+        return None, orbit.message
+    direction = math.copysign(1.0, problem.end - problem.start)
+    try:
+        first = _first_point(problem, problem.start, orbit.state, model.mode(orbit.mode), problem.periods,
+                             orbit.scale, direction)
+    except MapFailure as failure:
+        return None, str(failure)
+    return first, orbit.scale
+
+
+def _run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: int):
+    """Every branch (the first, then those switched to at period doublings) and the events."""
+    first, scale = _start(problem, warmup_revolutions, settings)
+    if first is None:
+        return [Branch(problem.periods, outcome=ContinuationOutcome.START_FAILED, message=scale)], [], None
+    branches, events, queue = [], [], [(Branch(problem.periods), first, 0)]
+    while queue:
+        branch, first, depth = queue.pop(0)
+        index = len(branches)
+        branches.append(branch)
+        found: list = []
+        _follow(problem, branch, index, first, scale, settings, found)
+        events += [f[0] for f in found]
+        for event, e, p, q in found:
+            if event.kind != "period_doubling" or depth >= settings.switch_depth:
+                continue
+            switched = _switch(problem, e, p, q, branch.periods, scale, settings)
+            if switched is None:
+                branch.message += f"; no period-{2 * branch.periods} orbit found at the period doubling " \
+                                  f"at {event.lam:.8g}"
+                continue
+            lam, x, mode = switched
+            try:
+                start = _first_point(problem, lam, x, mode, 2 * branch.periods, scale,
+                                     math.copysign(1.0, lam - event.lam))
+            except MapFailure:
+                continue
+            queue.append((Branch(2 * branch.periods, parent=index), start, depth + 1))
+    return branches, events, scale
+
+
+# --- the public function ---------------------------------------------------------------------------
+def _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction, settings):
+    if not isinstance(rig, Rig):
+        raise ParameterError("rig", rig, "a camdyn.Rig")
+    if not isinstance(scene, Scene) or scene.motion != "constant":
+        raise ParameterError("scene", scene, "a camdyn.Scene with motion 'constant' (a cam at constant speed)")
+    names = [p.name for p in PARAMETERS]
+    if parameter != SPEED and parameter not in names:
+        raise ParameterError("parameter", parameter, f"'{SPEED}' or a rig parameter ({', '.join(names)})")
+    for name, v in (("start", start), ("end", end)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not math.isfinite(v):
+            raise ParameterError(name, v, "a finite real number")
+    if start == end:
+        raise ParameterError("end", end, f"a value other than start ({start})")
+    if parameter == SPEED:
+        if speed_rpm is not None:
+            raise ParameterError("speed_rpm", speed_rpm, "None when the speed itself is continued")
+        if not start * end > 0:
+            raise ParameterError("end", end, "a speed of the same sign as start, and neither zero (rev/min)")
+    elif isinstance(speed_rpm, bool) or not isinstance(speed_rpm, (int, float)) or not speed_rpm != 0 \
+            or not math.isfinite(speed_rpm):
+        raise ParameterError("speed_rpm", speed_rpm, f"a nonzero cam speed (rev/min) to continue {parameter} at")
+    if isinstance(periods, bool) or not isinstance(periods, int) or not 1 <= periods <= 50:
+        raise ParameterError("periods", periods, "an integer, 1 <= periods <= 50")
+    if isinstance(phase_fraction, bool) or not isinstance(phase_fraction, (int, float)) \
+            or not 0 <= phase_fraction < 1:
+        raise ParameterError("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)")
+    if not isinstance(settings, ContinuationSettings):
+        raise ParameterError("settings", settings, "a camdyn.continuation.ContinuationSettings")
+
+
+def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *,
+                 speed_rpm: float | None = None, periods: int = 1, phase_fraction: float = 0.0,
+                 warmup_revolutions: int = 20, settings: ContinuationSettings = ContinuationSettings(),
+                 options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
+                 backend: str = "compiled"):
+    """Follow the branch of period-``periods`` orbits through the orbit found at ``start`` as
+    ``parameter`` goes toward ``end``; detect and locate folds, branch points, period doublings,
+    Neimark-Sacker bifurcations and grazing, and switch to the doubled branches.
+
+    ``parameter``: ``"speed_rpm"`` (the cam speed, rev/min), or a rig parameter by name (SI),
+    continued at the constant cam speed ``speed_rpm``.  The first orbit is found by
+    :func:`camdyn.periodic_orbit` after ``warmup_revolutions`` from the static equilibrium.
+    ``phase_fraction``: the section's time after each revolution's start, a fraction of T
+    (0 gives the sections of :func:`camdyn.sweep.bifurcation`; choose another where the
+    orbit is near a switching surface at 0).  ``jacobian(map, scale)`` makes the Jacobian
+    provider (any :class:`camdyn.section_map.JacobianProvider`).  Raises only on bad input; how
+    each branch ended is in the result (:class:`ContinuationOutcome`).
+
+    Returns an ``xarray.Dataset`` described in :func:`branch_dataset`.
+    """
+    _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction, settings)
+    problem = Problem(rig, scene, parameter, float(start), float(end), speed_rpm, periods, float(phase_fraction),
+                      options, jacobian, backend)
+    problem.model(problem.start)                 # a rig value the rig refuses raises here
+    problem.model(problem.end)
+    branches, events, scale = _run(problem, settings, warmup_revolutions)
+    return branch_dataset(problem, branches, events, scale)
+
+
+def _unit(parameter: str) -> str:
+    return "rev/min" if parameter == SPEED else next(p.unit for p in PARAMETERS if p.name == parameter)
+
+
+def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
+    """The branches and events as an ``xarray.Dataset``.
+
+    Dims: ``point`` (every orbit of every branch, branch by branch, in the order continued),
+    ``multiplier`` (2, by decreasing modulus), ``revolution`` (n of the longest period, NaN
+    beyond a point's own), ``event``, ``branch``.  Variables: ``lambda`` (the parameter, its
+    unit), ``alpha`` and ``alpha_dot`` at the section, ``multiplier_real``/``_imag``/``_modulus``,
+    ``stable`` (every ``|mu| < 1``), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
+    permanent contact), ``branch``, ``periods``, ``mode`` (code into attrs ``modes``),
+    ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's revolutions: the
+    points of the brute-force diagram); the events' ``event_kind`` (code into ``event_kinds``),
+    ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``, ``event_point``
+    (the point just before it), ``event_max_gap``, ``event_multiplier_real``/``_imag``; the branches'
+    ``branch_periods``, ``branch_parent`` (-1: none), ``branch_outcome`` (code into
+    ``outcomes``), and the messages as attrs ``branch_<i>_message``; attrs ``scale_alpha`` (rad)
+    and ``scale_alpha_dot`` (rad/s): the size of the motion at the start, the residual's scale.
+    """
+    import xarray as xr
+
+    unit, outcomes = _unit(problem.parameter), list(ContinuationOutcome)
+    n_rev = max([b.periods for b in branches] + [1])
+    data = {**_point_variables(problem, branches, unit, n_rev), **_event_variables(problem, branches, events, unit, n_rev),
+            "branch_periods": (("branch",), np.array([b.periods for b in branches], dtype=int), {}),
+            "branch_parent": (("branch",), np.array([b.parent for b in branches], dtype=int),
+                              {"long_name": "the branch it was switched from (-1: none)"}),
+            "branch_outcome": (("branch",), np.array([outcomes.index(b.outcome) for b in branches], dtype=int),
+                               {"long_name": "how the branch ended (index into the attribute outcomes)"})}
+    s = np.full(2, np.nan) if scale is None else np.asarray(scale, dtype=float)
+    attrs = {"parameter": problem.parameter, "parameter_units": unit, "start": problem.start, "end": problem.end,
+             "speed_rpm": problem.speed_rpm if problem.speed_rpm is not None else math.nan,
+             "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
+             "modes": " ".join(problem.model(problem.start).kernels.MODES), "event_kinds": " ".join(EVENTS),
+             "outcomes": " ".join(o.name for o in outcomes), "scale_alpha": float(s[0]), "scale_alpha_dot": float(s[1])}
+    for i, b in enumerate(branches):
+        attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
+    return xr.Dataset(data, attrs=attrs)
+
+
+def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int) -> dict:
+    points = [p for b in branches for p in b.points]
+    mu = np.array([_multipliers(p.jacobian) for p in points]).reshape(len(points), 2)
+    counts = [len(b.points) for b in branches]
+    P, PM = ("point",), ("point", "multiplier")
+    return {
+        "lambda": (P, np.array([p.lam for p in points]), {"units": unit, "long_name": problem.parameter}),
+        "alpha": (P, np.array([p.x[0] for p in points]), {"units": "rad", "long_name": "alpha at the section"}),
+        "alpha_dot": (P, np.array([p.x[1] for p in points]), {"units": "rad/s",
+                                                              "long_name": "alpha_dot at the section"}),
+        "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
+        "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
+        "multiplier_modulus": (PM, np.abs(mu), {"units": "1", "long_name": "|Floquet multiplier|"}),
+        "stable": (P, np.all(np.abs(mu) < 1.0, axis=1), {"long_name": "every |multiplier| < 1"}),
+        "max_gap": (P, np.array([p.max_gap for p in points]),
+                    {"units": "m", "long_name": "largest gap psi_i over the orbit (Eq. 6); < 0: deflection, "
+                                                "the follower never leaves the cam"}),
+        "branch": (P, np.repeat(np.arange(len(branches)), counts), {"long_name": "branch index"}),
+        "periods": (P, np.repeat([b.periods for b in branches], counts),
+                    {"long_name": "period n of the orbit, in cam periods"}),
+        "mode": (P, np.array([p.mode for p in points], dtype=int),
+                 {"long_name": "mode at the section (index into the attribute modes)"}),
+        "residual": (P, np.array([p.residual for p in points]), {"units": "1", "long_name": "scaled residual"}),
+        "alpha_revolution": (("point", "revolution"), _padded([p.alpha_revolutions for p in points], n_rev),
+                             {"units": "rad", "long_name": "alpha at the starts of the orbit's revolutions "
+                                                           "(the brute-force diagram's sections)"}),
+    }
+
+
+def _event_variables(problem: Problem, branches: list, events: list, unit: str, n_rev: int) -> dict:
+    offsets = np.cumsum([0] + [len(b.points) for b in branches])
+    E, EM = ("event",), ("event", "multiplier")
+    mu = np.array([e.multipliers for e in events], dtype=complex).reshape(-1, 2)
+    return {
+        "event_kind": (E, np.array([EVENTS.index(e.kind) for e in events], dtype=int),
+                       {"long_name": "event kind (index into the attribute event_kinds)"}),
+        "event_lambda": (E, np.array([e.lam for e in events]), {"units": unit, "long_name": problem.parameter}),
+        "event_alpha": (E, np.array([e.x[0] for e in events]), {"units": "rad"}),
+        "event_alpha_dot": (E, np.array([e.x[1] for e in events]), {"units": "rad/s"}),
+        "event_branch": (E, np.array([e.branch for e in events], dtype=int), {"long_name": "branch index"}),
+        "event_point": (E, np.array([offsets[e.branch] + e.point for e in events], dtype=int),
+                        {"long_name": "index of the point just before the event"}),
+        "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),
+                                   {"units": "rad", "long_name": "alpha at the starts of the revolutions at the event"}),
+        "event_max_gap": (E, np.array([e.max_gap for e in events]),
+                          {"units": "m", "long_name": "largest gap psi_i over the orbit at the event (0 at grazing)"}),
+        "event_multiplier_real": (EM, mu.real, {"units": "1"}),
+        "event_multiplier_imag": (EM, mu.imag, {"units": "1"}),
+    }
+
+
+def _padded(rows, width: int) -> np.ndarray:
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        out[i, :row.size] = row
+    return out
+
+
+def events_table(ds) -> list[tuple[str, float, int, int]]:
+    """The events of a :func:`continue_orbit` Dataset as (kind, lambda, branch, point) rows."""
+    kinds = ds.attrs["event_kinds"].split()
+    return [(kinds[int(k)], float(lam), int(b), int(p)) for k, lam, b, p in
+            zip(ds["event_kind"].values, ds["event_lambda"].values, ds["event_branch"].values,
+                ds["event_point"].values)]
+
+
+__all__ = ["continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
+           "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES"]

@@ -51,7 +51,6 @@ every branch), ``multiplier``, ``revolution`` and ``event``.
 """
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -64,6 +63,7 @@ from .engine.driver import integrate
 from .errors import CamdynError, ParameterError
 from .model import Model
 from .orbits import ShootingSettings, newton, periodic_orbit
+from .outcome import ActionableOutcome
 from .rig import PARAMETERS, Rig
 from .scene import Scene
 from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
@@ -86,7 +86,7 @@ MAX_BISECTIONS = 40
 SWITCH_OFFSETS = (1e-3, 1e-2, 3e-2, 1e-1)
 
 
-class ContinuationOutcome(enum.Enum):
+class ContinuationOutcome(ActionableOutcome):
     """How a branch ended (an actionable message each)."""
 
     END_REACHED = "the branch reached the end value of the parameter"
@@ -98,10 +98,6 @@ class ContinuationOutcome(enum.Enum):
                       "try another phase_fraction, a smaller min_step, or continue from beyond it")
     START_FAILED = ("no periodic orbit at the start value (see the message): try another start value, "
                     "phase_fraction or warmup_revolutions")
-
-    @property
-    def message(self) -> str:
-        return self.value
 
 
 @dataclass(frozen=True)

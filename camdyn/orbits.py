@@ -18,7 +18,6 @@ integration error, below which a residual is noise).
 """
 from __future__ import annotations
 
-import enum
 import functools
 import math
 from dataclasses import dataclass, field
@@ -32,6 +31,7 @@ from .engine.config import SolverOptions
 from .engine.driver import integrate
 from .errors import ParameterError
 from .model import Model
+from .outcome import ActionableOutcome
 from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
@@ -47,7 +47,7 @@ MAX_HALVINGS = 10
 SINGULAR_SIGMA = 1e-6
 
 
-class OrbitOutcome(enum.Enum):
+class OrbitOutcome(ActionableOutcome):
     """How the search for a periodic orbit ended (an actionable message each)."""
 
     CONVERGED = "P_n(x) = x to the stated tolerance: a periodic orbit of period n T"
@@ -62,14 +62,6 @@ class OrbitOutcome(enum.Enum):
                 "a continuation method is needed")
     MODE_CHANGED = ("the map ends in another mode than it starts in at the fixed point: the section "
                     "is on a switching surface; choose another phase")
-
-    @property
-    def ok(self) -> bool:
-        return self is OrbitOutcome.CONVERGED
-
-    @property
-    def message(self) -> str:
-        return self.value
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,20 @@ from __future__ import annotations
 import enum
 
 
-class Outcome(enum.Enum):
+class ActionableOutcome(enum.Enum):
+    """An enum of how something ended, whose values are actionable messages; its first member is
+    the one success (``ok``).  The base of camdyn's outcome enums."""
+
+    @property
+    def ok(self) -> bool:
+        return self is next(iter(type(self)))
+
+    @property
+    def message(self) -> str:
+        return self.value
+
+
+class Outcome(ActionableOutcome):
     SUCCESS = "the run reached t_end"
     STEP_FAILED = ("the Runge-Kutta method could not take a step (step size underflow); tighten or "
                    "loosen rtol/atol; a very stiff contact (large Y_c, Y_b) may need max_step")
@@ -22,11 +35,3 @@ class Outcome(enum.Enum):
                        "orbit does not exist; use the full model (follower='dynamic')")
     NO_QUASI_STATIC = ("no contact deformation carries the follower's inertia (Newton's method did not converge; "
                        "result.stats['where'] says when): use the full model (follower='dynamic')")
-
-    @property
-    def ok(self) -> bool:
-        return self is Outcome.SUCCESS
-
-    @property
-    def message(self) -> str:
-        return self.value

@@ -23,7 +23,6 @@ where, and the full model must be used.
 """
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass
 
@@ -33,6 +32,7 @@ from .cam import CamMotion, cam_motion
 from .derive.vocabulary import CAM_THETA, CAM_THETA_DDOT, CAM_THETA_DOT
 from .errors import ParameterError
 from .model import Model
+from .outcome import ActionableOutcome
 from .rig import Rig
 from .scene import Scene
 
@@ -43,7 +43,7 @@ MAX_NEWTON = 30
 ULPS = 4
 
 
-class QuasiStaticOutcome(enum.Enum):
+class QuasiStaticOutcome(ActionableOutcome):
     """How the quasi-static orbit ended (an actionable message each)."""
 
     SUCCESS = "the quasi-static contact orbit holds at every time asked (F_n > 0 throughout)"
@@ -51,14 +51,6 @@ class QuasiStaticOutcome(enum.Enum):
                "quasi-static orbit does not exist; use the full model (follower='dynamic')")
     NEWTON_FAILED = ("Newton's method found no contact deformation that carries the inertia (no convergence): "
                      "the contact is too soft or the speed too high for a quasi-static contact; use the full model")
-
-    @property
-    def ok(self) -> bool:
-        return self is QuasiStaticOutcome.SUCCESS
-
-    @property
-    def message(self) -> str:
-        return self.value
 
 
 @dataclass(frozen=True)

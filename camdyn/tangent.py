@@ -32,13 +32,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
+from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE_ALPHA, STATE_ALPHA_DOT
 from .engine.config import LOOK_AHEAD, SolverOptions
 from .engine.driver import integrate
 from .engine.kernels import compiled_jacobian, compiled_kernels
 from .engine.saltation import switch_saltation
 from .engine.tableau import TABLEAUS, arrays
-from .engine.variational import integrate_segment
+from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,
+                                 integrate_segment)
 from .errors import CamdynError, ParameterError
 from .model import Model
 from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
@@ -55,9 +56,6 @@ END_GAP = 1e-9
 #: abs(psi_i)^(1/4) law, whose singular share of Phi is ~gap^(1/4), is refused (the tests' bound
 #: on a monodromy against finite differences is 1e-6)
 END_GAP_CHANGE = 1e-6
-#: rows of the augmented state: x, then Phi row by row, then the integral of the divergence
-_PHI = slice(2, 6)
-_DIVERGENCE = 6
 
 
 class TangentFailure(CamdynError):
@@ -121,17 +119,16 @@ def _augmented(model: Model, m: int, t_start: float):
     jac = np.empty(2)
 
     def f(t, y):
-        a, ad = y[STATE_ALPHA], y[STATE_ALPHA_DOT]
+        a, ad = y[AUG_ALPHA], y[AUG_ALPHA_DOT]
         add = K.rhs(m, t, a, ad, p, *extra(t))
         if t == t_start:
             d = LOOK_AHEAD
             K.jacobian(m, t + d, a + d * ad, ad + d * add, p, *extra(t + d), jac)
         else:
             K.jacobian(m, t, a, ad, p, *extra(t), jac)
-        j0, j1 = jac
-        phi = y[_PHI]
-        return np.array([ad, add,
-                         phi[2], phi[3], j0 * phi[0] + j1 * phi[2], j0 * phi[1] + j1 * phi[3], j1])
+        out = np.empty(N_AUGMENTED)
+        fill_augmented(ad, add, jac, y, out)
+        return out
     return f
 
 
@@ -147,7 +144,7 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
         y, ok, message = _short_of_end(model, m, t0, t1, y0, settings, atol, compiled, END_GAP)
         if ok:
             fine, ok, message = _short_of_end(model, m, t0, t1, y0, settings, atol, compiled, END_GAP / 100)
-            change = np.max(np.abs(y[_PHI] - fine[_PHI])) / max(np.max(np.abs(fine[_PHI])), np.finfo(float).tiny)
+            change = np.max(np.abs(y[AUG_PHI] - fine[AUG_PHI])) / max(np.max(np.abs(fine[AUG_PHI])), np.finfo(float).tiny)
             if ok and not change <= END_GAP_CHANGE:
                 ok, message = False, (f"Phi with the Jacobian frozen over the last {END_GAP:g} s and the last "
                                       f"{END_GAP / 100:g} s differs by {change:.1e}: a singularity that matters")
@@ -155,7 +152,7 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
                              f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
                              "first contact: use camdyn.section_map.finite_differences)")
-    return y[:2].copy(), y[_PHI].reshape(2, 2), float(y[_DIVERGENCE])
+    return y[[AUG_ALPHA, AUG_ALPHA_DOT]], y[AUG_PHI].reshape(2, 2), float(y[AUG_DIVERGENCE])
 
 
 def _short_of_end(model: Model, m: int, t0: float, t1: float, y0, settings, atol, compiled: bool, gap: float):
@@ -165,10 +162,12 @@ def _short_of_end(model: Model, m: int, t0: float, t1: float, y0, settings, atol
     if not ok:
         return y, ok, message
     t, jac = t1 - gap, np.empty(2)
-    model.kernels.jacobian(m, t, float(y[0]), float(y[1]), model.p, *model._extra(t), jac)
+    model.kernels.jacobian(m, t, float(y[AUG_ALPHA]), float(y[AUG_ALPHA_DOT]), model.p, *model._extra(t), jac)
+    slope = np.empty(N_AUGMENTED)
+    fill_augmented(0.0, 0.0, jac, y, slope)          # one Euler step of Phi and the divergence
     out = y.copy()
-    out[_PHI] = ((np.eye(2) + gap * np.array([[0.0, 1.0], [jac[0], jac[1]]])) @ y[_PHI].reshape(2, 2)).ravel()
-    out[_DIVERGENCE] += gap * jac[1]
+    out[AUG_PHI] += gap * slope[AUG_PHI]
+    out[AUG_DIVERGENCE] += gap * slope[AUG_DIVERGENCE]
     return out, True, message
 
 
@@ -194,8 +193,8 @@ def _piece_end(model: Model, m: int, t: float, x, t1: float) -> float:
     """The end of the next piece of a segment to t1: its rate bound is abs(a_alpha_dot) (the
     divergence) plus sqrt(a_alpha) where the stiffness term repels (Eqs. 21-22 at the start)."""
     jac = np.empty(2)
-    model.kernels.jacobian(m, t, float(x[0]), float(x[1]), model.p, *model._extra(t), jac)
-    rate = abs(jac[1]) + math.sqrt(max(jac[0], 0.0))
+    model.kernels.jacobian(m, t, float(x[STATE_ALPHA]), float(x[STATE_ALPHA_DOT]), model.p, *model._extra(t), jac)
+    rate = abs(jac[JAC_D_ALPHA_DOT]) + math.sqrt(max(jac[JAC_D_ALPHA], 0.0))
     if not math.isfinite(rate) or rate <= 0.0:
         return t1
     return min(t1, t + RENORMALISE_NATS / rate)

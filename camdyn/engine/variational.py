@@ -16,29 +16,46 @@ import math
 import numpy as np
 from numba import njit
 
+from ..derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
+from .jit import jitable
 from .stepper import MAX_FACTOR, MIN_FACTOR, SAFETY, spacing
 
 cache.install()
 
-#: the augmented state's size: x (2), Phi (4, row by row), the divergence's integral (1)
-N_AUGMENTED = 7
+#: the augmented state's rows: x in the vocabulary's STATE order, then Phi row by row
+#: (Phi[i, j] at PHI_START + 2 i + j), then the integral of the divergence
+AUG_ALPHA, AUG_ALPHA_DOT = STATE_ALPHA, STATE_ALPHA_DOT
+PHI_START = len(STATE)
+AUG_PHI = slice(PHI_START, PHI_START + 4)
+AUG_DIVERGENCE = PHI_START + 4
+N_AUGMENTED = AUG_DIVERGENCE + 1
+
+
+@jitable
+def fill_augmented(ad, add, jac, y, out):
+    """out = the augmented field at y, given x' = (ad, add) and the Jacobian's second row ``jac``
+    (JACOBIAN order): Phi' = [[0, 1], [a_alpha, a_alpha_dot]] Phi, column by column, and the
+    divergence a_alpha_dot.  Compiled into :func:`augmented_field`; run as Python by camdyn.tangent."""
+    j0, j1 = jac[JAC_D_ALPHA], jac[JAC_D_ALPHA_DOT]
+    out[AUG_ALPHA], out[AUG_ALPHA_DOT] = ad, add
+    for k in range(2):
+        top, bottom = y[PHI_START + k], y[PHI_START + 2 + k]
+        out[PHI_START + k] = bottom
+        out[PHI_START + 2 + k] = j0 * top + j1 * bottom
+    out[AUG_DIVERGENCE] = j1
 
 
 @njit(cache=True, error_model="numpy")
 def augmented_field(rhs, jacobian, p, m, t, y, t_start, look_ahead, jac, out):
     """out = the augmented field at (t, y) in mode m (see the module docstring)."""
-    a, ad = y[0], y[1]
+    a, ad = y[AUG_ALPHA], y[AUG_ALPHA_DOT]
     add = rhs(m, t, a, ad, p)
     if t == t_start:
         jacobian(m, t + look_ahead, a + look_ahead * ad, ad + look_ahead * add, p, jac)
     else:
         jacobian(m, t, a, ad, p, jac)
-    out[0], out[1] = ad, add
-    out[2], out[3] = y[4], y[5]
-    out[4] = jac[0] * y[2] + jac[1] * y[4]
-    out[5] = jac[0] * y[3] + jac[1] * y[5]
-    out[6] = jac[1]
+    fill_augmented(ad, add, jac, y, out)
 
 
 @njit(cache=True, error_model="numpy")

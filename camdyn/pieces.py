@@ -93,7 +93,7 @@ def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.n
     if y.shape[0] == LEDGER_ROWS:
         y[WORK:LEDGER_ROWS] += work[:, None]
     switches = [dataclasses.replace(s, t=s.t + shift) for s in tr.switches]
-    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches)
+    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches, records=None)
 
 
 def _joined(parts: list[Trajectory], stopped: bool = False) -> Trajectory:

@@ -36,8 +36,10 @@ from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE_ALPHA, STATE_
 from .engine.config import LOOK_AHEAD, SolverOptions
 from .engine.driver import integrate
 from .engine.kernels import compiled_jacobian, compiled_kernels
+from .engine.loop import ALPHA, ALPHA_DOT
 from .engine.saltation import switch_saltation
 from .engine.tableau import TABLEAUS, arrays
+from .engine.tables import transition_rows
 from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,
                                  integrate_segment)
 from .errors import CamdynError, ParameterError
@@ -239,26 +241,28 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     K = model.kernels
     compiled = backend == "compiled"
     phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
-    m = K.MODES.index(tr.switches[0].before) if tr.switches else tr.end_mode
+    records, surface_of = tr.records, [row[1] for row in transition_rows(K)]
+    m = int(records["before"][0]) if len(records) else tr.end_mode
     t, divergence, log_det = t0, 0.0, 0.0
     growth = np.zeros(2) if renormalise else None
-    for sw in tr.switches:
-        _, phi, d, growth = _flow(model, m, t, sw.t, x, phi, settings, compiled, growth)
+    for sw in records:
+        t_sw, before, after = float(sw["t"]), int(sw["before"]), int(sw["after"])
+        _, phi, d, growth = _flow(model, m, t, t_sw, x, phi, settings, compiled, growth)
         divergence += d
-        before, after = K.MODES.index(sw.before), K.MODES.index(sw.after)
-        x = np.array([sw.alpha, sw.alpha_dot])
-        S = switch_saltation(model, before, after, K.SURFACES.index(sw.surface), sw.t, x)
+        x = np.array([sw["alpha"], sw["alpha_dot"]], dtype=float)
+        surface = surface_of[int(sw["transition"])]
+        S = switch_saltation(model, before, after, surface, t_sw, x)
         if not np.all(np.isfinite(S)):
-            raise TangentFailure(f"the switch at t = {sw.t:g} s across {sw.surface!r} grazes it (the field is "
-                                 "tangent to the surface): no saltation matrix")
+            raise TangentFailure(f"the switch at t = {t_sw:g} s across {K.SURFACES[surface]!r} grazes it (the "
+                                 "field is tangent to the surface): no saltation matrix")
         phi = S @ phi
         if renormalise:
             phi, growth = _orthonormalised(phi, growth)
         det = abs(np.linalg.det(S))
         log_det += math.log(det) if det > 0 else -math.inf
-        t, m = sw.t, after
+        t, m = t_sw, after
     flow_x, phi, d, growth = _flow(model, m, t, t1, x, phi, settings, compiled, growth)
-    return TangentResult(tr.y[:2, -1].copy(), phi, int(tr.end_mode), len(tr.switches), divergence + d, log_det,
+    return TangentResult(tr.y[[ALPHA, ALPHA_DOT], -1], phi, int(tr.end_mode), len(records), divergence + d, log_det,
                          flow_x, np.zeros(2) if growth is None else growth)
 
 

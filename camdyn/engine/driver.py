@@ -51,6 +51,9 @@ class Trajectory:
     outcome: Outcome
     stats: dict
     end_mode: int            # the mode at the end (to continue the run)
+    #: the engine's switch records (loop.SWITCH: t, transition, before, after by index, the state
+    #: after), for code that needs indices, not names (camdyn.tangent); None for a joined run
+    records: np.ndarray | None = None
 
     @property
     def regime(self) -> np.ndarray:
@@ -110,4 +113,4 @@ def _trajectory(model, r, samples: Samples, backend: str) -> Trajectory:
     stats = {"nfev": int(r.nfev), "steps": int(r.steps), "rejected_steps": int(r.rejected), "njev": 0,
              "switches": len(switches), "backend": backend}
     return Trajectory(samples.t[:n].copy(), samples.y[:, :n].copy(), samples.mode[:n].copy(), tuple(K.MODES),
-                      switches, Outcome[OUTCOMES[r.outcome]], stats, int(r.mode))
+                      switches, Outcome[OUTCOMES[r.outcome]], stats, int(r.mode), r.switches)

@@ -9,9 +9,12 @@ as ``(x / s, lambda / |end - start|)`` (s the size of the motion, as in :mod:`ca
 
 * **predictor**: z_pred = z_k + ds t_k, with t_k the unit tangent, the null vector of the
   scaled Jacobian [dP/dx - I, dP/dlambda] (from its SVD), oriented along the previous one;
-* **corrector**: Newton's method on ``G(z) = 0, t_k . (z - z_pred) = 0`` (the arclength
+* **corrector**: the chord method on ``G(z) = 0, t_k . (z - z_pred) = 0`` (the arclength
   condition: the correction is orthogonal to the tangent), stopping at the scaled residual
-  ``max_j |P_j(x) - x_j| / s_j <= tol``;
+  ``max_j |P_j(x) - x_j| / s_j <= tol``: it keeps the derivatives of the last point, one run
+  per iteration, while the residual shrinks by ``CHORD_CONTRACTION`` per iteration, and takes
+  Newton's step (the derivatives at the current z) when it does not; the derivatives are
+  evaluated once more at the converged orbit, for its tangent and its multipliers;
 * **derivatives**: dP/dx from any Jacobian provider (:func:`camdyn.section_map.finite_differences`
   by default; the variational equations can replace it); dP/dlambda by central differences in
   lambda with the step ``h = rtol^(1/3) max(|lambda|, |end - start|)``, the rule of
@@ -25,8 +28,8 @@ is at ``phase_fraction`` T after each revolution's start, so that it stays at th
 angle along the branch.
 
 **Detection.**  At every point the Floquet multipliers mu (eigenvalues of dP_n/dx) give test
-functions whose sign change between two points marks an event, located by bisection in
-arclength:
+functions whose sign change between two points marks an event, located in arclength (secant
+trials with the Illinois rule, :func:`_locate`):
 
 * ``fold``: the lambda-component of the tangent changes sign (a multiplier passes +1 and the
   branch turns back);
@@ -53,6 +56,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -77,10 +81,14 @@ GAP_SAMPLES = 256
 #: smooth there: the multipliers jump, e.g. where the orbit meets a new switching surface)
 EVENTS = ("fold", "branch_point", "period_doubling", "neimark_sacker", "grazing", "multiplier_jump")
 #: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value,
-#: and the multipliers on both sides of the bracket differ by less: bisection to locate_tol puts
+#: and the multipliers on both sides of the bracket differ by less: a bracket of locate_tol puts
 #: them within ~``|d mu / ds| locate_tol`` (~1e-5) of each other, unless they jump
 CRITICAL = 1e-2
-#: bisection in arclength stops after this many halvings of the bracket
+#: the corrector keeps the last point's derivatives while each iteration shrinks the residual by
+#: this factor or more (the chord method converges linearly, at a rate of the order of the
+#: derivatives' change over the step); else it evaluates them at the current z (Newton's step)
+CHORD_CONTRACTION = 0.25
+#: an event's location stops after this many trials (each shrinks the bracket)
 MAX_BISECTIONS = 40
 #: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
 SWITCH_OFFSETS = (1e-3, 1e-2, 3e-2, 1e-1)
@@ -153,8 +161,13 @@ class Problem:
 
     def model(self, lam: float) -> Model:
         if self.parameter == SPEED:
-            return Model(self.rig, self.scene, ConstantSpeed(lam))
+            return self._rig_model.with_cam(ConstantSpeed(lam))
         return Model(self.rig.replace(**{self.parameter: lam}), self.scene, ConstantSpeed(self.speed_rpm))
+
+    @cached_property
+    def _rig_model(self) -> Model:
+        """The rig's model (its equilibrium, its reach checked) once, when the speed is continued."""
+        return Model(self.rig, self.scene, ConstantSpeed(self.start))
 
     def section_map(self, lam: float, mode: int | None, periods: int | None = None) -> StroboscopicMap:
         model = self.model(lam)
@@ -165,8 +178,8 @@ class Problem:
 class Point(NamedTuple):
     """One orbit on a branch: lambda, x at the section, dP_n/dx, the unit tangent (scaled), the
     largest gap (m), alpha at the revolutions' starts (the brute-force diagram's section), the
-    mode at the section, the scaled residual, the corrector's steps, and the arclength step that
-    reached it."""
+    mode at the section, the scaled residual, the corrector's steps, and the scaled derivatives
+    of G there."""
 
     lam: float
     x: np.ndarray
@@ -177,6 +190,7 @@ class Point(NamedTuple):
     mode: int
     residual: float
     iterations: int
+    derivatives: np.ndarray     # the scaled [dG/dx, dG/dlambda] (2 x 3) at the point: the next corrector's
 
 
 @dataclass
@@ -209,6 +223,11 @@ class _Scaled(NamedTuple):
     J: np.ndarray
 
 
+def _residual(problem: Problem, lam: float, x, mode, periods: int, scale) -> np.ndarray:
+    """G scaled, (P_n(x; lambda) - x) / s: one run (raises MapFailure)."""
+    return (problem.section_map(lam, mode, periods)(x) - x) / scale
+
+
 def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale) -> _Scaled:
     """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure)."""
     section_map = problem.section_map(lam, mode, periods)
@@ -229,24 +248,29 @@ def _tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
     return t if float(t @ previous) >= 0 else -t
 
 
-def _correct(problem, z_pred, direction, mode, periods, scale, settings):
-    """Newton's method on G(z) = 0, direction . (z - z_pred) = 0: (z, evaluation, iterations),
-    or None when it fails (a run fails, the residual grows, or max_corrector is reached)."""
+def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
+    """The chord method on G(z) = 0, direction . (z - z_pred) = 0, from the derivatives ``A`` of
+    the last point: one run per iteration while the residual shrinks by CHORD_CONTRACTION or
+    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 3 runs
+    with finite differences).  Returns (z, evaluation at z, iterations), or None when it fails
+    (a run fails, the residual grows, or max_corrector is reached)."""
     z, last = z_pred.copy(), math.inf
     for it in range(settings.max_corrector + 1):
         lam, x = z[2] * problem.span, z[:2] * scale
-        try:
-            ev = _evaluate(problem, lam, x, mode, periods, scale)
-        except CamdynError:            # a failed run, or a rig value the rig refuses
+        try:                           # MapFailure, or a rig value the rig refuses
+            G = _residual(problem, lam, x, mode, periods, scale)
+            r = float(np.max(np.abs(G)))
+            if r <= settings.tol:
+                return z, _evaluate(problem, lam, x, mode, periods, scale), it
+            if math.isfinite(r) and r > CHORD_CONTRACTION * last:
+                A = _evaluate(problem, lam, x, mode, periods, scale).A
+        except CamdynError:
             return None
-        r = float(np.max(np.abs(ev.G)))
         if not math.isfinite(r) or (it >= 2 and r > last):
             return None
-        if r <= settings.tol:
-            return z, ev, it
         last = r
-        H = np.vstack([ev.A, direction])
-        rhs = np.concatenate([ev.G, [direction @ (z - z_pred)]])
+        H = np.vstack([A, direction])
+        rhs = np.concatenate([G, [direction @ (z - z_pred)]])
         try:
             z = z - np.linalg.solve(H, rhs)
         except np.linalg.LinAlgError:
@@ -288,7 +312,7 @@ def _refined_max(v: np.ndarray) -> float:
 def _point(problem, z, ev, tangent, mode, periods, scale, iterations) -> Point:
     lam, x = float(z[2] * problem.span), z[:2] * scale
     gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
-    return Point(lam, x.copy(), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))), iterations)
+    return Point(lam, x.copy(), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))), iterations, ev.A)
 
 
 def _z(problem, p: Point, scale) -> np.ndarray:
@@ -298,7 +322,7 @@ def _z(problem, p: Point, scale) -> np.ndarray:
 def _step(problem, p: Point, ds, periods, scale, settings) -> Point | None:
     """The point at arclength ds from p along its tangent, corrected; None when it fails."""
     z_pred = _z(problem, p, scale) + ds * p.tangent
-    found = _correct(problem, z_pred, p.tangent, p.mode, periods, scale, settings)
+    found = _correct(problem, z_pred, p.tangent, p.derivatives, p.mode, periods, scale, settings)
     if found is None:
         return None
     z, ev, it = found
@@ -321,24 +345,42 @@ def _changed(a: float, b: float) -> bool:
     return math.isfinite(a) and math.isfinite(b) and a * b < 0
 
 
-def _locate(problem, p: Point, ds: float, kind: str, periods, scale, settings):
-    """Bisection in arclength over [0, ds] from p on the sign of ``kind``'s test function: the
-    points on both sides of the event, ``locate_tol`` apart (after: None when the far end is a
-    failure).  A step whose corrector fails counts as past the event (the map is not smooth
-    beyond a grazing)."""
-    sign0 = math.copysign(1.0, _tests(p)[kind])
+def _locate(problem, p: Point, q: Point, ds: float, kind: str, periods, scale, settings):
+    """The sign change of ``kind``'s test function f between p and q (``ds`` apart in arclength),
+    bracketed in arclength from p to ``locate_tol``: the points on both sides of the event
+    (after: None when the far end is a failure).  The next trial is the secant root of the
+    bracket, with the Illinois rule (the value kept at an end twice in a row is halved, so that
+    both ends close in: superlinear for a smooth f) and kept ``locate_tol`` / 2 inside it; the
+    midpoint where an end has no value, and always for grazing (its f, the largest gap, has a
+    corner at the event: about the contact's deflection before it, the flight's height after,
+    and secant trials crawl in from the flat side).  A step whose corrector fails counts as past
+    the event (the map is not smooth beyond a grazing)."""
+    f0 = _tests(p)[kind]
+    sign0 = math.copysign(1.0, f0)
     lo, hi, before, after = 0.0, ds, p, None
+    f_lo, f_hi, kept = f0, _tests(q)[kind], 0
     for _ in range(MAX_BISECTIONS):
         if hi - lo <= settings.locate_tol:
             break
-        mid = 0.5 * (lo + hi)
-        q = _step(problem, p, mid, periods, scale, settings)
-        f = math.nan if q is None else _tests(q)[kind]
+        s = 0.5 * (lo + hi) if kind == "grazing" else _trial(lo, hi, f_lo, f_hi, settings.locate_tol)
+        r = _step(problem, p, s, periods, scale, settings)
+        f = math.nan if r is None else _tests(r)[kind]
         if math.isfinite(f) and math.copysign(1.0, f) == sign0:
-            lo, before = mid, q
+            lo, f_lo, before = s, f, r
+            f_hi, kept = (f_hi / 2.0, kept + 1) if kept > 0 else (f_hi, 1)
         else:
-            hi, after = mid, q
+            hi, f_hi, after = s, f, r
+            f_lo, kept = (f_lo / 2.0, kept - 1) if kept < 0 else (f_lo, -1)
     return before, after
+
+
+def _trial(lo: float, hi: float, f_lo: float, f_hi: float, tol: float) -> float:
+    """The secant root of f over [lo, hi] (the midpoint when an end has no finite value), kept
+    tol / 2 inside the bracket so that each trial shrinks it by at least that."""
+    if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or f_lo == f_hi:
+        return 0.5 * (lo + hi)
+    s = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    return min(max(s, lo + 0.5 * tol), hi - 0.5 * tol)
 
 
 def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], periods, scale, settings):
@@ -350,7 +392,7 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
             continue
         if kind == "branch_point" and _changed(f0["fold"], f1["fold"]):
             continue                                   # the +1 multiplier of the fold itself
-        before, after = _locate(problem, p, ds, kind, periods, scale, settings)
+        before, after = _locate(problem, p, q, ds, kind, periods, scale, settings)
         e = after or before
         mu = _multipliers(e.jacobian)
         named = kind if _smooth(kind, before, after) else "multiplier_jump"
@@ -434,7 +476,7 @@ def _first_point(problem, lam, x, mode, periods, scale, direction: float) -> Poi
     tangent = _tangent(ev.A, np.array([0.0, 0.0, direction]))
     gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
     return Point(lam, np.asarray(x, dtype=float).copy(), ev.J, tangent, gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), 0)
+                 float(np.max(np.abs(ev.G))), 0, ev.A)
 
 
 def _switch(problem, e: Point, p: Point, q: Point, periods: int, scale, settings):

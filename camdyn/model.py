@@ -89,6 +89,12 @@ def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
                        float(k_lambda), math.sqrt(-dM / rig.I_Pb))
 
 
+def _check_cam(scene: Scene, cam) -> None:
+    if getattr(cam, "kind", None) != scene.motion:
+        raise SceneError(f"the scene's motion is {scene.motion!r} but the cam given is "
+                         f"{type(cam).__name__} ({getattr(cam, 'kind', '?')!r})")
+
+
 class Model:
     """Scene kernels + rig + cam motion, ready to integrate."""
 
@@ -97,9 +103,7 @@ class Model:
             raise TypeError(f"rig must be a camdyn.Rig, got {type(rig).__name__}")
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a camdyn.Scene, got {type(scene).__name__}")
-        if getattr(cam, "kind", None) != scene.motion:
-            raise SceneError(f"the scene's motion is {scene.motion!r} but the cam given is "
-                             f"{type(cam).__name__} ({getattr(cam, 'kind', '?')!r})")
+        _check_cam(scene, cam)
         self.rig, self.scene, self.cam = rig, scene, cam
         self.kernels = scene.kernels()
         optional = [n for n in self.kernels.INPUTS if n not in _DERIVED + _CAM and getattr(rig, n) is None]
@@ -110,10 +114,25 @@ class Model:
             raise GeometryError(f"chi* = {self.equilibrium.chi:g} m <= mu_m w_b / 2: friction would lock "
                                 "the follower (the moment arm of Eq. 10 changes sign)")
         self._check_reach()
+        self.p = self._packed(cam)
+
+    def with_cam(self, cam: CamMotion) -> "Model":
+        """The same rig and scene driven by another cam motion of the scene's kind.  The static
+        equilibrium and the reach check depend on the rig only, so they are not redone (a
+        continuation in the cam speed builds one model per speed)."""
+        _check_cam(self.scene, cam)
+        other = object.__new__(Model)
+        other.rig, other.scene, other.cam = self.rig, self.scene, cam
+        other.kernels, other.equilibrium = self.kernels, self.equilibrium
+        other.p = self._packed(cam)
+        return other
+
+    def _packed(self, cam: CamMotion) -> np.ndarray:
+        """The kernels' parameter vector p: the rig, its static equilibrium and the cam's constants."""
         eq = self.equilibrium
-        values = {**rig.to_dict(), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta,
+        values = {**self.rig.to_dict(), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta,
                   **cam.values()}
-        self.p = self.kernels.pack({k: values[k] for k in self.kernels.INPUTS})
+        return self.kernels.pack({k: values[k] for k in self.kernels.INPUTS})
 
     def _check_reach(self):
         """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""

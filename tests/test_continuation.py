@@ -257,3 +257,17 @@ def test_bad_settings_name_the_setting(kwargs, name):
     with pytest.raises(ParameterError) as exc:
         ContinuationSettings(**kwargs)
     assert exc.value.name == name
+
+
+@pytest.mark.parametrize("f_lo, f_hi, expected", [
+    (-1.0, 3.0, 0.325),                 # the secant root: 0.2 + 0.5 / 4
+    (-1e-12, 2e-8, 0.2005),             # the root at lo + 2.5e-5: kept tol / 2 inside
+    (5.0, -1e-9, 0.6995),               # the root next to hi: kept tol / 2 inside
+    (-2.0, float("nan"), 0.45),         # hi has no value (a failed step): the midpoint
+    (1.0, 1.0, 0.45)])                  # no slope: the midpoint
+def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f_hi, expected):
+    """The secant trial of the event location (camdyn.continuation._trial) stays tol/2 inside
+    [lo, hi] = [0.2, 0.7] (tol = 1e-3), so every trial shrinks the bracket by at least that and
+    the location ends; the midpoint when an end has no value."""
+    from camdyn.continuation import _trial
+    assert _trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)

@@ -171,3 +171,16 @@ def test_static_kernels_get_the_rigs_zeros_and_nan_for_what_they_never_read():
     for name in ("chi_star", "vartheta", "Omega_c"):
         assert math.isnan(p[K.PARAMS.index(name)])
     assert all(math.isfinite(v) for v in K.rigid_contact(0.3, p)) and math.isfinite(K.reach(0.3, p))
+
+
+def test_a_model_under_another_cam_speed_is_the_model_built_for_it():
+    """Model.with_cam keeps the rig's equilibrium and packs the new cam's constants: the same
+    parameter vector and period as a model built from scratch for that speed (exact: the same
+    arithmetic), and a cam of another kind than the scene's is refused."""
+    scene = camdyn.Scene(damping="D", friction="coulomb")
+    built = Model(RIG, scene, camdyn.ConstantSpeed(700.0))
+    moved = Model(RIG, scene, camdyn.ConstantSpeed(300.0)).with_cam(camdyn.ConstantSpeed(700.0))
+    assert np.array_equal(moved.p, built.p)
+    assert moved.period == built.period and moved.equilibrium == built.equilibrium
+    with pytest.raises(SceneError, match="motion"):
+        built.with_cam(camdyn.Oscillating(amplitude_pp=math.pi, frequency_rpm=40.0))

@@ -179,6 +179,7 @@ class NewtonResult(NamedTuple):
     outcome: OrbitOutcome
     map_evaluations: int        # by the line search
     jacobian_evaluations: int   # provider calls (each also gives P)
+    failure: str = ""           # with RUN_FAILED: why the run failed (the MapFailure's message)
 
 
 def newton(section_map: StroboscopicMap, jacobian, x0, scale,
@@ -189,8 +190,8 @@ def newton(section_map: StroboscopicMap, jacobian, x0, scale,
     try:
         calls += 1
         Px, J = jacobian(x)
-    except MapFailure:
-        return NewtonResult(x, None, math.inf, 0, OrbitOutcome.RUN_FAILED, maps, calls)
+    except MapFailure as failure:
+        return NewtonResult(x, None, math.inf, 0, OrbitOutcome.RUN_FAILED, maps, calls, str(failure))
     r = _residual(Px - x, scale)
     for it in range(settings.max_iterations + 1):
         if r <= settings.tol:
@@ -207,8 +208,8 @@ def newton(section_map: StroboscopicMap, jacobian, x0, scale,
         try:
             calls += 1
             Px, J = jacobian(trial)
-        except MapFailure:
-            return NewtonResult(trial, None, r_new, it + 1, OrbitOutcome.RUN_FAILED, maps, calls)
+        except MapFailure as failure:
+            return NewtonResult(trial, None, r_new, it + 1, OrbitOutcome.RUN_FAILED, maps, calls, str(failure))
         x, r = trial, _residual(Px - trial, scale)
     return NewtonResult(x, J, r, settings.max_iterations, OrbitOutcome.MAX_ITERATIONS, maps, calls)
 
@@ -257,6 +258,8 @@ def _failed(model, x, periods, phase, message) -> PeriodicOrbit:
 def _orbit(section_map: StroboscopicMap, found: NewtonResult, scale) -> PeriodicOrbit:
     """The result of a Newton search: multipliers and verdict when it converged in one mode."""
     outcome, message = found.outcome, found.outcome.message
+    if found.failure:
+        message = f"{message}: {found.failure}"
     if outcome is OrbitOutcome.CONVERGED:
         end = section_map.evaluate(found.x).end_mode
         if end != section_map.mode:

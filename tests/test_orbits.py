@@ -254,3 +254,23 @@ def test_newton_reports_each_failure():
     assert stalled.outcome is OrbitOutcome.NEWTON_STALLED and np.all(stalled.x == 3.0)
     failing = FakeMap(lambda x: (_ for _ in ()).throw(MapFailure("a failed run", camdyn.Outcome.CHATTER)))
     assert newton(failing, finite_differences(failing, ones), np.zeros(2), ones).outcome is OrbitOutcome.RUN_FAILED
+
+
+def test_a_flight_orbit_coexists_with_the_contact_orbit_below_the_contact_loss_speed():
+    """The hysteresis behind Fig. 8's jump (docs/reproduction.md, fig7-8: the flight orbit's
+    branch folds at about 116 rev/min): at 125 rev/min, below the experiment rig's contact-loss
+    speed (130 rev/min), shooting finds a stable orbit in permanent contact (from rest; the
+    variational Jacobian, since its deflection is below any finite-difference step) and a stable
+    orbit of large flights (warmed up from the 150 rev/min flight orbit).  Bounds: 'distinct'
+    is 0.1 rad apart at the section, half the flight orbit's measured distance from the contact
+    orbit (0.21 rad); 'stable' is every |multiplier| < 1 (measured 0 and 0.63)."""
+    from camdyn.tangent import variational
+    rig = camdyn.load_rig("reference-experiment")
+    scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
+    assert 125.0 < camdyn.contact_loss_speed(rig)
+    contact = camdyn.periodic_orbit(rig, scene, speed_rpm=125.0, jacobian=variational)
+    flight = camdyn.periodic_orbit(rig, scene, speed_rpm=125.0,
+                                   y0=camdyn.periodic_orbit(rig, scene, speed_rpm=150.0).state)
+    assert contact.ok and flight.ok, (contact.message, flight.message)
+    assert contact.stable and flight.stable
+    assert abs(flight.state[0] - contact.state[0]) > 0.1

@@ -15,6 +15,7 @@ writing this module (see the module's docstring in camdyn.continuation):
 """
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -24,6 +25,7 @@ import camdyn
 from camdyn.analysis import compliance_shift
 from camdyn.continuation import (EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit,
                                  events_table)
+from camdyn.engine.config import SolverOptions
 from camdyn.errors import ParameterError
 from camdyn.model import Model
 from camdyn.section_map import StroboscopicMap, finite_differences
@@ -271,3 +273,79 @@ def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f
     the location ends; the midpoint when an end has no value."""
     from camdyn.continuation import _trial
     assert _trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)
+
+
+# --- the detectors on maps whose bifurcations are known in closed form -----------------------------
+class _AnalyticMap:
+    """P(x; lambda) in closed form, with the interface the continuation reads of a map."""
+
+    def __init__(self, f, lam):
+        self.f, self.lam = f, lam
+
+    def __call__(self, x):
+        return self.f(np.asarray(x, dtype=float), self.lam)
+
+
+@dataclasses.dataclass(frozen=True)
+class _AnalyticProblem:
+    """What camdyn.continuation reads of its Problem, for a map given in closed form; its
+    Jacobian is central differences with a step of 1e-6 (error ~1e-12 on these polynomials)."""
+
+    f: object
+    start: float
+    end: float
+    parameter: str = "lambda"
+    options: object = dataclasses.field(default_factory=lambda: SolverOptions(rtol=1e-10, atol=1e-13))
+
+    @property
+    def span(self):
+        return abs(self.end - self.start)
+
+    def section_map(self, lam, mode, periods=None):
+        return _AnalyticMap(self.f, lam)
+
+    def jacobian(self, section_map, scale):
+        def provider(x):
+            J = np.column_stack([(section_map(x + e) - section_map(x - e)) / 2e-6 for e in np.eye(2) * 1e-6])
+            return section_map(x), J
+        return provider
+
+
+def _continued(f, start, end, monkeypatch):
+    """Follow the fixed point x = 0 of f from start to end: the branch and its events."""
+    from camdyn import continuation as C
+    monkeypatch.setattr(C, "_gap", lambda problem, lam, x, mode, periods: (-1.0, np.array([x[0]]), 0))
+    problem, scale, settings = _AnalyticProblem(f, start, end), np.ones(2), ContinuationSettings()
+    first = C._first_point(problem, start, np.zeros(2), 0, 1, scale, 1.0)
+    branch, events = C.Branch(1), []
+    C._follow(problem, branch, 0, first, scale, settings, events)
+    return branch, [e[0] for e in events]
+
+
+def test_a_neimark_sacker_bifurcation_is_located_where_the_complex_pair_crosses_the_unit_circle(monkeypatch):
+    """x -> r(lambda) R(1 rad) x with r = 0.8 + 0.4 lambda: a complex pair of modulus r, which
+    crosses 1 at lambda = 0.5.  Located within 1e-5 (the location's tolerance, 1e-6 of the
+    range in arclength, with the branch's arclength close to its lambda here)."""
+    c, s = np.cos(1.0), np.sin(1.0)
+
+    def f(x, lam):
+        return (0.8 + 0.4 * lam) * np.array([c * x[0] - s * x[1], s * x[0] + c * x[1]])
+
+    branch, events = _continued(f, 0.0, 1.0, monkeypatch)
+    assert branch.outcome is ContinuationOutcome.END_REACHED
+    assert [e.kind for e in events] == ["neimark_sacker"]
+    assert events[0].lam == pytest.approx(0.5, abs=1e-5)
+    assert np.abs(events[0].multipliers) == pytest.approx([1.0, 1.0], abs=1e-4)
+
+
+def test_a_branch_point_is_told_from_a_fold(monkeypatch):
+    """x1 -> x1 + (lambda x1 - x1^3) / 2, x2 -> x2 / 2: the fixed point x = 0 for every lambda,
+    its multiplier 1 + lambda / 2 crossing +1 at lambda = 0 where the branches x1 = +-sqrt(lambda)
+    cross it (a pitchfork); the branch goes on through it without turning: a branch point, no fold."""
+    def f(x, lam):
+        return np.array([x[0] + 0.5 * (lam * x[0] - x[0] ** 3), 0.5 * x[1]])
+
+    branch, events = _continued(f, -1.0, 1.0, monkeypatch)
+    assert branch.outcome is ContinuationOutcome.END_REACHED
+    assert [e.kind for e in events] == ["branch_point"]
+    assert events[0].lam == pytest.approx(0.0, abs=1e-5)

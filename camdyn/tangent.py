@@ -38,7 +38,7 @@ from .engine.driver import integrate
 from .engine.kernels import compiled_jacobian, compiled_kernels
 from .engine.loop import ALPHA, ALPHA_DOT
 from .engine.saltation import switch_saltation
-from .engine.tableau import TABLEAUS, arrays
+from .engine.tableau import method_of
 from .engine.tables import transition_rows
 from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,
                                  integrate_segment)
@@ -178,7 +178,7 @@ def _integrate(model: Model, m: int, t0: float, t1: float, y0, settings: Tangent
     if compiled:
         K = model.kernels
         y, ok = integrate_segment(compiled_kernels(K, outputs=False).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
-                                  settings.rtol, atol, arrays(TABLEAUS["DOP853"]), LOOK_AHEAD)
+                                  settings.rtol, atol, method_of("DOP853"), LOOK_AHEAD)
         return y, ok, "the step size fell below the spacing of t"
     sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
     return sol.y[:, -1], sol.success, sol.message

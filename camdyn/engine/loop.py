@@ -278,14 +278,42 @@ def run(prob, method, cfg, start, samples):
 _run_compiled = njit(cache=True, error_model="numpy")(run)
 
 
+#: the compiled loop's machine-code entry per layout of its arguments (:func:`_layout`), found by
+#: the dispatcher on the first call with that layout: numba's dispatcher types every argument on
+#: every call, and typing the named tuples of cfuncs and arrays costs 0.1-0.6 ms, more than a
+#: short run (a stroboscopic map's, a stopping sweep's piece of 4 revolutions) takes to integrate
+_ENTRIES: dict = {}
+
+
 def loop_loaded() -> bool:
     """Whether the compiled loop is in memory (compiled or loaded from the cache already)."""
-    return bool(_run_compiled.signatures)
+    return bool(_ENTRIES) or bool(_run_compiled.signatures)
+
+
+def _layout(value):
+    """What numba's type of an argument depends on: a tuple by its class and fields, an array by
+    its dtype, dimensions and contiguity, anything else by its class (a cfunc's signature is the
+    one :mod:`.kernels` compiles its position in ``Kernels`` with)."""
+    if isinstance(value, tuple):
+        return (type(value),) + tuple(_layout(v) for v in value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.char, value.ndim, value.flags.c_contiguous
+    return type(value)
 
 
 def run_compiled(prob, method, cfg, start, samples) -> Run:
-    """:func:`run`, compiled; the kernels of ``prob`` must be numba cfuncs."""
-    return _finish(_run_compiled(prob, method, cfg, start, samples))
+    """:func:`run`, compiled; the kernels of ``prob`` must be numba cfuncs.  The first call with a
+    layout of arguments goes through numba's dispatcher (which compiles or loads the loop); later
+    ones enter the compiled code directly."""
+    args = (prob, method, cfg, start, samples)
+    key = _layout(args)
+    entry = _ENTRIES.get(key)
+    if entry is None:
+        raw = _run_compiled(*args)
+        signature = tuple(_run_compiled.typeof_pyval(a) for a in args)
+        _ENTRIES[key] = _run_compiled.overloads[signature].entry_point
+        return _finish(raw)
+    return _finish(entry(*args))
 
 
 def run_interpreted(prob, method, cfg, start, samples) -> Run:

@@ -14,6 +14,8 @@ coefficient is an error at import, not a silent loss of order.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 from dataclasses import dataclass
 from fractions import Fraction as Fr
 from typing import NamedTuple
@@ -232,3 +234,10 @@ def stages_per_step(tab: Tableau, dense: bool) -> int:
 
 
 __all__ = ["Tableau", "TableauError", "Method", "DOPRI5", "DOP853", "TABLEAUS", "arrays", "stages_per_step"]
+
+
+@lru_cache(maxsize=None)
+def method_of(name: str) -> Method:
+    """The :class:`Method` of the tableau named ``name`` in TABLEAUS, built once (the stepper
+    only reads it)."""
+    return arrays(TABLEAUS[name])

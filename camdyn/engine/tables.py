@@ -14,6 +14,8 @@ passes the tables (measured on the sliding benchmark, benchmarks/floor.py: ~0.2 
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 from types import ModuleType
 from typing import NamedTuple
 
@@ -48,7 +50,18 @@ class Tables(NamedTuple):
 
 
 def tables(K: ModuleType) -> Tables:
-    """The tables of a generated scene module ``K``."""
+    """The tables of a generated scene module ``K``, built once per module (the loop only reads
+    them; like the compiled kernels, a module reloaded in place keeps them); a stand-in that is
+    not a module (a test's namespace) has them built each call."""
+    return _module_tables(K) if isinstance(K, ModuleType) else _tables(K)
+
+
+@lru_cache(maxsize=None)
+def _module_tables(K: ModuleType) -> Tables:
+    return _tables(K)
+
+
+def _tables(K) -> Tables:
     transitions = transition_rows(K)
     n_modes = len(K.MODES)
     watch_start = np.searchsorted([tr[0] for tr in transitions], np.arange(n_modes + 1), side="left")

@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 
 from .engine.config import SolverOptions
-from .engine.driver import Trajectory
+from .engine.driver import Switch, Trajectory
 from .engine.loop import LEDGER_ROWS, STATE_ROWS, WORK
 from .model import Model
 from .outcome import Outcome
@@ -92,7 +92,7 @@ def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.n
     y = tr.y[:, :kept].copy()
     if y.shape[0] == LEDGER_ROWS:
         y[WORK:LEDGER_ROWS] += work[:, None]
-    switches = [dataclasses.replace(s, t=s.t + shift) for s in tr.switches]
+    switches = [Switch(s.t + shift, s.surface, s.before, s.after, s.alpha, s.alpha_dot) for s in tr.switches]
     return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches, records=None)
 
 

@@ -82,11 +82,18 @@ class StopWhenPeriodic:
         """The smallest p <= max_period with which the last ``revolutions`` section values repeat
         (alpha to :meth:`threshold`, the mode exactly); 0 when none does."""
         k = self.revolutions
+        if section.size < k + 1:
+            return 0
+        # largest[j]: max |alpha| over the last j + 1 values, so that the threshold of the last k + p
+        # values is read, not recomputed, for each p; the last pair rules most p out before the arrays
+        largest = np.maximum.accumulate(np.abs(section[-(k + self.max_period):])[::-1])
         for p in range(1, self.max_period + 1):
             if section.size < k + p:
                 return 0
+            limit = self.tol * (rtol * float(largest[k + p - 1]) + atol)
+            if modes[-1] != modes[-1 - p] or abs(section[-1] - section[-1 - p]) > limit:
+                continue
             a, m = section[-k - p:], modes[-k - p:]
-            limit = self.threshold(a, rtol, atol)
             if np.all(np.abs(a[p:] - a[:-p]) <= limit) and np.all(m[p:] == m[:-p]):
                 return p
         return 0

@@ -121,7 +121,20 @@ def _stage2(args) -> dict:
     out["onsets"] = onsets(out["classes"], speeds)
     out["onsets_lyapunov"] = {d: next((sp for sp in speeds if out["lyapunov"][f"{d}{sp:g}"]["chaos"] == "chaotic"),
                                       None) for d in MODELS}
-    out["verdict"] = verdict(out["classes"], speeds)
+    out["verdict"] = verdict(judged(out), speeds)
+    return out
+
+
+def judged(r: dict) -> dict:
+    """Each stage-2 run's class as the verdicts read it: by the largest Lyapunov exponent where
+    there is one (chaotic: aperiodic; regular: periodic, its periodicity class if that is
+    periodic, else "P (λ1 < 0)"; undecided: neither), by the periodicity class where there is
+    none (damping C and E: no tangent dynamics)."""
+    out = {}
+    for key, c in r["classes"].items():
+        ly = r.get("lyapunov", {}).get(key, {}).get("chaos", "n/a")
+        out[key] = {"chaotic": "aperiodic", "regular": c if str(c).startswith("P") else "P (λ1 < 0)",
+                    "undecided": "undecided"}.get(ly, c)
     return out
 
 
@@ -266,8 +279,9 @@ def _stage2_lines(st2: list[dict], speeds) -> list[str]:
                        + [fmt(r["onsets_lyapunov"][d]) if r["onsets_lyapunov"][d] else "none"] for d in MODELS]
             lines.append(md_table(["Ω_c (rev/min)"] + [f"{v:g}" for v in speeds] + ["first chaotic (λ1)"], ly_rows))
         lines.append("")
-        lines.append("Paper's statements on this grid: " + "; ".join(
-            f"{k}: {'yes' if v else '**no**'}" for k, v in verdict(r["classes"], speeds).items()) + ".")
+        lines.append("Paper's statements on this grid (chaos judged by λ1 where there is one, by periodicity for "
+                     "C and E): " + "; ".join(
+                         f"{k}: {'yes' if v else '**no**'}" for k, v in verdict(judged(r), speeds).items()) + ".")
         lines.append("")
     return lines
 
@@ -275,28 +289,30 @@ def _stage2_lines(st2: list[dict], speeds) -> list[str]:
 def _conclusion(st2: list[dict], speeds) -> list[str]:
     """Whether any geometry reproduces the onsets; otherwise the closest one and why not."""
     lines = []
-    found = [r for r in st2 if all(verdict(r["classes"], speeds).values())]
+    classes = [judged(r) for r in st2]          # chaos by lambda_1 where there is one
+    first = [onsets(c, speeds) for c in classes]
+    found = [r for r, c in zip(st2, classes) if all(verdict(c, speeds).values())]
     # a periodic range ending in a chaotic one, or periodic again above an aperiodic speed?
-    rows_ap = [(r, d) for r in st2 for d in MODELS if r["onsets"][d] is not None]
-    again = [(r, d) for r, d in rows_ap
-             if any(str(r["classes"][f"{d}{sp:g}"]).startswith("P") for sp in speeds if sp > r["onsets"][d])]
+    rows_ap = [(i, d) for i in range(len(st2)) for d in MODELS if first[i][d] is not None]
+    again = [(i, d) for i, d in rows_ap
+             if any(str(classes[i][f"{d}{sp:g}"]).startswith("P") for sp in speeds if sp > first[i][d])]
     if rows_ap:
-        lines.append(f"In stage 2, {len(rows_ap)} of {len(st2) * len(MODELS)} model rows have an aperiodic speed; "
-                     f"in {len(again)} of them a higher speed is periodic again.")
+        lines.append(f"In stage 2 (chaos by λ1 where there is one, by periodicity for C and E), {len(rows_ap)} of "
+                     f"{len(st2) * len(MODELS)} model rows have a chaotic speed; in {len(again)} of them a higher "
+                     "speed is periodic again.")
         lines.append("")
     if not found and st2:
-        fails = [(sum(not v for v in verdict(r["classes"], speeds).values()), i) for i, r in enumerate(st2)]
+        fails = [(sum(not v for v in verdict(c, speeds).values()), i) for i, c in enumerate(classes)]
         k, i = min(fails)
-        r = st2[i]
-        v = verdict(r["classes"], speeds)
-        low = [f"{d} {sp:g}" for d in "ABCD" for sp in speeds if sp < 150.0
-               and not str(r["classes"][f"{d}{sp:g}"]).startswith("P")]
+        r, c = st2[i], classes[i]
+        v = verdict(c, speeds)
+        low = [f"{d} {sp:g}" for d in "ABCD" for sp in speeds if sp < 150.0 and not str(c[f"{d}{sp:g}"]).startswith("P")]
         back = []
         for d in "BD":
-            on = r["onsets"][d]
-            later = [sp for sp in speeds if on is not None and sp > on and str(r["classes"][f"{d}{sp:g}"]).startswith("P")]
+            on = first[i][d]
+            later = [sp for sp in speeds if on is not None and sp > on and str(c[f"{d}{sp:g}"]).startswith("P")]
             if later:
-                back.append(f"{d} (" + ", ".join(f"{sp:g} {r['classes'][f'{d}{sp:g}']}" for sp in later) + ")")
+                back.append(f"{d} (" + ", ".join(f"{sp:g} {c[f'{d}{sp:g}']}" for sp in later) + ")")
         lines.append(f"Closest: *{_geo_text(r['geometry'])}*, which fails {k} of {len(v)} statements ("
                      + ", ".join(name for name, ok in v.items() if not ok) + ")"
                      + (f"; not periodic below 150 rev/min: {', '.join(low)}" if low else "")

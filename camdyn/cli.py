@@ -747,21 +747,10 @@ except ImportError:
     sys.exit(4)
 writer = importlib.import_module(package + ".writer")
 catalog = importlib.import_module(package + ".catalog")
-codegen = importlib.import_module(package + ".codegen")
 from tqdm import tqdm
 specs = tuple(sorted(set(catalog.CATALOG), key=lambda s: s.slug))
 bar = dict(total=len(specs), desc="deriving scenes", unit="scene", file=sys.stderr, disable=None)
-if jobs > 1:
-    from concurrent.futures import ProcessPoolExecutor
-    rank = getattr(writer, "cost_rank", None)  # slowest scenes first, where this derive says which
-    work = sorted(specs, key=rank) if rank else list(specs)
-    with ProcessPoolExecutor(jobs) as pool:
-        text_of = dict(zip(work, tqdm(pool.map(codegen.module_source, work), **bar)))
-    texts = [text_of[s] for s in specs]
-else:
-    texts = [codegen.module_source(s) for s in tqdm(specs, **bar)]
-files = {writer.module_name(s) + ".py": t for s, t in zip(specs, texts)}
-files["__init__.py"] = writer.registry_source(specs)
+files = writer.render(specs, jobs=jobs, progress=lambda done: tqdm(done, **bar))
 if not check_only:
     changed = writer.write(files, out)
     print(f"{len(files)} files generated in {out}; changed: {', '.join(changed) or 'none'}")
@@ -784,6 +773,9 @@ for slug, module in sorted(pkg.SCENES.items()):
     try:
         m = importlib.import_module(name + "." + module)
         assert m.SLUG == slug, f"{module}.SLUG is {m.SLUG!r}"
+        if m.VARIATIONAL is not None:
+            v = importlib.import_module(name + "." + m.VARIATIONAL)
+            assert v.SLUG == slug and v.PARAMS == m.PARAMS, f"{m.VARIATIONAL} is not {module}'s companion"
     except Exception as exc:
         bad.append(f"{module}: {type(exc).__name__}: {exc}")
 if "sympy" in sys.modules:

@@ -20,7 +20,7 @@ from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
 from .engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from .errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
-from .scene import Scene
+from .scene import Scene, variational_kernels
 
 _DERIVED = EQUILIBRIUM_NAMES  # computed here, not given by the rig
 _CAM = CAM_NAMES              # given by the cam motion
@@ -178,18 +178,26 @@ class Model:
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
         return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
 
+    @cached_property
+    def variational(self) -> ModuleType | None:
+        """The scene's variational kernels (``surface_gradient``, ``field_sensitivity``): the
+        companion of its generated module, imported on first use
+        (:func:`camdyn.scene.variational_kernels`), so that a run never loads them; None for a
+        scene without them (the linear models)."""
+        return variational_kernels(self.kernels)
+
     def field_sensitivity(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:
         """d(alpha_ddot)/d(q) in mode m at a fixed state and time for the scene's continuation
-        parameters q (the generated ``field_sensitivity``; its ``SENSITIVITY`` names them, in
-        the order of ``CONTINUATION_PARAMETERS``: the cam's speed constant in rad/s, k_s, e,
-        the damping constants), total derivatives: the static equilibrium follows the rig.
+        parameters q (the generated ``field_sensitivity``; its module's ``SENSITIVITY`` names
+        them, in the order of ``CONTINUATION_PARAMETERS``: the cam's speed constant in rad/s, k_s,
+        e, the damping constants), total derivatives: the static equilibrium follows the rig.
         Raises :class:`SceneError` for a scene without it (the linear models)."""
-        kernel = getattr(self.kernels, "field_sensitivity", None)
+        kernel = getattr(self.variational, "field_sensitivity", None)
         if kernel is None:
             raise SceneError(f"scene {self.kernels.SLUG!r} has no parameter derivatives (non-linear model only)")
-        out = np.empty(len(self.kernels.SENSITIVITY))
+        out = np.empty(len(self.variational.SENSITIVITY))
         kernel(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
-        return dict(zip(self.kernels.SENSITIVITY, map(float, out)))
+        return dict(zip(self.variational.SENSITIVITY, map(float, out)))
 
     def surface_gradient(self, m: int, s: int, t: float, alpha: float, alpha_dot: float) -> np.ndarray:
         """(dh/dalpha, dh/dalpha_dot, dh/dt) of surface s's value h under mode m's laws (the
@@ -197,7 +205,7 @@ class Model:
         Raises :class:`SceneError` where the scene has none (no switching surfaces) or it is
         not defined (a surface m does not watch; a user cam motion where dh/dt needs the
         derivative of Theta_ddot)."""
-        kernel = getattr(self.kernels, "surface_gradient", None)
+        kernel = getattr(self.variational, "surface_gradient", None)
         if kernel is None:
             raise SceneError(f"scene {self.kernels.SLUG!r} has no switching surfaces to differentiate")
         out = np.empty(len(SURFACE_GRADIENT))

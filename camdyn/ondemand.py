@@ -7,6 +7,8 @@ imports SymPy) and writes the module that ``python -m camdyn.derive`` would writ
 scene, byte for byte, to
 
     <user cache>/scenes/<key>/scene_<slug>.py
+    <user cache>/scenes/<key>/variational_<slug>.py   (its variational kernels, if it has any:
+                                                      imported only for tangent dynamics)
 
 ``<user cache>`` is the folder of compiled code (``camdyn.engine.cache``: ``$CAMDYN_CACHE_DIR``
 or the platform's); ``<key>`` hashes the installed ``camdyn.derive`` sources and the SymPy
@@ -81,7 +83,11 @@ def load(spec: SceneSpec) -> ModuleType:
     if not path.is_file():
         check_derivable(spec)
         _derive(spec, path)
-    name = f"camdyn_scene_{derive_key()}_{spec.slug}"
+    return import_file(f"camdyn_scene_{derive_key()}_{spec.slug}", path)
+
+
+def import_file(name: str, path: Path) -> ModuleType:
+    """The module of the file ``path``, imported under ``name`` once per process."""
     if name in sys.modules:
         return sys.modules[name]
     module_spec = importlib.util.spec_from_file_location(name, path)

@@ -4,12 +4,14 @@ A :class:`Scene` names the contact law, damping model, friction model, cam motio
 and the misprint and switch options (the vocabulary is ``camdyn.derive.vocabulary``, shared
 with the derivation).  The scenes of ``derive/catalog.py`` are generated into
 ``camdyn.generated``; any other valid scene is derived on first use into the per-user cache
-(:mod:`camdyn.ondemand`, needs SymPy).
+(:mod:`camdyn.ondemand`, needs SymPy).  A scene's variational kernels are in a companion module
+beside its own, which :func:`variational_kernels` imports only when they are asked for.
 """
 from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from pathlib import Path
 from types import ModuleType
 
 from camdyn import generated
@@ -62,3 +64,34 @@ class Scene(SceneSpec):
     @staticmethod
     def available() -> list[str]:
         return sorted(generated.SCENES)
+
+
+#: what a companion module shares with its scene's module: the scene, the layout of the
+#: parameter vector p its kernels read and the indices of the modes and surfaces they take
+_SHARED = ("SLUG", "PARAMS", "MODES", "SURFACES")
+
+
+def variational_kernels(kernels: ModuleType) -> ModuleType | None:
+    """The variational kernels of a scene's generated module ``kernels`` (``surface_gradient``,
+    ``field_sensitivity``), from its companion module, which this imports on first use (a run
+    never does); None for a scene without them (``VARIATIONAL`` None: the linear models).
+
+    The companion is beside the scene's module: in its package (``camdyn.generated``, or a
+    generated folder imported as a package), or in its folder for a module imported from a
+    file (the scenes derived on demand, :mod:`camdyn.ondemand`)."""
+    name = kernels.VARIATIONAL
+    if name is None:
+        return None
+    path = Path(kernels.__file__).with_name(name + ".py")
+    if not path.is_file():
+        raise SceneError(f"the variational kernels of scene {kernels.SLUG!r} are missing: no {path}. Regenerate "
+                         "them with 'python -m camdyn.derive' (a scene derived on demand: 'camdyn cache --clear')")
+    if kernels.__package__:
+        module = importlib.import_module(f"{kernels.__package__}.{name}")
+    else:
+        module = ondemand.import_file(f"{kernels.__name__}__{name}", path)
+    differ = [k for k in _SHARED if getattr(module, k, None) != getattr(kernels, k)]
+    if differ:
+        raise SceneError(f"{path} does not belong to the scene module {kernels.__file__} (they differ in "
+                         f"{', '.join(differ)}): regenerate both with 'python -m camdyn.derive'")
+    return module

@@ -5,20 +5,25 @@
 :class:`Case`\\ s (one per mode, or per surface and mode) holding named definitions
 (:mod:`derive.fields`).  :mod:`derive.codegen` writes the text.
 
-Kernels (arguments in the order of the generated module's docstring):
+Kernels (arguments in the order of the generated module's docstring), in the scene's module
+``scene_<slug>``, the one a run imports:
 
   rhs(m, t, alpha, alpha_dot, p)              alpha_ddot in mode m
   surface(m, s, t, alpha, alpha_dot, p)       the value of surface s under mode m's laws
   jacobian(m, t, alpha, alpha_dot, p, out)    out[:] = d(alpha_ddot)/d(alpha, alpha_dot)
+  outputs(m, t, alpha, alpha_dot, p, out)     out[:] = the OUTPUTS
+  cam(t, p)                                   Theta and its rates (built-in motions; arrays too)
+  static_moment, reach, rigid_contact, spring_potential: run-independent (equilibrium, Eq. 29)
+
+and the variational kernels, in its companion module ``variational_<slug>``, which only the
+tangent dynamics and the parameter continuation import (:attr:`SceneModule.variational`):
+
   field_sensitivity(m, t, alpha, alpha_dot, p, out)
                                               out[:] = d(alpha_ddot)/d(SENSITIVITY), the continuation
                                               parameters (non-linear model)
   surface_gradient(m, s, t, alpha, alpha_dot, p, out)
                                               out[:] = dh/d(alpha, alpha_dot), dh/dt of surface s
                                               under mode m's laws, for the surfaces m watches
-  outputs(m, t, alpha, alpha_dot, p, out)     out[:] = the OUTPUTS
-  cam(t, p)                                   Theta and its rates (built-in motions; arrays too)
-  static_moment, reach, rigid_contact, spring_potential: run-independent (equilibrium, Eq. 29)
 """
 from __future__ import annotations
 
@@ -65,9 +70,13 @@ class Function:
 
 @dataclass(frozen=True)
 class SceneModule:
+    """A scene's kernels: ``functions`` for its module, ``variational`` for its companion
+    module (empty for a scene without them: the linear models)."""
+
     spec: SceneSpec
     automaton: Automaton
     functions: tuple[Function, ...]
+    variational: tuple[Function, ...] = ()
 
 
 def _state_args(spec: SceneSpec, *dispatch: str, out: bool = False) -> tuple[str, ...]:
@@ -157,6 +166,18 @@ def build(spec: SceneSpec) -> SceneModule:
                               _mode_cases(A, lambda mode: fields.jacobian(spec, mode)),
                               "Second row of the state Jacobian in mode m (Eqs. 21-22): out[0] = "
                               "d(alpha_ddot)/d(alpha), out[1] = d(alpha_ddot)/d(alpha_dot).", "fill"))
+    functions.append(Function("outputs", _state_args(spec, "m", out=True), ("m",), tuple(OUTPUTS),
+                              _mode_cases(A, lambda mode: fields.outputs(spec, mode)),
+                              "The output quantities in mode m: out[OUT_<NAME>] for each name of OUTPUTS.",
+                              "fill"))
+    functions += _static_functions(spec)
+    return SceneModule(spec, A, tuple(functions), _variational_functions(spec, A))
+
+
+def _variational_functions(spec: SceneSpec, A: Automaton) -> tuple[Function, ...]:
+    """The kernels of the companion module: the field's parameter derivatives (non-linear model)
+    and the switching surfaces' gradients (a scene with transitions)."""
+    functions = []
     if spec.model == "nonlinear":
         names = fields.continuation_parameters(spec, A.modes)
         functions.append(Function("field_sensitivity", _state_args(spec, "m", out=True), ("m",),
@@ -172,12 +193,7 @@ def build(spec: SceneSpec) -> SceneModule:
                                   "surfaces m watches: out[GRAD_D_ALPHA] = dh/dalpha, out[GRAD_D_ALPHA_DOT] = "
                                   "dh/dalpha_dot, out[GRAD_D_T] = dh/dt at a fixed state (through Theta(t)); "
                                   "nan elsewhere.", "fill"))
-    functions.append(Function("outputs", _state_args(spec, "m", out=True), ("m",), tuple(OUTPUTS),
-                              _mode_cases(A, lambda mode: fields.outputs(spec, mode)),
-                              "The output quantities in mode m: out[OUT_<NAME>] for each name of OUTPUTS.",
-                              "fill"))
-    functions += _static_functions(spec)
-    return SceneModule(spec, A, tuple(functions))
+    return tuple(functions)
 
 
 __all__ = ["SceneSpec", "SceneSpecError", "Case", "Function", "SceneModule", "build", "OPTIONS", "OUTPUTS",

@@ -225,9 +225,10 @@ JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
 SURFACE_GRADIENT = JACOBIAN + ("d_t",)
 GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T = range(len(SURFACE_GRADIENT))
 #: the continuation parameters, in the order the generated ``field_sensitivity`` kernel writes
-#: d(alpha_ddot)/d(parameter) to ``out`` (each scene: those its fields read, listed in its
-#: module's SENSITIVITY): the cam's speed (Omega_c at constant speed, omega_c for the
-#: oscillating cam), the spring stiffness k_s, the eccentricity e, then the damping constants
+#: d(alpha_ddot)/d(parameter) to ``out`` (each scene: those its fields read, listed in the
+#: SENSITIVITY of its companion module of variational kernels): the cam's speed (Omega_c at
+#: constant speed, omega_c for the oscillating cam), the spring stiffness k_s, the
+#: eccentricity e, then the damping constants
 CONTINUATION_PARAMETERS = ("Omega_c", "omega_c", "k_s", "e", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
                            "zeta_E", "beta_E")
 #: the cam's state as the generated ``cam`` kernel and a user's cam motion return it

@@ -12,6 +12,8 @@ The hybrid automaton is data (MODES, SURFACES, INITIAL, TRANSITIONS, RESETS; the
 read it are camdyn.derive.automaton's docstring) and the kernels compute, per mode, the
 named quantities of the derivation once each.
 
+The scene has no variational kernels (VARIATIONAL is None).
+
 Arguments of every kernel, in this order where it takes them:
     m: mode index: a position in MODES (MODE_<NAME> constants)
     s: surface index: a position in SURFACES (SURFACE_<NAME> constants)
@@ -30,6 +32,8 @@ import numpy
 
 SCENE = {'contact': 'line', 'damping': 'D', 'friction': 'coulomb', 'motion': 'constant', 'model': 'linear_exact', 'sliding_velocity': 'kinematic', 'damping_sign': 'dissipative', 'damping_switch': 'episode'}
 SLUG = 'line_d_coulomb_constant_linear_exact'
+#: the companion module of the variational kernels, beside this one (None: the scene has none)
+VARIATIONAL = None
 PARAMS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'l_lambda', 'mu_m', 'zeta_D', 'Y_e', 'alpha_star', 'chi_star', 'vartheta', 'Omega_c', 'cos_alpha0', 'cos_alpha0_d_2_m_alpha_star_d_2', 'cos_alpha0_m_alpha_star', 'cos_alpha0_p_theta0', 'cos_alpha_star', 'cos_alpha_star_p_theta0', 'cos_theta0', 'sin_alpha0', 'sin_alpha0_d_2_m_alpha_star_d_2', 'sin_alpha0_m_alpha_star', 'sin_alpha0_p_theta0', 'sin_alpha_star', 'sin_alpha_star_p_theta0', 'sin_theta0')
 INPUTS = ('r_c', 'e', 'w_b', 'chi0', 'alpha0', 'theta0', 'd_x', 'd_y', 'L_us', 'k_s', 'I_Pb', 'Y_c', 'Y_b', 'nu_c', 'nu_b', 'l_lambda', 'mu_m', 'zeta_D', 'alpha_star', 'chi_star', 'vartheta', 'Omega_c')
 UNITS = {'r_c': 'm', 'e': 'm', 'w_b': 'm', 'chi0': 'm', 'alpha0': 'rad', 'theta0': 'rad', 'd_x': 'm', 'd_y': 'm', 'L_us': 'm', 'k_s': 'N/m', 'I_Pb': 'kg m^2', 'l_lambda': 'm', 'mu_m': '1', 'zeta_D': '1', 'Y_e': 'Pa', 'alpha_star': 'rad', 'chi_star': 'm', 'vartheta': 'rad/s', 'Omega_c': 'rad/s', 'cos_alpha0': '1', 'cos_alpha0_d_2_m_alpha_star_d_2': '1', 'cos_alpha0_m_alpha_star': '1', 'cos_alpha0_p_theta0': '1', 'cos_alpha_star': '1', 'cos_alpha_star_p_theta0': '1', 'cos_theta0': '1', 'sin_alpha0': '1', 'sin_alpha0_d_2_m_alpha_star_d_2': '1', 'sin_alpha0_m_alpha_star': '1', 'sin_alpha0_p_theta0': '1', 'sin_alpha_star': '1', 'sin_alpha_star_p_theta0': '1', 'sin_theta0': '1', 'Y_c': 'Pa', 'Y_b': 'Pa', 'nu_c': '1', 'nu_b': '1'}

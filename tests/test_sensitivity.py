@@ -37,7 +37,7 @@ def _difference(scene, name, m, state):
 def test_field_sensitivity_matches_central_differences(damping):
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
     model = _model(scene)
-    names = model.kernels.SENSITIVITY
+    names = model.variational.SENSITIVITY
     assert names == tuple(n for n in CONTINUATION_PARAMETERS if n in names)     # the vocabulary's order
     assert names[:3] == ("Omega_c", "k_s", "e")
     a = model.equilibrium.alpha - 2e-5                       # pressed into the cam: in contact

@@ -11,10 +11,11 @@ dt = -grad_h . dx / (grad_h . f- + dh/dt), and spends that time under the other 
 (Aizerman & Gantmakher 1958; Leine & Nijmeijer 2004, Sec. 3.5; di Bernardo et al. 2008,
 Sec. 2.5), with f- the field of the mode before and f+ the field of the mode after, both at
 the switching state, and grad_h, dh/dt the gradient of the surface's value under the mode
-before's laws (the generated ``surface_gradient`` kernel).  The same formula covers the entry
-into the Filippov sliding mode of a stuck follower (f+ = the stick field, which keeps h = v_r
-at 0: then grad_h^T S = 0, the perturbation is projected onto the surface) and the exit from
-it (f+ = f- where the one-sided field turns away: S = I).
+before's laws (the generated ``surface_gradient`` kernel, in the scene's companion module of
+variational kernels).  The same formula covers the entry into the Filippov sliding mode of a
+stuck follower (f+ = the stick field, which keeps h = v_r at 0: then grad_h^T S = 0, the
+perturbation is projected onto the surface) and the exit from it (f+ = f- where the one-sided
+field turns away: S = I).
 
 Why it is assembled at run time, not generated: the target mode of a transition is chosen at
 run time among candidates (``derive.automaton``: the first whose conditions hold), so the pair

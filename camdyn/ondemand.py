@@ -4,11 +4,9 @@ A :class:`camdyn.Scene` whose options are valid but were not generated into
 ``camdyn.generated`` (``derive/catalog.py`` lists those) is derived when it is first used:
 ``python -m camdyn.derive.single`` runs in a separate process (``import camdyn`` never
 imports SymPy) and writes the module that ``python -m camdyn.derive`` would write for that
-scene, byte for byte, to
-
-    <user cache>/scenes/<key>/scene_<slug>.py
-    <user cache>/scenes/<key>/variational_<slug>.py   (its variational kernels, if it has any:
-                                                      imported only for tangent dynamics)
+scene, byte for byte, to ``<user cache>/scenes/<key>/scene_<slug>.py``, with its companion
+``variational_<slug>.py`` beside it (the variational kernels, if it has any: imported only
+for the tangent dynamics).
 
 ``<user cache>`` is the folder of compiled code (``camdyn.engine.cache``: ``$CAMDYN_CACHE_DIR``
 or the platform's); ``<key>`` hashes the installed ``camdyn.derive`` sources and the SymPy

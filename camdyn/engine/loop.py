@@ -25,7 +25,7 @@ from numba import njit
 
 from ..derive.vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
-from .jit import jitable
+from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
 from .rules import (NONFINITE, across, chattering, first_crossing, initial_mode, left_at_start, scratch,
                     switch, zero_at_start)
@@ -83,7 +83,7 @@ class Run(NamedTuple):
     alpha_dot: float
 
 
-@jitable
+@allocating
 def _record(sw, n, t, w, before, after, a, ad):
     """Append a switch as column n of sw (rows SW_*), doubling the buffer when full; returns it."""
     if n == sw.shape[1]:
@@ -159,7 +159,7 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
     return c0, c1, UNUSABLE
 
 
-@jitable
+@allocating
 def _buffers(method, tab):
     """The loop's work arrays: the stages K, the interpolant Q, first_crossing's work, the
     kernels' output buffer, the ledger's works (0) and its scratch, the switches (rows SW_*)."""
@@ -179,7 +179,7 @@ def _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work):
     accumulate(prob, m, t, h, y0, y1, Q, t, t_cross, buf, ledger_work)
 
 
-@jitable
+@allocating
 def run(prob, method, cfg, start, samples):
     """Integrate the hybrid model from ``start`` (see the module docstring): the fields of a
     :class:`Run` as a plain tuple, with the switch buffer (rows SW_*) and their count in

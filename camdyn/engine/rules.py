@@ -39,7 +39,7 @@ import math
 import numpy as np
 
 from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
-from .jit import jitable
+from .jit import allocating, jitable
 from .stepper import dense_eval
 
 #: first_crossing's transition index when a surface value is not finite
@@ -52,11 +52,11 @@ NONFINITE = -2
 G_PREV, R_PREV, VALUES = 0, 1, 2
 
 
-@jitable
+@allocating
 def scratch(n_transitions, n_surfaces):
     """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES.  One array, not
-    three: a compiled call pays an atomic reference count per array it passes.  (np.empty and
-    a loop, no np.zeros or max of ints: each compiles one more overload on a cold start.)"""
+    three: fewer arguments to pass down.  (np.empty and a loop, no np.zeros or max of ints: each
+    compiles one more overload on a cold start.)"""
     n = n_transitions if n_transitions > n_surfaces else n_surfaces
     work = np.empty((3, n if n > 1 else 1))
     for r in range(3):
@@ -257,8 +257,7 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     crosses, NONFINITE when a value is not finite.  ``have_start``: work's rows G_PREV and
     R_PREV already hold the values at t0 (the previous step's end); with no crossing, they
     hold the values at t1 on return.  (Runs once per step: the kernel is called here directly,
-    and only the rare crossing found is a call, :func:`_crossing_in`, each compiled call
-    passing arrays paying atomic reference counts.)
+    and only the rare crossing found is a call, :func:`_crossing_in`.)
     """
     tab = prob.tables
     data, kernel, p = tab.data, prob.kernels.surface, prob.p

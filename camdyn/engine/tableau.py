@@ -187,8 +187,9 @@ class Method(NamedTuple):
     first-same-as-last stage (its row is b), then the extra stages of the interpolant (DOP853);
     rows ``c_row``, ``b_row``, ``e_row``, ``e3_row`` are c (1 for the FSAL stage), b, e and e3;
     rows ``p_row ..`` are the dense output in power form, one row per stage, ``degree`` columns.
-    One array, not six: compiled code pays an atomic reference count per array for every call
-    that passes the method (a few per step)."""
+    One array, not six: reference-counted compiled code pays an atomic count per array for every
+    call that passes the method (a few per step; the engine's helpers are compiled without
+    reference counts, :mod:`camdyn.engine.jit`)."""
 
     coef: np.ndarray
     n_stages: int

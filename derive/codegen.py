@@ -33,6 +33,7 @@ from . import laws
 from . import symbols as S
 from . import trig
 from .automaton import Automaton
+from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
 from .vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, SceneSpec
 
@@ -47,7 +48,7 @@ ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
         "cam": "(Theta, Theta_dot, Theta_ddot) of the user's cam motion at t (rad, rad/s, rad/s^2)",
         "out": "a float64 array the results are written into (length: the number of results)"}
 RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_ddot_dalpha_dot": "1/s",
-                "value": "m, m/s or m/s^2",
+                "value": "m, m/s or m/s^2", "rate": "the value's unit per s",
                 "dh_dalpha": "surface unit/rad", "dh_dalpha_dot": "surface unit s/rad", "dh_dt": "surface unit/s", "Theta": "rad", "Theta_dot": "rad/s", "Theta_ddot": "rad/s^2",
                 "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
                 "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
@@ -164,6 +165,14 @@ def _families(cases: tuple[Case, ...]) -> list[_Family]:
     return [_Family.of(group) for group in groups.values()]
 
 
+def _separate_families(f: Function) -> list[list[_Family]]:
+    """Style "separate": per result, the families of the cases reduced to that result and the
+    definitions it needs (so its common subexpressions, and arithmetic, are those of a function
+    returning it alone)."""
+    return [_families(tuple(Case(c.key, Kernel(c.kernel.definitions, (c.kernel.results[r],)).pruned())
+                            for c in f.cases)) for r in range(len(f.results))]
+
+
 # --- printing -----------------------------------------------------------------------------
 class _Writer:
     """Prints one function: guards from dispatch keys, families, variants, results."""
@@ -197,7 +206,8 @@ class _Writer:
         arg = dispatch[i]
         return " or ".join(f"{arg} == {self._value_name(arg, v)}" for v in sorted({k[i] for k in keys}))
 
-    def family_lines(self, fam: _Family) -> list[str]:
+    def family_lines(self, fam: _Family, bare: bool = False) -> list[str]:
+        """The family's code; ``bare``: up to its results, without returning or storing them."""
         lines = [f"{n} = p[{self.params.index(n)}]" for n in _param_names(fam.expressions())]
         rep = dict(fam.replacements)
         index = {sym: i for i, (sym, _) in enumerate(fam.replacements)}
@@ -235,7 +245,7 @@ class _Writer:
                 lines += [head] + ["    " + x for x in body + self._definition(v)]
         for r in fam.results:
             emit(deps(r), lines)
-        return lines + self._results(fam.results)
+        return lines if bare else lines + self._results(fam.results)
 
     def _replacement_keys(self, fam: _Family, index) -> dict:
         """The cases that use each replacement (directly or through later ones)."""
@@ -272,25 +282,42 @@ class _Writer:
         return ["return (" + ", ".join(code) + ")" if len(code) > 1 else f"return {code[0]}"]
 
     def _missing(self) -> list[str]:
-        return ["out[:] = nan", "return"] if self.f.style == "fill" else ["return nan"]
+        return ["out[:] = nan", "return"] if self.f.style in ("fill", "separate") else ["return nan"]
 
     def source(self, families: list[_Family], universe: set) -> str:
+        return self._source([(fam.keys, self.family_lines(fam)) for fam in families], universe)
+
+    def separate_source(self, parts: list[list[_Family]], universe: set) -> str:
+        """Style "separate": per case, each result's family code in turn, each stored in out."""
+        groups: dict = {}  # (family of each result, by position) -> the keys they compute together
+        for key in [k for fam in parts[0] for k in fam.keys]:
+            groups.setdefault(tuple(next(i for i, f in enumerate(fams) if key in f.keys) for fams in parts),
+                              []).append(key)
+        blocks = []
+        for which, keys in groups.items():
+            body = []
+            for r, (fams, i) in enumerate(zip(parts, which)):
+                body += self.family_lines(fams[i], bare=True) + [f"out[{r}] = {self.printer.doprint(fams[i].results[0])}"]
+            blocks.append((keys, body + ["return"]))
+        return self._source(blocks, universe)
+
+    def _source(self, blocks: list[tuple[list, list[str]]], universe: set) -> str:
+        """The function: docstring, then each block of code under a guard on its keys."""
         f = self.f
         text = [f.doc, "", "Arguments: " + ", ".join(f.args) + " (see the module docstring)."]
-        text.append("Returns " + ("(written to out): " if f.style == "fill" else ": ") + ", ".join(
+        text.append("Returns " + ("(written to out): " if f.style in ("fill", "separate") else ": ") + ", ".join(
             f"{n} ({RESULT_UNITS[n]})" for n in f.results) + ".")
         lines = [f"def {f.name}({', '.join(f.args)}):", textwrap.indent('"""' + "\n".join(text) + '\n"""', "    ")]
         if "cam" in f.args:
             lines.append("    Theta, Theta_dot, Theta_ddot = cam")
         remaining = set(universe)
-        for k, fam in enumerate(families):
-            body = self.family_lines(fam)
-            covers = set(fam.keys) == remaining
-            if covers and k == len(families) - 1:
+        for k, (keys, body) in enumerate(blocks):
+            covers = set(keys) == remaining
+            if covers and k == len(blocks) - 1:
                 lines += ["    " + x for x in body]
             else:
-                lines += [f"    if {self.guard(fam.keys, remaining)}:"] + ["        " + x for x in body]
-            remaining -= set(fam.keys)
+                lines += [f"    if {self.guard(keys, remaining)}:"] + ["        " + x for x in body]
+            remaining -= set(keys)
         if remaining:
             lines += ["    " + x for x in self._missing()]
         return "\n".join(lines)
@@ -425,23 +452,31 @@ def _variational_doc(spec: SceneSpec) -> list[str]:
         spec, "parameter vector, laid out as PARAMS (SI units); build it with the scene module's pack()") + ['"""']
 
 
+def _flat(families: dict, functions) -> list[list[_Family]]:
+    """The family lists of every function, a "separate" one's per result."""
+    return [fams for f in functions
+            for fams in (families[f.name] if f.style == "separate" else [families[f.name]])]
+
+
 @dataclass
 class _Layout:
     """What a scene's two modules share: the kernels' families, and the parameter vector p (its
     names, and the trigonometric constants pack() computes) that covers both modules' kernels."""
 
     mod: SceneModule
-    families: dict       # function name -> [_Family]
+    families: dict       # function name -> [_Family] (style "separate": per result, [[_Family]])
     params: list
     constants: dict
 
     @classmethod
     def of(cls, spec: SceneSpec) -> "_Layout":
         mod = build(spec)
-        families = {f.name: _families(f.cases) for f in mod.functions + mod.variational}
+        functions = mod.functions + mod.variational
+        families = {f.name: _separate_families(f) if f.style == "separate" else _families(f.cases)
+                    for f in functions}
         constants: dict = {}
         exprs: list = []
-        for fams in families.values():
+        for fams in _flat(families, functions):
             for fam in fams:
                 constants.update(fam.constants)
                 exprs += fam.expressions()
@@ -455,7 +490,9 @@ class _Layout:
 
     def kernels(self, functions) -> list[str]:
         A = self.mod.automaton
-        return [_Writer(f, A, self.params).source(self.families[f.name], _universe(f, A)) for f in functions]
+        return [_Writer(f, A, self.params).separate_source(self.families[f.name], _universe(f, A))
+                if f.style == "separate" else _Writer(f, A, self.params).source(self.families[f.name], _universe(f, A))
+                for f in functions]
 
 
 def _module_text(header: str, doc: list[str], imports: list[str], data: list[str], code: list[str]) -> str:

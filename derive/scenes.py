@@ -10,6 +10,9 @@ Kernels (arguments in the order of the generated module's docstring), in the sce
 
   rhs(m, t, alpha, alpha_dot, p)              alpha_ddot in mode m
   surface(m, s, t, alpha, alpha_dot, p)       the value of surface s under mode m's laws
+  surface_with_rate(m, s, t, alpha, alpha_dot, p, out)
+                                              out[:] = the values of surface s and of its declared
+                                              rate, each computed as surface computes it
   jacobian(m, t, alpha, alpha_dot, p, out)    out[:] = d(alpha_ddot)/d(alpha, alpha_dot)
   outputs(m, t, alpha, alpha_dot, p, out)     out[:] = the OUTPUTS
   cam(t, p)                                   Theta and its rates (built-in motions; arrays too)
@@ -56,7 +59,9 @@ class Function:
 
     ``dispatch``: the arguments that select a case (e.g. ``("m",)``), in ``args``;
     ``style``: how results come back: "return" (one float), "fill" (written to ``out``),
-    "tuple" (a tuple of floats), "numpy" (a tuple of arrays or floats, NumPy-printed).
+    "tuple" (a tuple of floats), "numpy" (a tuple of arrays or floats, NumPy-printed),
+    "separate" (written to ``out``, each result computed from the definitions it needs alone,
+    with its own common subexpressions: the same arithmetic as a function returning it alone).
     """
 
     name: str
@@ -95,6 +100,19 @@ def _surface_cases(spec: SceneSpec, automaton: Automaton) -> tuple[Case, ...]:
             kernel = fields.surface(spec, mode, name)
             if kernel is not None:
                 out.append(Case((m, s), kernel))
+    return tuple(out)
+
+
+def _rate_cases(spec: SceneSpec, automaton: Automaton) -> tuple[Case, ...]:
+    """Each surface with a declared rate (``automaton.rates``) with that rate, under each mode's
+    laws where both have a meaning: the results of the two surface kernels, in one case."""
+    out = []
+    for m, mode in enumerate(automaton.modes):
+        for s, name in enumerate(automaton.surfaces):
+            value = fields.surface(spec, mode, name) if name in automaton.rates else None
+            rate = fields.surface(spec, mode, automaton.rates[name]) if value is not None else None
+            if rate is not None:
+                out.append(Case((m, s), Kernel(value.definitions + rate.definitions, value.results + rate.results)))
     return tuple(out)
 
 
@@ -161,6 +179,13 @@ def build(spec: SceneSpec) -> SceneModule:
                                   _surface_cases(spec, A),
                                   "The value of switching surface s under mode m's laws (SURFACES); nan where "
                                   "the surface has no meaning in the mode."))
+        if A.rates:
+            functions.append(Function("surface_with_rate", _state_args(spec, "m", "s", out=True), ("m", "s"),
+                                      ("value", "rate"), _rate_cases(spec, A),
+                                      "Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) "
+                                      "under mode m's laws, bitwise as surface computes each, in one call: "
+                                      "out[0] = value, out[1] = rate; nan for a surface without a rate.",
+                                      "separate"))
     functions.append(Function("jacobian", _state_args(spec, "m", out=True), ("m",),
                               ("dalpha_ddot_dalpha", "dalpha_ddot_dalpha_dot"),
                               _mode_cases(A, lambda mode: fields.jacobian(spec, mode)),

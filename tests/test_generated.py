@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import math
 import subprocess
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 
+import camdyn
 from camdyn import generated
 from registry import SCENES
 
@@ -225,7 +228,7 @@ def test_kernels_match_lambdify_oracle(slug):
             expected = np.array(oracle(*[args[a] for a in state], *oracle_values, *(cam if extra else [])),
                                 dtype=float)
             call = list(case.key) + [args[a] for a in state] + [p] + ([cam] if extra else [])
-            if f.style == "fill":
+            if f.style in ("fill", "separate"):
                 out = np.empty(len(f.results))
                 kernel(*call, out)
                 got = out
@@ -251,6 +254,59 @@ def test_every_generated_module_is_at_most_1400_lines():
     sizes = {p.name: len(p.read_text().splitlines()) for p in GENERATED.glob("*.py")}
     assert set(sizes) == expected and any(name.startswith("variational_") for name in sizes)
     assert {name: n for name, n in sizes.items() if n > MAX_LINES} == {}
+
+
+@numba.njit(error_model="numpy")
+def _with_rate_mismatches(surface, with_rate, m, s, rate, p, states):
+    """How many states where with_rate's values differ, bit for bit, from surface's of s and rate."""
+    out = np.empty(2)
+    bad = 0
+    for i in range(states.shape[0]):
+        t, a, ad = states[i, 0], states[i, 1], states[i, 2]
+        with_rate(m, s, t, a, ad, p, out)
+        g, r = surface(m, s, t, a, ad, p), surface(m, rate, t, a, ad, p)
+        if not ((out[0] == g or (math.isnan(out[0]) and math.isnan(g))) and
+                (out[1] == r or (math.isnan(out[1]) and math.isnan(r)))):
+            bad += 1
+    return bad
+
+
+@pytest.mark.parametrize("slug", [s for s in SCENES if any(r >= 0 for r in _module(s).RATE_OF_SURFACE)])
+def test_surface_with_rate_is_surface_bit_for_bit(slug):
+    """surface_with_rate(m, s, ...) writes exactly surface(m, s, ...) and surface(m,
+    RATE_OF_SURFACE[s], ...), compiled as the engine compiles them (cfuncs), in every mode: the
+    crossing check samples a surface with its rate in one call, the root search and the targets
+    read them one at a time, and the two must agree to the last bit."""
+    from camdyn.engine.kernels import compiled_kernels, python_kernels
+    from registry import RIG, cam_for, scene_from_slug
+    mod = _module(slug)
+    scene = scene_from_slug(slug)
+    model = camdyn.Model(RIG, scene, cam_for(scene))
+    p = np.ascontiguousarray(model.p, dtype=float)
+    rng = np.random.default_rng(11)
+    states = np.column_stack([rng.uniform(0, 0.5, 2000), rng.uniform(-0.3, 0.3, 2000), rng.uniform(-50, 50, 2000)])
+    states[:10, 1] = model.static_state()[0]  # the static equilibrium: gap values near 0
+    compiled = scene.motion != "user"
+    kern = compiled_kernels(mod, outputs=False) if compiled else python_kernels(mod, model.cam)
+    checked = 0
+    for s, rate in enumerate(mod.RATE_OF_SURFACE):
+        if rate < 0:
+            continue
+        for m in range(len(mod.MODES)):
+            if compiled:
+                assert _with_rate_mismatches(kern.surface, kern.surface_with_rate, m, s, rate, p, states) == 0
+            else:
+                out = np.empty(2)
+                for t, a, ad in states[:200]:
+                    kern.surface_with_rate(m, s, t, a, ad, p, out)
+                    expected = np.array([kern.surface(m, s, t, a, ad, p), kern.surface(m, rate, t, a, ad, p)])
+                    np.testing.assert_array_equal(out, expected)
+            checked += 1
+    assert checked >= len(mod.MODES)
+
+
+#: kernels only the tangent dynamics and the continuation use (camdyn.tangent, camdyn.continuation)
+STABILITY_KERNELS = ("surface_gradient", "field_sensitivity")
 
 
 @pytest.mark.parametrize("slug", SCENES)

@@ -14,6 +14,8 @@ class Kernels(NamedTuple):
 
     - ``rhs(m, t, alpha, alpha_dot, p) -> alpha_ddot``
     - ``surface(m, s, t, alpha, alpha_dot, p) -> value``
+    - ``surface_with_rate(m, s, t, alpha, alpha_dot, p, out)``: out[0] = surface s's value, out[1]
+      its declared rate's (RATE_OF_SURFACE[s]), computed together
     - ``outputs(m, t, alpha, alpha_dot, p, out)``: the OUTPUTS written to ``out``
     - ``reset(j, t, alpha, alpha_dot, p, out)``: reset j's state written to ``out``
     """
@@ -22,6 +24,7 @@ class Kernels(NamedTuple):
     surface: Any
     outputs: Any
     reset: Any
+    surface_with_rate: Any = None   # None: no surface of the scene has a rate (never called)
 
 
 class Problem(NamedTuple):

@@ -97,11 +97,12 @@ def test_tables_encode_the_generated_automaton(slug):
     assert initial == [c[0] for c in K.INITIAL]
     assert data["mode_contact"][:tab.n_modes].tolist() == [int(c) for c in K.CONTACT_OF_MODE]
     assert [K.OUTPUTS[i] for i in data["flows"][:3]] == ["P_in", "D_c", "D_f"]
-    for m in range(len(K.MODES)):  # each surface a mode's crossing check samples, once
+    for m in range(len(K.MODES)):  # each surface a mode's crossing check samples, once (a rate with its surface)
         sampled = data["sampled"][data["sampled_start"][m]:data["sampled_start"][m + 1]].tolist()
+        evaluated = sampled + [K.RATE_OF_SURFACE[s] for s in sampled if K.RATE_OF_SURFACE[s] >= 0]
         watched = {tr[1] for tr in K.TRANSITIONS if tr[0] == m}
-        assert len(sampled) == len(set(sampled))
-        assert set(sampled) == watched | {K.RATE_OF_SURFACE[s] for s in watched if K.RATE_OF_SURFACE[s] >= 0}
+        assert len(evaluated) == len(set(evaluated))
+        assert set(evaluated) == watched | {K.RATE_OF_SURFACE[s] for s in watched if K.RATE_OF_SURFACE[s] >= 0}
     assert tab.data.size == tab.sampled + data["sampled_start"][tab.n_modes] and tab.n_surfaces == len(K.SURFACES)
 
 

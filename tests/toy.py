@@ -14,7 +14,7 @@ import numpy as np
 
 from camdyn.derive.vocabulary import OUTPUTS
 from camdyn.engine.config import Settings
-from camdyn.engine.kernels import FILL, RHS, SURFACE, no_fill
+from camdyn.engine.kernels import FILL, RHS, SURFACE, SURFACE_FILL, no_fill
 from camdyn.engine.problem import Kernels, Problem
 from camdyn.engine.tables import tables
 
@@ -53,7 +53,10 @@ def clock_problem(functions, directions, rates=None):
 
     def surface(m, s, t, a, ad, p):
         return functions[s](a)
-    kern = Kernels(None, surface, _no_outputs, None)
+
+    def surface_with_rate(m, s, t, a, ad, p, out):
+        out[0], out[1] = functions[s](a), functions[mod.RATE_OF_SURFACE[s]](a)
+    kern = Kernels(None, surface, _no_outputs, None, surface_with_rate)
     return Problem(kern, tables(mod), np.zeros(1))
 
 
@@ -79,6 +82,12 @@ def _toy_surface(m, s, t, a, ad, p):
     return a if s == 0 else ad
 
 
+def _toy_surface_with_rate(m, s, t, a, ad, p, out):
+    """The gap and its rate (surface 0 and 1) together."""
+    out[0] = a
+    out[1] = ad
+
+
 BOUNCE = module(["gap", "gap_rate"], [(0, 0, -1, ((1, ()),)), (1, 0, +1, ((0, ()),))],
                 ((1, ((0, -1),)), (0, ())))
 BOUNCE_WITH_RATE = module(["gap", "gap_rate"], [(0, 0, -1, ((1, ()),)), (1, 0, +1, ((0, ()),))],
@@ -92,8 +101,9 @@ def bounce_problem(p, compiled: bool, rate: bool = False) -> Problem:
     if compiled:
         if _compiled_bounce is None:
             _compiled_bounce = Kernels(numba.cfunc(RHS)(_toy_rhs), numba.cfunc(SURFACE)(_toy_surface),
-                                       numba.cfunc(FILL)(_no_outputs), no_fill)
+                                       numba.cfunc(FILL)(_no_outputs), no_fill,
+                                       numba.cfunc(SURFACE_FILL)(_toy_surface_with_rate))
         kern = _compiled_bounce
     else:
-        kern = Kernels(_toy_rhs, _toy_surface, _no_outputs, None)
+        kern = Kernels(_toy_rhs, _toy_surface, _no_outputs, None, _toy_surface_with_rate)
     return Problem(kern, tables(mod), np.asarray(p, dtype=float))

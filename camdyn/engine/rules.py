@@ -48,18 +48,18 @@ NONFINITE = -2
 
 #: rows of first_crossing's work array (:func:`scratch`): per watched transition of the mode
 #: (k = w - watch_start[m]), its surface's value and rate at the previous sample; per surface,
-#: its value at the current sample
-G_PREV, R_PREV, VALUES = 0, 1, 2
+#: its value at the current sample; the output of the kernel surface_with_rate (value, rate)
+G_PREV, R_PREV, VALUES, WITH_RATE = 0, 1, 2, 3
 
 
 @allocating
 def scratch(n_transitions, n_surfaces):
-    """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES.  One array, not
-    three: fewer arguments to pass down.  (np.empty and a loop, no np.zeros or max of ints: each
-    compiles one more overload on a cold start.)"""
+    """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES, WITH_RATE (at least
+    2 long).  One array, not four: fewer arguments to pass down.  (np.empty and a loop, no
+    np.zeros or max of ints: each compiles one more overload on a cold start.)"""
     n = n_transitions if n_transitions > n_surfaces else n_surfaces
-    work = np.empty((3, n if n > 1 else 1))
-    for r in range(3):
+    work = np.empty((4, n if n > 2 else 2))
+    for r in range(4):
         for k in range(work.shape[1]):
             work[r, k] = 0.0
     return work
@@ -256,11 +256,13 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     Returns (w, t): the transition's row and the located far-side time; w = -1 when nothing
     crosses, NONFINITE when a value is not finite.  ``have_start``: work's rows G_PREV and
     R_PREV already hold the values at t0 (the previous step's end); with no crossing, they
-    hold the values at t1 on return.  (Runs once per step: the kernel is called here directly,
-    and only the rare crossing found is a call, :func:`_crossing_in`.)
+    hold the values at t1 on return.  A surface with a declared rate is sampled with its rate in
+    one kernel call (``surface_with_rate``; Tables.sampled).  (Runs once per step: the kernels
+    are called here directly, and only the rare crossing found is a call, :func:`_crossing_in`.)
     """
     tab = prob.tables
-    data, kernel, p = tab.data, prob.kernels.surface, prob.p
+    data, kernel, with_rate, p = tab.data, prob.kernels.surface, prob.kernels.surface_with_rate, prob.p
+    pair = work[WITH_RATE]
     w0, w1 = data[tab.watch_start + m], data[tab.watch_start + m + 1]
     q0, q1 = data[tab.sampled_start + m], data[tab.sampled_start + m + 1]
     h = t1 - t0
@@ -282,7 +284,12 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
             a, ad = dense_eval(tb, t0, h, y0, y1, Q)
         for q in range(q0, q1):
             s = data[tab.sampled + q]
-            work[VALUES, s] = kernel(m, s, tb, a, ad, p)
+            rate = data[tab.surface_rate + s]
+            if rate >= 0:
+                with_rate(m, s, tb, a, ad, p, pair)
+                work[VALUES, s], work[VALUES, rate] = pair[0], pair[1]
+            else:
+                work[VALUES, s] = kernel(m, s, tb, a, ad, p)
         for w in range(w0, w1):
             k = w - w0
             if (found >> k) & 1:

@@ -43,7 +43,7 @@ class Tables(NamedTuple):
     surface_rate: int              # per surface: the surface that is its time derivative, or -1
     flows: int                     # the outputs integrated by the energy ledger (P_in, D_c, D_f)
     sampled_start: int             # per mode, and one past the end: its sampled surfaces (rows)
-    sampled: int                   # per row: a surface mode m samples (watched, or a watched one's rate), once
+    sampled: int                   # per row: a surface mode m samples, once, with its rate if it has one
     n_modes: int
     n_transitions: int
     n_surfaces: int
@@ -86,16 +86,18 @@ def _tables(K) -> Tables:
 
 
 def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tuple[list[int], list[int]]:
-    """Per mode, the surfaces its crossing check samples: those its transitions watch and their
-    declared rates, each once, in the order of first use (compressed rows: mode m's are
-    ``sampled[sampled_start[m]:sampled_start[m + 1]]``)."""
+    """Per mode, the kernel calls of its crossing check at a sample: the surfaces its transitions
+    watch, each once, in the order of first use, where one with a declared rate is evaluated with
+    that rate in one call (``surface_with_rate``), and a watched rate already so evaluated is not
+    called again (compressed rows: mode m's are ``sampled[sampled_start[m]:sampled_start[m + 1]]``)."""
     start, sampled = [0], []
     for m in range(len(K.MODES)):
+        watched = [tr[1] for tr in transitions[watch_start[m]:watch_start[m + 1]]]
+        covered = {K.RATE_OF_SURFACE[s] for s in watched} - {-1}
         mine: list[int] = []
-        for tr in transitions[watch_start[m]:watch_start[m + 1]]:
-            for s in (tr[1], K.RATE_OF_SURFACE[tr[1]]):
-                if s >= 0 and s not in mine:
-                    mine.append(s)
+        for s in watched:
+            if s not in mine and (s not in covered or K.RATE_OF_SURFACE[s] >= 0):
+                mine.append(s)
         sampled += mine
         start.append(len(sampled))
     return start, sampled

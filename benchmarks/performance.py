@@ -32,6 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import types
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +47,7 @@ import camdyn
 import floor
 import sweep_stop
 from camdyn.engine import rules, stepper
+from camdyn.engine.jit import jitable
 from camdyn.engine.config import SolverOptions
 from camdyn.engine.driver import integrate
 from camdyn.engine.kernels import compiled_kernels
@@ -428,46 +430,82 @@ def engine_pieces(model, run, args, mode: int, rounds: int) -> dict:
     return {k: min(v) / steps[k] * 1e6 for k, v in times.items()}
 
 
-@register_jitable(error_model="numpy")
-def _values_via_call(prob, m, t, a, ad, work):
+def _values(prob, m, t, a, ad, work):
     """A mode's sampled surfaces (Tables.sampled) into work's VALUES row, as first_crossing
-    computes them, but in a called helper that takes the Problem and the work array."""
+    computes them (a surface with a rate and its rate in one call), but in a called helper that
+    takes the Problem and the work array."""
     tab = prob.tables
+    pair = work[rules.WITH_RATE]
     for q in range(tab.data[tab.sampled_start + m], tab.data[tab.sampled_start + m + 1]):
         s = tab.data[tab.sampled + q]
-        work[rules.VALUES, s] = prob.kernels.surface(m, s, t, a, ad, prob.p)
+        rate = tab.data[tab.surface_rate + s]
+        if rate >= 0:
+            prob.kernels.surface_with_rate(m, s, t, a, ad, prob.p, pair)
+            work[rules.VALUES, s], work[rules.VALUES, rate] = pair[0], pair[1]
+        else:
+            work[rules.VALUES, s] = prob.kernels.surface(m, s, t, a, ad, prob.p)
+
+
+def _copy(fn, name):
+    return types.FunctionType(fn.__code__, fn.__globals__, name)
+
+
+#: _values compiled as numba compiles a helper by default (reference-counted), and as the engine's
+#: helpers are (camdyn.engine.jit.jitable: no reference counts, the caller's arrays borrowed)
+_values_counted = register_jitable(error_model="numpy")(_copy(_values, "_values_counted"))
+_values_borrowed = jitable(_copy(_values, "_values_borrowed"))
 
 
 @njit(error_model="numpy")
-def _sample_loop(prob, work, m, n, a, ad):
+def _counted_loop(prob, work, m, n, a, ad):
     acc = 0.0
     for i in range(n):
-        _values_via_call(prob, m, i * 1e-8, a, ad, work)
+        _values_counted(prob, m, i * 1e-8, a, ad, work)
+        acc += work[rules.VALUES, 0]
+    return acc
+
+
+@njit(error_model="numpy")
+def _borrowed_loop(prob, work, m, n, a, ad):
+    acc = 0.0
+    for i in range(n):
+        _values_borrowed(prob, m, i * 1e-8, a, ad, work)
         acc += work[rules.VALUES, 0]
     return acc
 
 
 @njit(error_model="numpy")
 def _direct_loop(prob, work, m, n, a, ad):
-    """The same surface values as _sample_loop, by direct kernel calls in the loop (as first_crossing)."""
+    """The same surface values as _counted_loop, by direct kernel calls in the loop."""
     tab = prob.tables
-    surface, p = prob.kernels.surface, prob.p
+    surface, with_rate, p = prob.kernels.surface, prob.kernels.surface_with_rate, prob.p
+    pair = work[rules.WITH_RATE]
     acc = 0.0
     for i in range(n):
         for q in range(tab.data[tab.sampled_start + m], tab.data[tab.sampled_start + m + 1]):
             s = tab.data[tab.sampled + q]
-            work[rules.VALUES, s] = surface(m, s, i * 1e-8, a, ad, p)
+            rate = tab.data[tab.surface_rate + s]
+            if rate >= 0:
+                with_rate(m, s, i * 1e-8, a, ad, p, pair)
+                work[rules.VALUES, s], work[rules.VALUES, rate] = pair[0], pair[1]
+            else:
+                work[rules.VALUES, s] = surface(m, s, i * 1e-8, a, ad, p)
         acc += work[rules.VALUES, 0]
     return acc
 
 
+CALLS = ("a helper(prob, ..., work), reference-counted", "the same helper without reference counts (jitable)",
+         "the same kernel calls, direct")
+
+
 def call_costs(model, args, mode: int, calls: int = 200_000) -> dict:
     """ns per sample: the mode's sampled surfaces through a called helper passing the Problem and
-    the work array, against the same kernel calls made directly, both compiled."""
+    the work array, compiled with and without numba's reference counting, against the same
+    kernel calls made directly, all compiled."""
     work = rules.scratch(args.prob.tables.n_transitions, args.prob.tables.n_surfaces)
     a, ad = args.start.alpha, args.start.alpha_dot
-    fns = {"a helper(prob, ..., work)": lambda: _sample_loop(args.prob, work, mode, calls, a, ad),
-           "the same kernel calls, direct": lambda: _direct_loop(args.prob, work, mode, calls, a, ad)}
+    loops = (_counted_loop, _borrowed_loop, _direct_loop)
+    fns = {k: (lambda f=f: f(args.prob, work, mode, calls, a, ad)) for k, f in zip(CALLS, loops)}
     for fn in fns.values():
         fn()
     times = floor.interleaved(fns, 7)
@@ -481,7 +519,7 @@ def rule_work(model, run) -> dict:
     from camdyn.engine import loop
     from camdyn.engine.kernels import python_kernels
     from camdyn.engine.problem import Problem
-    counts = {"rhs": 0, "surface": 0, "extremum": 0, "locate": 0}
+    counts = {"rhs": 0, "surface": 0, "with_rate": 0, "extremum": 0, "locate": 0}
     kern = python_kernels(model.kernels)
 
     def counted(name, fn):
@@ -494,7 +532,8 @@ def rule_work(model, run) -> dict:
         for n, fn in saved.items():
             setattr(rules, n, counted(n, fn))
         args = floor.engine_args(model, run)
-        prob = Problem(kern._replace(rhs=counted("rhs", kern.rhs), surface=counted("surface", kern.surface)),
+        prob = Problem(kern._replace(rhs=counted("rhs", kern.rhs), surface=counted("surface", kern.surface),
+                                     surface_with_rate=counted("with_rate", kern.surface_with_rate)),
                        args.prob.tables, args.prob.p)
         r = loop.run_interpreted(prob, args.method, args.cfg, args.start, args.samples)
     finally:
@@ -706,8 +745,10 @@ def safety_lines(fs: dict) -> list[str]:
             f"start: {extra} in all (one step of the method to the located time, 12, and f at the restart, 1, "
             "per switch), a negligible share here;",
             f"- rule work per accepted step (counted on the interpreted backend, same loop source, "
-            f"{counts['steps']} steps): {counts['surface']:.2f} surface evaluations (the floor: "
-            f"{4 * len(rep.watch)}; the engine also samples the gap rate), {counts['extremum']:.3f} extremum "
+            f"{counts['steps']} steps): {counts['surface'] + 2 * counts['with_rate']:.2f} surface evaluations "
+            f"(the floor: {4 * len(rep.watch)}; the engine also samples the gap rate) in "
+            f"{counts['surface'] + counts['with_rate']:.2f} kernel calls ({counts['with_rate']:.2f} of them "
+            f"surface_with_rate: the gap and its rate in one call), {counts['extremum']:.3f} extremum "
             f"searches of the gap rate's turns (micro-hop checks), {counts['locate'] - counts['extremum']:.3f} "
             f"root locations, {counts['rhs']:.2f} RHS evaluations."]
 
@@ -718,13 +759,16 @@ def engine_time_lines(fs: dict) -> list[str]:
              "interleaved with its full loop; us per accepted step):", "",
              "| engine pieces | us per step |", "|---|---|"]
     lines += [f"| {k} | {v:.2f} |" for k, v in pieces.items()]
-    (k1, ns1), (k2, ns2) = calls.items()
-    lines += ["", f"A sample's surface values through `{k1}` cost {ns1:.0f} ns against {ns2:.0f} ns for the "
-              "same kernel calls made directly (both in a compiled loop).  Every call that passes a tuple of "
-              "arrays increments and decrements the reference count of each array in it; the automaton's "
-              "tables, the method and first_crossing's work are therefore one array each, and first_crossing "
-              "calls the surface kernel directly at each sample (only a sample that may hide a crossing "
-              "calls the locating helpers).", "",
+    counted, borrowed, direct = (calls[k] for k in CALLS)
+    lines += ["", f"A sample's surface values through a helper taking the Problem and the work array cost "
+              f"{counted:.0f} ns compiled as numba compiles a helper by default, {borrowed:.0f} ns compiled as the "
+              f"engine's helpers are (`camdyn.engine.jit.jitable`), and {direct:.0f} ns for the same kernel calls "
+              "made directly (all in a compiled loop).  By default every compiled call increments and decrements, "
+              "atomically, the reference count of each array it is passed, those in tuples included; the "
+              "engine's helpers are compiled without reference counting (they borrow their caller's arrays), "
+              "the automaton's tables, the method and first_crossing's work are one array each, and "
+              "first_crossing calls the surface kernels directly at each sample (only a sample that may hide a "
+              "crossing calls the locating helpers).", "",
               f"`integrate()` on the same run (Python set-up of the tables, method and settings, and the "
               f"Trajectory, included): {rep.integrate_s * 1e3:.2f} ms against "
               f"{min(rep.times[floor.ENGINE]) * 1e3:.2f} ms for `run_compiled` alone."]

@@ -456,22 +456,19 @@ _values_counted = register_jitable(error_model="numpy")(_copy(_values, "_values_
 _values_borrowed = jitable(_copy(_values, "_values_borrowed"))
 
 
-@njit(error_model="numpy")
-def _counted_loop(prob, work, m, n, a, ad):
-    acc = 0.0
-    for i in range(n):
-        _values_counted(prob, m, i * 1e-8, a, ad, work)
-        acc += work[rules.VALUES, 0]
-    return acc
+def _sample_loop(helper):
+    """A compiled loop that fills work's VALUES row n times through ``helper`` (a _values copy)."""
+    @njit(error_model="numpy")
+    def loop(prob, work, m, n, a, ad):
+        acc = 0.0
+        for i in range(n):
+            helper(prob, m, i * 1e-8, a, ad, work)
+            acc += work[rules.VALUES, 0]
+        return acc
+    return loop
 
 
-@njit(error_model="numpy")
-def _borrowed_loop(prob, work, m, n, a, ad):
-    acc = 0.0
-    for i in range(n):
-        _values_borrowed(prob, m, i * 1e-8, a, ad, work)
-        acc += work[rules.VALUES, 0]
-    return acc
+_counted_loop, _borrowed_loop = _sample_loop(_values_counted), _sample_loop(_values_borrowed)
 
 
 @njit(error_model="numpy")

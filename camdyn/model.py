@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 from functools import cached_property
 from types import ModuleType
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq
@@ -41,6 +42,15 @@ class Equilibrium:
     @property
     def frequency_Hz(self) -> float:
         return self.vartheta / (2 * math.pi)
+
+
+class Rate(NamedTuple):
+    """:attr:`Model.fastest_rate`: the rate (rad/s), the mode it is found in, and whether the
+    damping term d(alpha_ddot)/d(alpha_dot) dominates it (else the stiffness term)."""
+
+    value: float
+    mode: str
+    damping: bool
 
 
 def static_parameters(rig: Rig, kernels: ModuleType) -> np.ndarray:
@@ -177,6 +187,25 @@ class Model:
         out = np.empty(2)
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
         return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
+
+    @cached_property
+    def fastest_rate(self) -> "Rate":
+        """The fastest rate of the linearized motion (rad/s) at the static equilibrium (alpha*, 0,
+        t = 0): the largest |eigenvalue| of the state matrix [[0, 1], [J_alpha, J_alpha_dot]]
+        (Eqs. 21-22, the generated Jacobian) over the scene's modes.  An explicit Runge-Kutta
+        step cannot be much longer than a few times 1/rate (its stability region), so the rate
+        sets the work per simulated second; in an undamped contact mode it is vartheta (Eq. 23),
+        a strong damping law or a steep friction law raises it."""
+        alpha = self.equilibrium.alpha
+        best = Rate(0.0, self.kernels.MODES[0], False)
+        for m, name in enumerate(self.kernels.MODES):
+            ja, jad = self.jacobian(m, 0.0, alpha, 0.0)
+            if not (math.isfinite(ja) and math.isfinite(jad)):
+                continue
+            rate = float(np.max(np.abs(np.linalg.eigvals([[0.0, 1.0], [ja, jad]]))))
+            if rate > best.value:
+                best = Rate(rate, name, jad * jad > abs(ja))
+        return best
 
     @cached_property
     def variational(self) -> ModuleType | None:

@@ -13,18 +13,24 @@ from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, Trajectory, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
 from . import quasistatic, stopping
-from .errors import ParameterError
+from .errors import CamdynError, ParameterError
 from .model import Model
 from .outcome import Outcome
 from .pieces import integrate_in_pieces
 from .result import Outputs, Result
-from .rig import Rig
+from .rig import PARAMETERS, Rig
 from .scene import Scene
 
 MAX_SAMPLES = 50_000_000
 #: contact-mode periods one run may span: ~20 steps each, so about 2e9 steps at the most
 #: (hours of SciPy stepping); beyond it the run is refused instead of hanging
 MAX_CONTACT_PERIODS = 1e8
+#: the fastest rate (rad/s) of the linearized motion a run accepts (Model.fastest_rate): an
+#: explicit Runge-Kutta step is at most a few times 1/rate (measured with DOP853: 4.4e8 steps per
+#: simulated second at 2.75e9 rad/s, zeta_D = 1e5 on the example rig; far from equilibrium many
+#: more: 3.3e9 per second at 1.2e7 rad/s, k_s = 1e14), so 1e7 rad/s is ~2e6 steps per simulated
+#: second and more; the shipped rigs are below 5e4 rad/s (reference-experiment: 4.3e4)
+MAX_RATE = 1e7
 
 
 def _positive(name, value, valid):
@@ -67,6 +73,12 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     A scene with ``follower="quasistatic"`` is not integrated: the Result holds the quasi-static
     contact orbit at the samples (:mod:`camdyn.quasistatic`; alpha_dot the rigid rate), up to
     where it does not exist (``Outcome.CONTACT_TENSILE``, ``result.stats["where"]``).
+
+    Raises :class:`~camdyn.errors.ParameterError`, before any work, for a run that could not
+    finish: more than MAX_CONTACT_PERIODS periods of the contact mode, MAX_SAMPLES samples, or a
+    linearized motion faster than MAX_RATE rad/s (:attr:`Model.fastest_rate`: a damping, spring
+    or inertia value far outside a mechanism's, for which an explicit method needs millions of
+    steps per millisecond); the message names the parameters.
     """
     if backend not in BACKENDS:
         raise ParameterError("backend", backend, f"one of {BACKENDS}")
@@ -75,7 +87,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     if backend == "compiled" and getattr(cam, "kind", None) == "user":
         raise ParameterError("backend", backend, "'python' for a UserMotion: its Theta(t) is a Python "
                              "callable, which compiled code cannot call")
-    model = Model(rig, scene, cam)
+    model = checked_model(rig, scene, cam)
     duration = run_duration(cam, model.equilibrium.vartheta, t_end, revolutions)
     check_start(t_start, y0)
     t_eval = t_start + np.arange(sample_count(duration, sample_rate_Hz)) / float(sample_rate_Hz)
@@ -130,6 +142,42 @@ def _watch(stop, sample_rate_Hz, period: float, options: SolverOptions):
 
 
 # --- simulate's checks, also run on every point of a sweep before any work (camdyn.sweep_check) ---
+def checked_model(rig: Rig, scene: Scene, cam: CamMotion) -> Model:
+    """The Model of a run, refused (:class:`ParameterError`) where its linearized motion is
+    faster than MAX_RATE: an explicit method would take minutes or hours for milliseconds."""
+    model = Model(rig, scene, cam)
+    rate = model.fastest_rate
+    if rate.value > MAX_RATE:
+        drivers = ", ".join(f"{n} = {getattr(rig, n):g} (rate ~ {n}^{e:.2g})" for n, e in _rate_drivers(model)[:6])
+        raise ParameterError("the fastest rate of the linearized motion (rad/s)", float(f"{rate.value:.3g}"),
+                             f"<= {MAX_RATE:.0e} (an explicit method needs about rate/6 steps per simulated "
+                             "second)", reason=f"in mode {rate.mode}; most sensitive to {drivers or 'no single parameter'}")
+    return model
+
+
+def _rate_drivers(model: Model, factor: float = 1.1) -> list[tuple[str, float]]:
+    """The rig parameters the fastest rate grows or falls with, with d log rate / d log value
+    (where its size is >= 0.2, the largest first), found by changing each by ``factor``: what
+    the error names."""
+    base, rig = model.fastest_rate.value, model.rig
+    found = []
+    for name in sorted(set(model.kernels.INPUTS) & _RIG_NAMES):
+        value = getattr(rig, name)
+        if not value:
+            continue
+        try:
+            other = Model(rig.replace(**{name: value * factor}), model.scene, model.cam).fastest_rate.value
+        except CamdynError:
+            continue
+        elasticity = math.log(other / base) / math.log(factor)
+        if abs(elasticity) >= 0.2:
+            found.append((-abs(elasticity), name, elasticity))
+    return [(name, elasticity) for _, name, elasticity in sorted(found)]
+
+
+_RIG_NAMES = {p.name for p in PARAMETERS}
+
+
 def run_duration(cam: CamMotion, vartheta: float, t_end, revolutions) -> float:
     """The run's length (s) from ``t_end`` or ``revolutions``; refused beyond
     MAX_CONTACT_PERIODS periods of the contact mode (angular frequency ``vartheta``, Eq. 23)."""

@@ -4,7 +4,7 @@ The settings shared by every point (simulate's keywords) are checked once: a bad
 once.  The grid is checked point by point, by building what simulate builds: the point's rig
 (``Rig.replace`` validates every parameter), its cam (``ConstantSpeed`` validates the speed),
 the :class:`camdyn.model.Model` of rig, scene and cam (geometry, friction lock, static
-equilibrium), and the run-length limits of :mod:`camdyn.simulation` (a cam period for
+equilibrium, the fastest rate of its linearized motion: ``checked_model``), and the run-length limits of :mod:`camdyn.simulation` (a cam period for
 ``revolutions``, at most ``MAX_CONTACT_PERIODS`` periods of the contact mode, at most
 ``MAX_SAMPLES`` samples).  A Model is built once per distinct rig of the grid, with one of
 the grid's cams: it depends on the cam only through its kind and constants, which every cam of
@@ -23,8 +23,7 @@ import numpy as np
 
 from .cam import ConstantSpeed
 from .errors import CamdynError, ParameterError
-from .model import Model
-from .simulation import BACKENDS, check_start, run_duration, sample_count, simulate, solver_options
+from .simulation import BACKENDS, check_start, checked_model, run_duration, sample_count, simulate, solver_options
 from .sweep_spec import CAM_NAMES, SweepSpec
 
 #: lines of an InvalidGridError's message at the most (its ``invalid`` lists every point)
@@ -129,7 +128,7 @@ def _rigs(spec: SweepSpec, rig_at: list[int], cam) -> dict[tuple, object]:
     for where in itertools.product(*(range(spec.shape[k]) for k in rig_at)):
         values = {n: float(spec.axes[n][i]) for n, i in zip(names, where)}
         rig = _attempt(spec.rig.replace, **values) if values else spec.rig
-        model = rig if isinstance(rig, str) else _attempt(Model, rig, spec.scene, cam)
+        model = rig if isinstance(rig, str) else _attempt(checked_model, rig, spec.scene, cam)
         out[where] = model if isinstance(model, str) else (rig, model.equilibrium.vartheta)
     return out
 

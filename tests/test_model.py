@@ -184,3 +184,43 @@ def test_a_model_under_another_cam_speed_is_the_model_built_for_it():
     assert moved.period == built.period and moved.equilibrium == built.equilibrium
     with pytest.raises(SceneError, match="motion"):
         built.with_cam(camdyn.Oscillating(amplitude_pp=math.pi, frequency_rpm=40.0))
+
+
+def test_fastest_rate_of_the_undamped_frictionless_contact_is_vartheta():
+    """Eq. 23: without damping or friction the contact mode's linearized motion at alpha* is an
+    undamped oscillator of angular frequency vartheta (the same -dM/dalpha, from the generated
+    Jacobian here and the equilibrium solver there); bound 1e-6: the equilibrium's own solve."""
+    model = Model(RIG, camdyn.Scene(damping="none", friction="none"), camdyn.ConstantSpeed(0.0))
+    rate = model.fastest_rate
+    assert rate.mode == "contact" and not rate.damping
+    assert rate.value == pytest.approx(model.equilibrium.vartheta, rel=1e-6)
+
+
+@pytest.mark.parametrize("preset", camdyn.presets.available())
+def test_no_shipped_rig_comes_near_the_rate_limit(preset):
+    """simulation.MAX_RATE refuses runs an explicit method cannot finish; the shipped rigs, in
+    every generated scene with a constant-speed cam, stay 100x below it."""
+    from camdyn.simulation import MAX_RATE
+    from registry import SCENES, cam_for, scene_from_slug
+    rig = camdyn.presets.load_rig(preset)
+    rates = {}
+    for slug in SCENES:
+        scene = scene_from_slug(slug)
+        if scene.motion != "constant" or scene.model != "nonlinear":
+            continue
+        try:
+            rates[slug] = Model(rig, scene, cam_for(scene)).fastest_rate.value
+        except ParameterError:  # a parameter the preset does not give (e.g. damping C's beta_C)
+            continue
+    assert rates and max(rates.values()) < MAX_RATE / 100
+
+
+@pytest.mark.parametrize("changes, culprit", [({"zeta_D": 1e6}, "zeta_D"), ({"k_s": 1e14}, "k_s"),
+                                              ({"I_Pb": 1e-9}, "I_Pb")])
+def test_a_run_too_stiff_for_an_explicit_method_is_refused_naming_the_parameter(changes, culprit):
+    """Found by tests/test_bad_input.py: zeta_D = 1e6 made a 2 ms run take ~9e6 steps (15 s compiled, far longer interpreted),
+    k_s = 1e14 ~7e6 (15 s); now refused before the run, naming the rate's parameters."""
+    rig = RIG.replace(**changes)
+    with pytest.raises(ParameterError, match="fastest rate of the linearized motion") as err:
+        camdyn.simulate(rig, camdyn.Scene(), speed_rpm=300, t_end=0.002)
+    assert f"{culprit} = " in str(err.value) and "<= 1e+07" in str(err.value)

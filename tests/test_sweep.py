@@ -179,6 +179,13 @@ def test_a_point_beyond_the_run_limits_is_invalid():
         S.sweep(RIG, SCENE, {"speed_rpm": [1.0, 1000.0]}, revolutions=60, sample_rate_Hz=1e6, progress=False)
 
 
+def test_a_rig_too_stiff_for_an_explicit_method_is_an_invalid_point():
+    """simulate's rate limit (simulation.MAX_RATE) is checked per rig of the grid, before any run."""
+    with pytest.raises(S.InvalidGridError, match=r"zeta_D=1e\+06 \(every speed_rpm\): the fastest rate") as info:
+        S.sweep(RIG, SCENE, {"speed_rpm": [900.0], "zeta_D": [0.1, 1e6]}, revolutions=1, progress=False)
+    assert sorted(info.value.invalid) == [1]
+
+
 @pytest.mark.parametrize("settings, error, match", [
     (dict(revolutions=2, rtol=1.0), ParameterError, "rtol"),
     (dict(revolution=3), TypeError, "not a keyword of camdyn.simulate"),

@@ -148,10 +148,11 @@ def checked_model(rig: Rig, scene: Scene, cam: CamMotion) -> Model:
     model = Model(rig, scene, cam)
     rate = model.fastest_rate
     if rate.value > MAX_RATE:
-        drivers = ", ".join(f"{n} = {getattr(rig, n):g} (rate ~ {n}^{e:.2g})" for n, e in _rate_drivers(model)[:6])
+        drivers = ", ".join(f"{n} = {getattr(rig, n):g} (rate ~ {n}^{e:.2g})"
+                            for n, e in _rate_drivers(model)[:6]) or "no single parameter"
         raise ParameterError("the fastest rate of the linearized motion (rad/s)", float(f"{rate.value:.3g}"),
                              f"<= {MAX_RATE:.0e} (an explicit method needs about rate/6 steps per simulated "
-                             "second)", reason=f"in mode {rate.mode}; most sensitive to {drivers or 'no single parameter'}")
+                             "second)", reason=f"in mode {rate.mode}; most sensitive to {drivers}")
     return model
 
 

@@ -38,8 +38,8 @@ def _check_result(r):
 @example(name="I_Pb", value=1e-300)  # found by this test: a contact mode at 1e152 Hz, a near-endless run
 @example(name="k_s", value=1e300)
 @example(name="zeta_D", value=1e300)  # found by this test: a trial stage at alpha = inf raised from math.sin
-@example(name="zeta_D", value=1e6)  # found by this test on a fresh clone: a 2 ms run of ~9e6 steps (minutes interpreted;
-# now refused by simulation.MAX_RATE)
+@example(name="zeta_D", value=1e6)  # found by this test on a fresh clone: a 2 ms run of ~9e6 steps
+# (minutes interpreted; now refused by simulation.MAX_RATE)
 @example(name="k_s", value=1e14)  # ~7e6 steps for 2 ms, 15 s: refused likewise
 @example(name="beta_D", value=4.177100561004714e146)  # found by this test: an overflowing field gave an
 # initial step of 0 s (ZeroDivisionError in the compiled initial-step estimate)

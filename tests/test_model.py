@@ -218,8 +218,9 @@ def test_no_shipped_rig_comes_near_the_rate_limit(preset):
 @pytest.mark.parametrize("changes, culprit", [({"zeta_D": 1e6}, "zeta_D"), ({"k_s": 1e14}, "k_s"),
                                               ({"I_Pb": 1e-9}, "I_Pb")])
 def test_a_run_too_stiff_for_an_explicit_method_is_refused_naming_the_parameter(changes, culprit):
-    """Found by tests/test_bad_input.py: zeta_D = 1e6 made a 2 ms run take ~9e6 steps (15 s compiled, far longer interpreted),
-    k_s = 1e14 ~7e6 (15 s); now refused before the run, naming the rate's parameters."""
+    """Found by tests/test_bad_input.py: zeta_D = 1e6 made a 2 ms run take ~9e6 steps (15 s
+    compiled, far longer interpreted), k_s = 1e14 ~7e6; now refused before the run, naming the
+    rate's parameters."""
     rig = RIG.replace(**changes)
     with pytest.raises(ParameterError, match="fastest rate of the linearized motion") as err:
         camdyn.simulate(rig, camdyn.Scene(), speed_rpm=300, t_end=0.002)

@@ -202,7 +202,8 @@ class Model:
             ja, jad = self.jacobian(m, 0.0, alpha, 0.0)
             if not (math.isfinite(ja) and math.isfinite(jad)):
                 continue
-            rate = float(np.max(np.abs(np.linalg.eigvals([[0.0, 1.0], [ja, jad]]))))
+            disc = jad * jad + 4.0 * ja   # eigenvalues (jad +- sqrt(disc)) / 2
+            rate = (abs(jad) + math.sqrt(disc)) / 2 if disc >= 0 else math.sqrt(-ja)
             if rate > best.value:
                 best = Rate(rate, name, jad * jad > abs(ja))
         return best

@@ -48,7 +48,7 @@ import floor
 import sweep_stop
 from camdyn.engine import rules, stepper
 from camdyn.engine.jit import jitable
-from camdyn.engine.config import SolverOptions
+from camdyn.engine.config import EventSettings, SolverOptions
 from camdyn.engine.driver import integrate
 from camdyn.engine.kernels import compiled_kernels
 from camdyn.engine.tables import tables
@@ -59,7 +59,12 @@ DOCS, IMG = ROOT / "docs", ROOT / "docs" / "img"
 RIG = camdyn.example_rig()
 ATOL_PER_RTOL = 1e-4           # atol = 1e-4 rtol throughout
 REFERENCE_RTOL = 1e-12         # engine DOP853: the reference; engine RK45: its check
-CAMDYN = {"camdyn compiled DOP853": "DOP853", "camdyn compiled RK45": "RK45"}
+#: camdyn's runs: label -> (method, interior points of the crossing check); the last is the
+#: engine without its interior checks (EventSettings(interior_points=0)), to show what that
+#: safety costs against the peers, which locate no events
+CAMDYN = {"camdyn compiled DOP853": ("DOP853", 3), "camdyn compiled RK45": ("RK45", 3),
+          "camdyn DOP853, no interior checks": ("DOP853", 0)}
+MAIN, BARE = "camdyn compiled DOP853", "camdyn DOP853, no interior checks"
 
 
 @dataclass(frozen=True)
@@ -137,11 +142,13 @@ class Sample(NamedTuple):
     switches: int
 
 
-def camdyn_runner(case: Case, model: Model, method: str, rtol: float) -> Callable[[], Sample]:
+def camdyn_runner(case: Case, model: Model, method: str, rtol: float,
+                  interior_points: int = 3) -> Callable[[], Sample]:
     """driver.integrate() on a model built once (as the peers' runners are): the work measured is
     integration, event location and sampling, not model set-up or output kernels."""
     t_eval, y0 = case.t_eval(), model.static_state()
-    options = SolverOptions(method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL)
+    options = SolverOptions(method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL,
+                            events=EventSettings(interior_points=interior_points))
 
     def run() -> Sample:
         tr = integrate(model, (0.0, case.t_end), y0, t_eval, options)
@@ -291,7 +298,7 @@ def prepare(case: Case, peers: dict) -> Prepared:
 
 def solvers(pc: Prepared, peers: dict, rtol: float, skip: set) -> dict[str, Callable[[], Sample]]:
     """Every solver's runner at rtol (those in ``skip`` left out)."""
-    out = {label: camdyn_runner(pc.case, pc.model, method, rtol) for label, method in CAMDYN.items()}
+    out = {label: camdyn_runner(pc.case, pc.model, method, rtol, points) for label, (method, points) in CAMDYN.items()}
     if peers.get("numbalsoda"):
         for m in ("DOP853", "LSODA"):
             out[f"numbalsoda {m}"] = numbalsoda_runner(pc.case, pc.model, pc.nbs_rhs, m, rtol)
@@ -357,12 +364,13 @@ class Ratio(NamedTuple):
     peer: float            # the fastest peer's time at this error / camdyn's
 
 
-def ratios(result: dict) -> list[Ratio]:
-    """Per camdyn DOP853 point: the peers' time at the error it reached, over its time (> 1: ahead)."""
+def ratios(result: dict, label: str = MAIN) -> list[Ratio]:
+    """Per point of camdyn's run ``label``: the peers' time at the error it reached, over its time
+    (> 1: ahead)."""
     curves = result["curves"]
     peers = [k for k in curves if not k.startswith("camdyn")]
     rows = []
-    for rtol, s, e in curves["camdyn compiled DOP853"]:
+    for rtol, s, e in curves[label]:
         if not math.isfinite(e):
             continue
         target = max(e, 1e-300)
@@ -802,6 +810,10 @@ def ratio_lines(results: list) -> list[str]:
     return lines + [""]
 
 
+def _span(values: list) -> str:
+    return f"{fmt(min(values, default=math.nan), '.2f')}-{fmt(max(values, default=math.nan), '.2f')}"
+
+
 def target_lines(results: list) -> list[str]:
     if not peers_available()["numbalsoda"]:  # a peer that did not run is not one camdyn is ahead of
         return ["## Targets", "",
@@ -812,31 +824,52 @@ def target_lines(results: list) -> list[str]:
              "The issue's goal: ahead of numbalsoda at equal error at every tolerance on every scene.  Per scene, "
              "over the tolerances measured (\"never\" counts as ahead):", "",
              "| scene | x numbalsoda min-max | tolerances where behind numbalsoda | ahead at every tolerance | "
-             "x fastest peer min-max |", "|---|---|---|---|---|"]
+             "x fastest peer min-max | x numbalsoda without interior checks min-max |", "|---|---|---|---|---|---|"]
     for res in results:
         rows = ratios(res)
         nbs = [r.numbalsoda for r in rows if r.nbs_reached]
         behind = [f"{r.rtol:.0e} ({r.numbalsoda:.2f})" for r in rows if r.nbs_reached and r.numbalsoda < 1]
         peer = [r.peer for r in rows if math.isfinite(r.peer)]
-        lines.append(f"| {res['case'].key} | {fmt(min(nbs, default=math.nan), '.2f')}-"
-                     f"{fmt(max(nbs, default=math.nan), '.2f')} | {', '.join(behind) or 'none'} | "
-                     f"{'yes' if rows and not behind else 'no'} | {fmt(min(peer, default=math.nan), '.2f')}-"
-                     f"{fmt(max(peer, default=math.nan), '.2f')} |")
-    return lines + ["", numbalsoda_summary(results), ""]
+        bare = [v for v in versus(res, BARE, "numbalsoda") if math.isfinite(v)]
+        lines.append(f"| {res['case'].key} | {_span(nbs)} | {', '.join(behind) or 'none'} | "
+                     f"{'yes' if rows and not behind else 'no'} | {_span(peer)} | {_span(bare)} |")
+    return lines + [""] + summary_lines(results) + [""]
 
 
-def numbalsoda_summary(results: list) -> str:
-    """One sentence: at how many (scene, rtol) points camdyn is ahead of numbalsoda, and by how much."""
-    rows = [r for res in results for r in ratios(res)]
-    ahead = [r for r in rows if not r.nbs_reached or r.numbalsoda >= 1]
-    behind = [r.numbalsoda for r in rows if r.nbs_reached and r.numbalsoda < 1]
-    text = (f"camdyn compiled DOP853 is ahead of numbalsoda at {len(ahead)} of {len(rows)} (scene, rtol) points "
-            f"({sum(not r.nbs_reached for r in rows)} of them where numbalsoda never reached camdyn's error)")
+def versus(result: dict, label: str, peer_prefix: str) -> list[float]:
+    """Per point of camdyn's run ``label``: the best time of the peers named ``peer_prefix...`` at
+    the error it reached, over its time (nan: none of them reached that error)."""
+    curves = result["curves"]
+    peers = [k for k in curves if k.startswith(peer_prefix)]
+    out = []
+    for _, s, e in curves[label]:
+        if math.isfinite(e):
+            at = [time_at_error(curves[k], max(e, 1e-300)) for k in peers]
+            out.append(min((v for v in at if math.isfinite(v)), default=math.nan) / s)
+    return out
+
+
+def numbalsoda_summary(results: list, label: str = MAIN, peer_prefix: str = "numbalsoda") -> str:
+    """One sentence: at how many (scene, rtol) points camdyn's run ``label`` is ahead of the peers
+    ``peer_prefix...`` (numbalsoda: its best of LSODA and DOP853), and by how much."""
+    rows = [v for res in results for v in versus(res, label, peer_prefix)]
+    never = sum(not math.isfinite(v) for v in rows)
+    behind = [v for v in rows if v < 1]
+    name = "numbalsoda" if peer_prefix == "numbalsoda" else peer_prefix
+    text = (f"{label} is ahead of {name} at {len(rows) - len(behind)} of {len(rows)} (scene, rtol) points "
+            f"({never} of them where {name} never reached camdyn's error)")
     if behind:
-        text += (f" and behind at {len(behind)}, where numbalsoda needs {min(behind):.2f}-{max(behind):.2f} x "
+        text += (f" and behind at {len(behind)}, where {name} needs {min(behind):.2f}-{max(behind):.2f} x "
                  f"camdyn's time (median {statistics.median(behind):.2f})")
     return text + "."
 
+
+def summary_lines(results: list) -> list[str]:
+    """The Targets section's summary: camdyn as it runs, without its interior checks, and its DOP853
+    against numbalsoda's (the same method): where the difference lies."""
+    return [f"- {numbalsoda_summary(results)}", f"- {numbalsoda_summary(results, BARE)}",
+            f"- {numbalsoda_summary(results, MAIN, 'numbalsoda DOP853')}",
+            f"- {numbalsoda_summary(results, MAIN, 'numbalsoda LSODA')}"]
 
 
 def scene_lines(results: list) -> list[str]:

@@ -88,6 +88,12 @@ CRITICAL = 1e-2
 #: this factor or more (the chord method converges linearly, at a rate of the order of the
 #: derivatives' change over the step); else it evaluates them at the current z (Newton's step)
 CHORD_CONTRACTION = 0.25
+#: a Newton step, from derivatives evaluated at the current z, that does not shrink the residual
+#: by this factor ends the corrector as failed: Newton's step converges quadratically where the
+#: map is smooth and the prediction is near, so the step is too long or the map not smooth there
+#: (past a grazing); the step is retried shorter instead of spending max_corrector Newton steps
+#: (2 n + 3 runs each with finite differences) on it
+NEWTON_CONTRACTION = 0.5
 #: an event's location stops after this many trials (each shrinks the bracket)
 MAX_BISECTIONS = 40
 #: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
@@ -253,8 +259,9 @@ def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
     the last point: one run per iteration while the residual shrinks by CHORD_CONTRACTION or
     more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 3 runs
     with finite differences).  Returns (z, evaluation at z, iterations), or None when it fails
-    (a run fails, the residual grows, or max_corrector is reached)."""
-    z, last = z_pred.copy(), math.inf
+    (a run fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION,
+    or max_corrector is reached)."""
+    z, last, fresh = z_pred.copy(), math.inf, False
     for it in range(settings.max_corrector + 1):
         lam, x = z[2] * problem.span, z[:2] * scale
         try:                           # MapFailure, or a rig value the rig refuses
@@ -262,7 +269,10 @@ def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
             r = float(np.max(np.abs(G)))
             if r <= settings.tol:
                 return z, _evaluate(problem, lam, x, mode, periods, scale), it
-            if math.isfinite(r) and r > CHORD_CONTRACTION * last:
+            if fresh and not r <= NEWTON_CONTRACTION * last:
+                return None
+            fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
+            if fresh:
                 A = _evaluate(problem, lam, x, mode, periods, scale).A
         except CamdynError:
             return None

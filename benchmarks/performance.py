@@ -46,6 +46,7 @@ from numba.extending import register_jitable
 import camdyn
 import floor
 import sweep_stop
+from camdyn.derive.vocabulary import WITH_RATE_RATE, WITH_RATE_VALUE
 from camdyn.engine import rules, stepper
 from camdyn.engine.jit import jitable
 from camdyn.engine.config import EventSettings, SolverOptions
@@ -449,7 +450,7 @@ def _values(prob, m, t, a, ad, work):
         rate = tab.data[tab.surface_rate + s]
         if rate >= 0:
             prob.kernels.surface_with_rate(m, s, t, a, ad, prob.p, pair)
-            work[rules.VALUES, s], work[rules.VALUES, rate] = pair[0], pair[1]
+            work[rules.VALUES, s], work[rules.VALUES, rate] = pair[WITH_RATE_VALUE], pair[WITH_RATE_RATE]
         else:
             work[rules.VALUES, s] = prob.kernels.surface(m, s, t, a, ad, prob.p)
 
@@ -492,7 +493,7 @@ def _direct_loop(prob, work, m, n, a, ad):
             rate = tab.data[tab.surface_rate + s]
             if rate >= 0:
                 with_rate(m, s, i * 1e-8, a, ad, p, pair)
-                work[rules.VALUES, s], work[rules.VALUES, rate] = pair[0], pair[1]
+                work[rules.VALUES, s], work[rules.VALUES, rate] = pair[WITH_RATE_VALUE], pair[WITH_RATE_RATE]
             else:
                 work[rules.VALUES, s] = surface(m, s, i * 1e-8, a, ad, p)
         acc += work[rules.VALUES, 0]

@@ -40,7 +40,8 @@ from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
 from .graph import Definition, quantity
-from .vocabulary import CAM_STATE, OPTIONS, OUTPUTS, SceneOptionError, SceneSpec  # noqa: F401  (re-exported)
+from .vocabulary import (CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError,  # noqa: F401  (re-exported)
+                         SceneSpec)
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
 
@@ -181,10 +182,11 @@ def build(spec: SceneSpec) -> SceneModule:
                                   "the surface has no meaning in the mode."))
         if A.rates:
             functions.append(Function("surface_with_rate", _state_args(spec, "m", "s", out=True), ("m", "s"),
-                                      ("value", "rate"), _rate_cases(spec, A),
+                                      SURFACE_WITH_RATE, _rate_cases(spec, A),
                                       "Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) "
                                       "under mode m's laws, bitwise as surface computes each, in one call: "
-                                      "out[0] = value, out[1] = rate; nan for a surface without a rate.",
+                                      "out[WITH_RATE_VALUE] = value, out[WITH_RATE_RATE] = rate "
+                                      "(camdyn.derive.vocabulary); nan for a surface without a rate.",
                                       "separate"))
     functions.append(Function("jacobian", _state_args(spec, "m", out=True), ("m",),
                               ("dalpha_ddot_dalpha", "dalpha_ddot_dalpha_dot"),

@@ -224,6 +224,10 @@ JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
 #: is differentiated through the alpha_ddot it contains
 SURFACE_GRADIENT = JACOBIAN + ("d_t",)
 GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T = range(len(SURFACE_GRADIENT))
+#: the entries the generated ``surface_with_rate`` kernel writes to ``out``, in order: a
+#: surface's value and the value of its declared rate (the scene module's RATE_OF_SURFACE)
+SURFACE_WITH_RATE = ("value", "rate")
+WITH_RATE_VALUE, WITH_RATE_RATE = range(len(SURFACE_WITH_RATE))
 #: the continuation parameters, in the order the generated ``field_sensitivity`` kernel writes
 #: d(alpha_ddot)/d(parameter) to ``out`` (each scene: those its fields read, listed in the
 #: SENSITIVITY of its companion module of variational kernels): the cam's speed (Omega_c at

@@ -347,7 +347,7 @@ def surface(m, s, t, alpha, alpha_dot, p):
 
 
 def surface_with_rate(m, s, t, alpha, alpha_dot, p, out):
-    """Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) under mode m's laws, bitwise as surface computes each, in one call: out[0] = value, out[1] = rate; nan for a surface without a rate.
+    """Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) under mode m's laws, bitwise as surface computes each, in one call: out[WITH_RATE_VALUE] = value, out[WITH_RATE_RATE] = rate (camdyn.derive.vocabulary); nan for a surface without a rate.
 
     Arguments: m, s, t, alpha, alpha_dot, p, out (see the module docstring).
     Returns (written to out): value (m, m/s or m/s^2), rate (the value's unit per s).

@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import numba
 import numpy as np
 
-from camdyn.derive.vocabulary import OUTPUTS
+from camdyn.derive.vocabulary import OUTPUTS, WITH_RATE_RATE, WITH_RATE_VALUE
 from camdyn.engine.config import Settings
 from camdyn.engine.kernels import FILL, RHS, SURFACE, SURFACE_FILL, no_fill
 from camdyn.engine.problem import Kernels, Problem
@@ -55,7 +55,7 @@ def clock_problem(functions, directions, rates=None):
         return functions[s](a)
 
     def surface_with_rate(m, s, t, a, ad, p, out):
-        out[0], out[1] = functions[s](a), functions[mod.RATE_OF_SURFACE[s]](a)
+        out[WITH_RATE_VALUE], out[WITH_RATE_RATE] = functions[s](a), functions[mod.RATE_OF_SURFACE[s]](a)
     kern = Kernels(None, surface, _no_outputs, None, surface_with_rate)
     return Problem(kern, tables(mod), np.zeros(1))
 
@@ -84,8 +84,8 @@ def _toy_surface(m, s, t, a, ad, p):
 
 def _toy_surface_with_rate(m, s, t, a, ad, p, out):
     """The gap and its rate (surface 0 and 1) together."""
-    out[0] = a
-    out[1] = ad
+    out[WITH_RATE_VALUE] = a
+    out[WITH_RATE_RATE] = ad
 
 
 BOUNCE = module(["gap", "gap_rate"], [(0, 0, -1, ((1, ()),)), (1, 0, +1, ((0, ()),))],

@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 import numpy as np
 
-from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
+from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT, WITH_RATE_RATE, WITH_RATE_VALUE
 from .jit import allocating, jitable
 from .stepper import dense_eval
 
@@ -287,7 +287,7 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
             rate = data[tab.surface_rate + s]
             if rate >= 0:
                 with_rate(m, s, tb, a, ad, p, pair)
-                work[VALUES, s], work[VALUES, rate] = pair[0], pair[1]
+                work[VALUES, s], work[VALUES, rate] = pair[WITH_RATE_VALUE], pair[WITH_RATE_RATE]
             else:
                 work[VALUES, s] = kernel(m, s, tb, a, ad, p)
         for w in range(w0, w1):

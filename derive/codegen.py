@@ -372,6 +372,11 @@ def _index_constants(kind: str, names) -> list[str]:
     return [f"{constant_name(kind, n)} = {i}" for i, n in enumerate(names)]
 
 
+def _named(table: str, kind: str, names) -> list[str]:
+    """A table of names and its index constants (``MODES`` and ``MODE_<NAME> = i``)."""
+    return [f"{table} = {tuple(names)!r}"] + _index_constants(kind, names)
+
+
 def _automaton_code(A: Automaton) -> list[str]:
     mode = {m.name: constant_name("MODE", m.name) for m in A.modes}
     surf = {s: constant_name("SURFACE", s) for s in A.surfaces}
@@ -381,15 +386,13 @@ def _automaton_code(A: Automaton) -> list[str]:
                  for t in ts]
         return "(" + ", ".join(items) + ",)"
 
-    lines = ["# --- the hybrid automaton (derive.automaton) ---",
-             "MODES = " + repr(tuple(m.name for m in A.modes))] + _index_constants("MODE", [m.name for m in A.modes])
+    lines = ["# --- the hybrid automaton (derive.automaton) ---"] + _named("MODES", "MODE", [m.name for m in A.modes])
     lines += ["#: per mode: the follower touches the cam (Eq. 10) or flies (Eq. 15)",
               "CONTACT_OF_MODE = " + repr(tuple(m.contact for m in A.modes)),
               "#: per mode: the damping law of models D, E ('impact' t_a..t_b, 'viscous' after), or None",
               "PHASE_OF_MODE = " + repr(tuple(m.phase for m in A.modes)),
               "#: per mode: Coulomb friction, sliding forward ('fwd', v_r > 0), backward, or 'stick', or None",
-              "SLIP_OF_MODE = " + repr(tuple(m.slip for m in A.modes)),
-              "SURFACES = " + repr(A.surfaces)] + _index_constants("SURFACE", A.surfaces)
+              "SLIP_OF_MODE = " + repr(tuple(m.slip for m in A.modes))] + _named("SURFACES", "SURFACE", A.surfaces)
     rate = [surf[A.rates[s]] if s in A.rates else "-1" for s in A.surfaces]
     lines += ["#: per surface: the surface that is its time derivative (-1: none); an excursion across",
               "#: zero and back inside one step is found where the derivative changes sign",
@@ -523,9 +526,8 @@ def _scene_source(L: _Layout) -> str:
 def _variational_source(L: _Layout) -> str:
     """The text of a scene's companion module (``variational_<slug>``)."""
     spec, A = L.mod.spec, L.mod.automaton
-    data = [f"SLUG = {spec.slug!r}", "PARAMS = " + repr(tuple(L.params)),
-            "MODES = " + repr(tuple(m.name for m in A.modes))] + _index_constants("MODE", [m.name for m in A.modes])
-    data += ["SURFACES = " + repr(A.surfaces)] + _index_constants("SURFACE", A.surfaces)
+    data = [f"SLUG = {spec.slug!r}", "PARAMS = " + repr(tuple(L.params))]
+    data += _named("MODES", "MODE", [m.name for m in A.modes]) + _named("SURFACES", "SURFACE", A.surfaces)
     sensitivity = next((f.results for f in L.mod.variational if f.name == "field_sensitivity"), None)
     if sensitivity is not None:
         names = tuple(n[len(SENSITIVITY_PREFIX):] for n in sensitivity)

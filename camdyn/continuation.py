@@ -64,6 +64,7 @@ import numpy as np
 from .cam import ConstantSpeed
 from .engine.config import SolverOptions
 from .engine.driver import integrate
+from .engine.loop import ALPHA, ALPHA_DOT
 from .errors import CamdynError, ParameterError
 from .model import Model
 from .orbits import ShootingSettings, newton, periodic_orbit
@@ -300,12 +301,7 @@ def _gap(problem: Problem, lam: float, x, mode: int, periods: int):
     tr = integrate(model, (t0, t1), x, t_eval, problem.options, mode=mode, backend=problem.backend)
     if not tr.outcome.ok or tr.t.size != t_eval.size:
         raise MapFailure(f"the run along the orbit failed: {tr.outcome.message}", tr.outcome)
-    K = model.kernels
-    out = np.empty(len(K.OUTPUTS))
-    psi = np.empty(t_eval.size)
-    for i in range(t_eval.size):
-        K.outputs(int(tr.mode[i]), float(tr.t[i]), float(tr.y[0, i]), float(tr.y[1, i]), model.p, out)
-        psi[i] = out[K.OUT_PSI_I]
+    psi = model.outputs_at(tr.mode, tr.t, tr.y[ALPHA], tr.y[ALPHA_DOT], problem.backend)[model.kernels.OUT_PSI_I]
     alpha_revs = tr.y[0, np.searchsorted(t_eval, starts)]
     return _refined_max(psi), alpha_revs, int(tr.end_mode)
 

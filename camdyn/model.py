@@ -188,6 +188,16 @@ class Model:
         self.kernels.jacobian(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
         return float(out[JAC_D_ALPHA]), float(out[JAC_D_ALPHA_DOT])
 
+    def outputs_at(self, modes, t, alpha, alpha_dot, backend: str = "compiled") -> np.ndarray:
+        """The output quantities (rows in the order of ``OUTPUTS``: ``OUT_<NAME>``) at samples of
+        a run (its modes, times and states), by the compiled outputs kernel or, with backend
+        "python", the generated Python one."""
+        from .engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
+        K = self.kernels
+        compiled = backend == "compiled"
+        kern = compiled_kernels(K) if compiled else python_kernels(K, self.cam if self.scene.motion == "user" else None)
+        return outputs_on_samples(kern, compiled, modes, t, alpha, alpha_dot, self.p, len(K.OUTPUTS))
+
     @cached_property
     def fastest_rate(self) -> "Rate":
         """The fastest rate of the linearized motion (rad/s) at the static equilibrium (alpha*, 0,

@@ -248,13 +248,8 @@ LEDGER_OUTPUTS = ("work_in", "dissipated_contact", "dissipated_friction")
 
 def _output_values(model: Model, traj, backend: str) -> dict:
     """The output quantities at every sample of ``traj`` and the ledger's works, by name."""
-    from .engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
-    K = model.kernels
-    compiled = backend == "compiled"
-    kern = compiled_kernels(K) if compiled else python_kernels(K, model.cam if model.scene.motion == "user" else None)
-    values = outputs_on_samples(kern, compiled, traj.mode, traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT], model.p,
-                                len(K.OUTPUTS))
-    outputs = dict(zip(K.OUTPUTS, values))
+    values = model.outputs_at(traj.mode, traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT], backend)
+    outputs = dict(zip(model.kernels.OUTPUTS, values))
     if traj.y.shape[0] == LEDGER_ROWS:
         for i, name in enumerate(LEDGER_OUTPUTS):
             outputs[name] = traj.y[WORK + i].copy()

@@ -527,7 +527,7 @@ def _start(problem: Problem, warmup_revolutions: int, settings):
         return None, orbit.message
     direction = math.copysign(1.0, problem.end - problem.start)
     try:
-        first = _first_point(problem, problem.start, orbit.state, model.mode(orbit.mode), problem.periods,
+        first = _first_point(problem, problem.start, orbit.state, orbit.mode_index, problem.periods,
                              orbit.scale, direction)
     except MapFailure as failure:
         return None, str(failure)

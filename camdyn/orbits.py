@@ -94,6 +94,7 @@ class PeriodicOrbit:
     scale: np.ndarray = field(default_factory=lambda: np.ones(2))
     map_evaluations: int = 0
     jacobian_evaluations: int = 0
+    mode_index: int = -1         # ``mode`` as an index of MODES (-1: no orbit, mode "")
 
     @property
     def ok(self) -> bool:
@@ -274,4 +275,4 @@ def _orbit(section_map: StroboscopicMap, found: NewtonResult, scale) -> Periodic
     return PeriodicOrbit(found.x.copy(), section_map.model.kernels.MODES[section_map.mode], section_map.periods,
                          section_map.phase, multipliers, stable, found.residual, found.iterations, outcome, message,
                          found.jacobian, np.asarray(scale, dtype=float).copy(),
-                         found.map_evaluations + 1, found.jacobian_evaluations)
+                         found.map_evaluations + 1, found.jacobian_evaluations, section_map.mode)

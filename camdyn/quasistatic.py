@@ -57,7 +57,7 @@ class QuasiStaticOutcome(ActionableOutcome):
 class QuasiStaticOrbit:
     """``alpha`` (rad) at the times ``t`` (s), with ``alpha_dot`` and ``alpha_ddot`` of the rigid
     kinematics, the rigid-contact angle ``alpha_i``, the normal force ``F_n`` (N) and the mode
-    (a name of the scene's MODES) at each; ``outcome`` and ``message`` (with where F_n turns
+    (a name of the scene's MODES, and its index in ``mode_index``) at each; ``outcome`` and ``message`` (with where F_n turns
     tensile: ``t_tensile`` s and ``Theta_tensile`` rad, else NaN).  The arrays stop at the
     first time where the orbit fails."""
 
@@ -68,6 +68,7 @@ class QuasiStaticOrbit:
     alpha_i: np.ndarray
     F_n: np.ndarray
     mode: tuple
+    mode_index: np.ndarray       # the same modes as indices of MODES (int64)
     outcome: QuasiStaticOutcome
     message: str
     t_tensile: float = math.nan
@@ -150,7 +151,7 @@ def orbit_at(model: Model, t: np.ndarray) -> QuasiStaticOrbit:
             outcome, where = QuasiStaticOutcome.TENSILE, float(ti)
             break
         rows.append((alpha, ad, add, a_i, F_n))
-        modes.append(K.MODES[m])
+        modes.append(m)
     cols = np.array(rows, dtype=float).reshape(-1, 5).T
     theta = float(np.asarray(model.cam_state(where)[CAM_THETA])) if math.isfinite(where) else math.nan
     message = outcome.message
@@ -158,7 +159,8 @@ def orbit_at(model: Model, t: np.ndarray) -> QuasiStaticOrbit:
         message = (f"{outcome.message} (at t = {where:.6g} s, cam angle Theta = {theta:.6g} rad = "
                    f"{math.degrees(theta) % 360:.4g} deg mod 360)")
     tensile = outcome is QuasiStaticOutcome.TENSILE
-    return QuasiStaticOrbit(t[:cols.shape[1]].copy(), *cols, tuple(modes), outcome, message,
+    return QuasiStaticOrbit(t[:cols.shape[1]].copy(), *cols, tuple(K.MODES[m] for m in modes),
+                            np.array(modes, dtype=np.int64), outcome, message,
                             where if tensile else math.nan, theta if tensile else math.nan)
 
 

@@ -120,7 +120,7 @@ def _quasi_static(model: Model, t_eval: np.ndarray, backend: str, **refused) -> 
                                  "has no start, ledger or stop)")
     orbit = quasistatic.orbit_at(model, t_eval)
     K = model.kernels
-    mode = np.array([K.MODES.index(m) for m in orbit.mode], dtype=np.int64)
+    mode = orbit.mode_index
     outcome = {"SUCCESS": Outcome.SUCCESS, "TENSILE": Outcome.CONTACT_TENSILE,
                "NEWTON_FAILED": Outcome.NO_QUASI_STATIC}[orbit.outcome.name]
     stats = {"nfev": 0, "steps": 0, "rejected_steps": 0, "njev": 0, "switches": 0, "backend": backend,

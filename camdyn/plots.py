@@ -429,7 +429,7 @@ EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neim
                  "multiplier_jump": "x"}
 
 
-def _runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:
+def stability_runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:
     """Maximal runs [i, j] of equal flags, each sharing its last index with the next run's first."""
     cuts = [0] + [k for k in range(1, flags.size) if flags[k] != flags[k - 1]] + [flags.size]
     return [(a, min(b, flags.size - 1), bool(flags[a])) for a, b in zip(cuts[:-1], cuts[1:])]
@@ -459,7 +459,7 @@ def branches(ds, *, diagram=None, contact_loss_rpm: float | None = None, ax=None
             idx = np.flatnonzero(ds["branch"].values == b)
             n = int(ds["periods"].values[idx[0]])
             colour = colours[min(n.bit_length() - 1, len(colours) - 1)]
-            for i, j, ok in _runs(stable[idx]):
+            for i, j, ok in stability_runs(stable[idx]):
                 rows = idx[i:j + 1]
                 ax.plot(lam[rows], alphas[rows, :n], color=colour, lw=1.0, ls="-" if ok else "--")
             ax.plot([], [], color=colour, lw=1.0, ls="-", label=f"period {n} T (dashed: unstable)")

@@ -14,6 +14,7 @@ from scipy.optimize import brentq
 
 import camdyn
 from camdyn.analysis import energy_balance_peak, static_equilibrium
+from camdyn.plots import EVENT_MARKERS, stability_runs
 
 from .common import PAPER, Context, StudyOutput, experiment_rig, figure, fmt, impact_run, md_table, parallel_map, save
 
@@ -99,18 +100,19 @@ def _draw_branches(ax, legs: list[dict]) -> None:
         lam, ok = np.array(b["lambda"]), np.array(b["stable"], dtype=bool)
         rp = np.array([np.nan if v is None else v for v in b["alpha_rp"]])
         for k in np.unique(b["branch"]):
-            on = np.array(b["branch"]) == k
-            n = int(np.array(b["periods"])[on][0])
-            for stable, ls in ((True, "-"), (False, "--")):
+            on = np.flatnonzero(np.array(b["branch"]) == k)
+            n = int(np.array(b["periods"])[on[0]])
+            for i, j, stable in stability_runs(ok[on]):   # as plots.branches draws them
                 label = f"{b['name']} orbit, period {n}, continued ({'stable' if stable else 'unstable'})"
-                ax.plot(lam[on], np.where(ok[on] == stable, rp[on], np.nan), color=colours.get((b["name"], n), "tab:purple"),
-                        ls=ls, lw=1.1, label=label if np.any(ok[on] == stable) and label not in labelled else None)
+                rows = on[i:j + 1]
+                ax.plot(lam[rows], rp[rows], color=colours.get((b["name"], n), "tab:purple"),
+                        ls="-" if stable else "--", lw=1.1, label=label if label not in labelled else None)
                 labelled.add(label)
         for e in b["events"]:
             on = np.array(b["branch"]) == e["branch"]
             order = np.argsort(lam[on])
             y = np.interp(e["speed_rpm"], lam[on][order], rp[on][order])
-            ax.plot(e["speed_rpm"], y, "D" if e["kind"] == "fold" else "s", mfc="none", color="tab:red", ms=6)
+            ax.plot(e["speed_rpm"], y, EVENT_MARKERS.get(e["kind"], "x"), mfc="none", color="tab:red", ms=6)
             ax.annotate(e["kind"].replace("_", " "), (e["speed_rpm"], y), fontsize=7, xytext=(4, 4),
                         textcoords="offset points")
 

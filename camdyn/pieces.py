@@ -21,7 +21,8 @@ from typing import Callable
 import numpy as np
 
 from .engine.config import SolverOptions
-from .engine.driver import Switch, Trajectory
+from .engine.driver import Trajectory
+from .engine.switches import Switches
 from .engine.loop import LEDGER_ROWS, STATE_ROWS, WORK
 from .model import Model
 from .outcome import Outcome
@@ -92,8 +93,7 @@ def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.n
     y = tr.y[:, :kept].copy()
     if y.shape[0] == LEDGER_ROWS:
         y[WORK:LEDGER_ROWS] += work[:, None]
-    switches = [Switch(s.t + shift, s.surface, s.before, s.after, s.alpha, s.alpha_dot) for s in tr.switches]
-    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=switches, records=None)
+    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=tr.switches.shifted(shift))
 
 
 def _joined(parts: list[Trajectory], stopped: bool = False) -> Trajectory:
@@ -107,4 +107,4 @@ def _joined(parts: list[Trajectory], stopped: bool = False) -> Trajectory:
     return dataclasses.replace(last, t=np.concatenate([p.t for p in parts]),
                                y=np.concatenate([p.y for p in parts], axis=1),
                                mode=np.concatenate([p.mode for p in parts]),
-                               switches=[s for p in parts for s in p.switches], stats=stats)
+                               switches=Switches.joined([p.switches for p in parts]), stats=stats)

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .engine.driver import Switch
+from .engine.switches import Switches
 from .outcome import Outcome
 
 
@@ -60,7 +60,8 @@ class Result:
     alpha_r = alpha - alpha_i (residual response, Section 4), psi_i, psi_j,
     psi_i_dot, F_s, F_n, F_f, v_r, N_x, energy, P_in, D_c, D_f, and ``regime``
     (the name of the regime active at each sample).  ``switches`` lists every
-    regime switch; ``outcome`` says how the run ended (check ``result.ok``).
+    regime switch (:class:`~camdyn.engine.switches.Switches`: each a ``Switch``, the times as
+    ``switches.t``); ``outcome`` says how the run ended (check ``result.ok``).
     """
 
     t: np.ndarray
@@ -69,7 +70,7 @@ class Result:
     Theta: np.ndarray
     regime: np.ndarray
     outputs: Mapping[str, np.ndarray]    # a dict, or Outputs (computed when first read)
-    switches: list[Switch]
+    switches: Switches
     outcome: Outcome
     stats: dict
     period: float
@@ -99,20 +100,26 @@ class Result:
 
     def impacts(self) -> np.ndarray:
         """Times at which contact starts (a switch from a free mode to a contact mode)."""
-        contact = self.meta["contact"]
-        return np.array([s.t for s in self.switches if not contact[s.before] and contact[s.after]])
+        before, after = self._contact_across_switches()
+        return self.switches.t[~before & after]
 
     def separations(self) -> np.ndarray:
         """Times at which contact ends."""
-        contact = self.meta["contact"]
-        return np.array([s.t for s in self.switches if contact[s.before] and not contact[s.after]])
+        before, after = self._contact_across_switches()
+        return self.switches.t[before & ~after]
+
+    def _contact_across_switches(self) -> tuple[np.ndarray, np.ndarray]:
+        """Whether the follower touches the cam before and after each switch (CONTACT_OF_MODE)."""
+        sw = self.switches
+        contact = np.array([self.meta["contact"][name] for name in sw.modes], dtype=bool)
+        return contact[sw.before], contact[sw.after]
 
     def after(self, t0: float) -> "Result":
         """The samples at t >= t0 (e.g. to drop a transient)."""
         keep = self.t >= t0
         return Result(self.t[keep], self.alpha[keep], self.alpha_dot[keep], self.Theta[keep],
                       self.regime[keep], {k: v[keep] for k, v in self.outputs.items()},
-                      [s for s in self.switches if s.t >= t0], self.outcome, self.stats,
+                      self.switches[self.switches.t >= t0], self.outcome, self.stats,
                       self.period, self.scene, self.alpha_star, self.meta)
 
     def summary(self) -> str:

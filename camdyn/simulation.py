@@ -12,6 +12,8 @@ from .derive.vocabulary import CAM_THETA
 from .engine.config import EventSettings, SolverOptions
 from .engine.driver import BACKENDS, Trajectory, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
+from .engine.switches import Switches
+from .engine.tables import transition_surfaces
 from . import quasistatic, stopping
 from .errors import CamdynError, ParameterError
 from .model import Model
@@ -125,7 +127,8 @@ def _quasi_static(model: Model, t_eval: np.ndarray, backend: str, **refused) -> 
                "NEWTON_FAILED": Outcome.NO_QUASI_STATIC}[orbit.outcome.name]
     stats = {"nfev": 0, "steps": 0, "rejected_steps": 0, "njev": 0, "switches": 0, "backend": backend,
              "follower": "quasistatic", "where": "" if orbit.ok else orbit.message}
-    traj = Trajectory(orbit.t, np.vstack([orbit.alpha, orbit.alpha_dot]), mode, tuple(K.MODES), [], outcome,
+    traj = Trajectory(orbit.t, np.vstack([orbit.alpha, orbit.alpha_dot]), mode, tuple(K.MODES),
+                      Switches.none(transition_surfaces(K), K.MODES), outcome,
                       stats, int(mode[-1]) if mode.size else 0)
     return _result(model, traj, backend)
 

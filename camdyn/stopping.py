@@ -27,6 +27,7 @@ import numpy as np
 
 from .engine.driver import Trajectory
 from .engine.loop import ALPHA
+from .engine.switches import Switches
 from .errors import ParameterError
 
 #: outputs that accumulate over a run (the energy ledger's works): extended by their increment
@@ -146,15 +147,15 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
         return np.concatenate([x, tail])
 
     cycle, end = result.t[run - 1] - result.t[run - 1 - L], result.t[run - 1]
-    kept = [s for s in result.switches if s.t <= end]    # the run's last piece may go on past its last sample
-    last = [s for s in kept if s.t > end - cycle]
+    switches = result.switches
+    kept = switches[switches.t <= end]         # the run's last piece may go on past its last sample
+    last = kept[kept.t > end - cycle]
     cycles = int(math.ceil((t_end - end) / cycle))
-    more = [dataclasses.replace(s, t=s.t + m * cycle) for m in range(1, cycles + 1) for s in last]
-    more = [s for s in more if s.t <= t_end]
+    more = Switches.joined([kept, last.repeated(cycle, cycles)])
     outputs = {k: grown(v, k in ACCUMULATED) for k, v in result.outputs.items()}
     return dataclasses.replace(result, t=t_eval.copy(), alpha=grown(result.alpha), alpha_dot=grown(result.alpha_dot),
                                Theta=grown(result.Theta, True), regime=grown(result.regime), outputs=outputs,
-                               switches=kept + more)
+                               switches=more[more.t <= t_end])
 
 
 __all__ = ["StopWhenPeriodic", "Watch", "per_revolution", "extend"]

@@ -241,7 +241,7 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     K = model.kernels
     compiled = backend == "compiled"
     phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
-    records, surface_of = tr.records, [row[1] for row in transition_rows(K)]
+    records, surface_of = tr.switches.records, [row[1] for row in transition_rows(K)]
     m = int(records["before"][0]) if len(records) else tr.end_mode
     t, divergence, log_det = t0, 0.0, 0.0
     growth = np.zeros(2) if renormalise else None

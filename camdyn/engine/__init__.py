@@ -17,9 +17,9 @@ import importlib
 from .config import BACKENDS, METHODS, EventSettings, SolverOptions
 
 #: names loaded on first use (PEP 562): the driver imports numba, the settings do not
-_LAZY = {"integrate": ".driver", "Switch": ".driver", "Trajectory": ".driver"}
+_LAZY = {"integrate": ".driver", "Switch": ".switches", "Switches": ".switches", "Trajectory": ".driver"}
 
-__all__ = ["integrate", "SolverOptions", "EventSettings", "Switch", "Trajectory", "BACKENDS", "METHODS"]
+__all__ = ["integrate", "SolverOptions", "EventSettings", "Switch", "Switches", "Trajectory", "BACKENDS", "METHODS"]
 
 
 def __getattr__(name: str):

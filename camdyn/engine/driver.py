@@ -19,24 +19,12 @@ from .config import BACKENDS, SolverOptions, settings
 from .kernels import compiled_kernels, python_kernels
 from .loop import LEDGER_ROWS, OUTCOMES, STATE_ROWS, Samples, Start, loop_loaded, run_compiled, run_interpreted
 from .problem import Problem
+from .switches import Switches
 from .tableau import method_of
-from .tables import tables, transition_rows
+from .tables import tables, transition_surfaces
 
 #: "compiled": the loop and the kernels compiled by numba (built-in cam motions);
 #: "python": the same loop run by Python (any cam motion, e.g. a user's callables; ~100x slower)
-
-
-@dataclass(frozen=True)
-class Switch:
-    """One switch of mode: when, which surface was crossed, the modes before and after, and the
-    state the run continued from."""
-
-    t: float
-    surface: str
-    before: str
-    after: str
-    alpha: float
-    alpha_dot: float
 
 
 @dataclass
@@ -47,13 +35,10 @@ class Trajectory:
     y: np.ndarray            # rows loop.ALPHA, ALPHA_DOT (and with the ledger the works from loop.WORK on)
     mode: np.ndarray         # mode index at each sample (into modes)
     modes: tuple             # the scene's MODES
-    switches: list
+    switches: Switches
     outcome: Outcome
     stats: dict
     end_mode: int            # the mode at the end (to continue the run)
-    #: the engine's switch records (loop.SWITCH: t, transition, before, after by index, the state
-    #: after), for code that needs indices, not names (camdyn.tangent); None for a joined run
-    records: np.ndarray | None = None
 
     @property
     def regime(self) -> np.ndarray:
@@ -106,12 +91,9 @@ def _notice_compile() -> None:
 
 def _trajectory(model, r, samples: Samples, backend: str) -> Trajectory:
     K = model.kernels
-    surfaces = [K.SURFACES[row[1]] for row in transition_rows(K)]
-    sw = r.switches                          # by column: a record's fields one by one cost ~1 us each
-    switches = [Switch(t, surfaces[w], K.MODES[b], K.MODES[a], x, v) for t, w, b, a, x, v in
-                zip(*(sw[name].tolist() for name in ("t", "transition", "before", "after", "alpha", "alpha_dot")))]
+    switches = Switches(r.switches, transition_surfaces(K), K.MODES)
     n = r.n_samples
     stats = {"nfev": int(r.nfev), "steps": int(r.steps), "rejected_steps": int(r.rejected), "njev": 0,
              "switches": len(switches), "backend": backend}
     return Trajectory(samples.t[:n].copy(), samples.y[:, :n].copy(), samples.mode[:n].copy(), tuple(K.MODES),
-                      switches, Outcome[OUTCOMES[r.outcome]], stats, int(r.mode), r.switches)
+                      switches, Outcome[OUTCOMES[r.outcome]], stats, int(r.mode))

@@ -106,3 +106,10 @@ def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tu
 def transition_rows(K: ModuleType) -> list[tuple]:
     """The module's transitions in the order of :class:`Tables` (to name a switch's surface)."""
     return sorted(K.TRANSITIONS, key=lambda tr: tr[0])
+
+
+@lru_cache(maxsize=None)
+def transition_surfaces(K: ModuleType) -> tuple[str, ...]:
+    """The name of the surface each transition crosses, by the transition's index (a switch
+    record's ``transition``), once per scene module."""
+    return tuple(K.SURFACES[row[1]] for row in transition_rows(K))

@@ -278,14 +278,14 @@ def document(result: cal.Calibration, exp_rig: camdyn.Rig, chaos_scan: dict | No
         "- **130 rev/min** (experiment's settings) fixes the experiment's spring moment against the cam's "
         "pull, hence the experiment's k_s (same geometry, same preload length L_us).",
         "",
-        f"That leaves 5 parameters fixed by assumption (r_c, χ0, d_x, d_y, Θ0), one for each degree of freedom "
-        f"the targets leave: r_c (the point-contact law's r_c |ψ_i*| is matched through L_us whatever r_c is), "
-        f"χ0 (sets the scale of I_Pb and w_b), d_x (trades against L_us in the spring moment), d_y (only "
-        f"L_us − d_y enters Eq. 11), Θ0 (no static target sees it). Their reasons are in the table above. The "
-        f"chaos onsets of Section 4 (B and D aperiodic above about 155 rev/min, E earlier, A and C periodic "
-        f"at 155) are not fitted: they are checked by `python -m camdyn.studies fig4-5` and reported in "
-        f"[reproduction.md](reproduction.md); whether another assumed geometry would reproduce them is "
-        f"scanned by `python -m camdyn.studies chaos-scan` (section *Chaos onsets: geometry scan* below).",
+        "That leaves 5 parameters fixed by assumption (r_c, χ0, d_x, d_y, Θ0), one for each degree of freedom "
+        "the targets leave: r_c (the point-contact law's r_c |ψ_i*| is matched through L_us whatever r_c is), "
+        "χ0 (sets the scale of I_Pb and w_b), d_x (trades against L_us in the spring moment), d_y (only "
+        "L_us − d_y enters Eq. 11), Θ0 (no static target sees it). Their reasons are in the table above. The "
+        "chaos onsets of Section 4 (B and D aperiodic above about 155 rev/min, E earlier, A and C periodic "
+        "at 155) are not fitted: they are checked by `python -m camdyn.studies fig4-5` and reported in "
+        "[reproduction.md](reproduction.md); whether another assumed geometry would reproduce them is "
+        "scanned by `python -m camdyn.studies chaos-scan` (section *Chaos onsets: geometry scan* below).",
         "",
         "```text",
         dof.statement(),

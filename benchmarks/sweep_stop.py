@@ -103,6 +103,26 @@ def _leg(leg: tuple) -> tuple:
     return ds, time.perf_counter() - t0
 
 
+#: the two continuation legs, (start, end, phase fraction of the section), start and end times
+#: the contact-loss speed: down from 1.6 with the diagram's section, up from 0.8 with the section
+#: at T/2 (see :func:`continued`)
+LEGS = ((1.6, 0.8, 0.0), (0.8, 1.6, 0.5))
+
+
+def together(grid, loss: float, revolutions: int) -> dict:
+    """The whole job on one ``ProcessPoolExecutor(2)``: the two continuation legs submitted
+    first, then the stopped diagram's chunks on the same pool (a worker done with its leg takes
+    chunks): the wall time from the pool's start to the last result, and the diagram (equal to
+    the one run alone: a point's values depend on the point only)."""
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(2) as pool:
+        legs = [pool.submit(_leg, (start * loss, end * loss, phase)) for start, end, phase in LEGS]
+        ds = S.bifurcation(RIG, SCENE, grid, revolutions=revolutions, transient_revolutions=revolutions // 2,
+                           executor=pool, progress=False, rtol=RTOL, atol=ATOL, stop=camdyn.StopWhenPeriodic())
+        done = [leg.result() for leg in legs]
+    return {"seconds": time.perf_counter() - t0, "diagram": ds, "legs": done}
+
+
 def continued(loss: float, fast) -> dict:
     """The branches over the benchmark's range (camdyn.continue_orbit, finite-difference monodromy):
     down from 1.6 x the contact-loss speed with the diagram's section (phase 0), and up from 0.8 x
@@ -112,12 +132,11 @@ def continued(loss: float, fast) -> dict:
     both exist (the branch interpolated linearly to the diagram's speeds inside it)."""
     from camdyn.continuation import events_table
     out, events = {}, []
-    legs = ((1.6, 0.8, 0.0), (0.8, 1.6, 0.5))
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:         # the two directions at once, one per core
-        done = list(pool.map(_leg, [(start * loss, end * loss, phase) for start, end, phase in legs]))
+        done = list(pool.map(_leg, [(start * loss, end * loss, phase) for start, end, phase in LEGS]))
     seconds = time.perf_counter() - t0
-    for (_, _, phase), (ds, _) in zip(legs, done):
+    for (_, _, phase), (ds, _) in zip(LEGS, done):
         events += [(kind, lam / loss) for kind, lam, _, _ in events_table(ds)]
         out[phase] = ds
     ds = out[0.0]
@@ -127,7 +146,7 @@ def continued(loss: float, fast) -> dict:
     grid = fast["speed_rpm"].values
     both = (fast["stop_period"].values == 1) & (grid >= lam.min()) & (grid <= lam.max()) if on.any() else grid < 0
     diff = np.abs(np.interp(grid[both], lam[order], alpha[order]) - fast["alpha_section"].values[both, 0])
-    return {"seconds": seconds, "leg_seconds": [leg_s for _, leg_s in done], "events": events,
+    return {"seconds": seconds, "leg_seconds": [leg_s for _, leg_s in done], "events": events, "legs": done,
             "compared": int(both.sum()),
             "max_diff": float(diff.max()) if diff.size else np.nan,
             "points": int(sum(d.sizes["point"] for d in out.values()))}
@@ -157,11 +176,17 @@ def shooting(repeats: int = 5) -> dict:
 
 def measure(quick: bool = False) -> dict:
     d = diagrams(40 if quick else 200, 100 if quick else 200)
-    return {"diagram": d, "continued": continued(d["loss"], d["fast"]), "shoot": shooting()}
+    c = continued(d["loss"], d["fast"])
+    job = together(d["fast"]["speed_rpm"].values, d["loss"], d["revolutions"])
+    job["same_diagram"] = bool(np.array_equal(job["diagram"]["alpha_section"].values, d["fast"]["alpha_section"].values,
+                                              equal_nan=True))
+    job["same_branches"] = all(np.array_equal(a["lambda"].values, b["lambda"].values)
+                               for (a, _), (b, _) in zip(job["legs"], c["legs"]))
+    return {"diagram": d, "continued": c, "together": job, "shoot": shooting()}
 
 
 def lines(m: dict) -> list[str]:
-    d, s, c = m["diagram"], m["shoot"], m["continued"]
+    d, s, c, j = m["diagram"], m["shoot"], m["continued"], m["together"]
     saved = 1 - d["run"] / d["requested"]
     periods = ", ".join(f"{n} of period {p}" for p, n in enumerate(d["periods"]) if p and n)
     q_s, q = s["quasistatic"]
@@ -197,9 +222,14 @@ def lines(m: dict) -> list[str]:
            f"{', '.join(f'{k} {v:.4f}' for k, v in c['events']) or 'none'}.  The stable period-1 branch against the "
            f"stopped diagram's period-1 sections at the {c['compared']} speeds both cover: max |difference| "
            f"{c['max_diff']:.1e} rad (the branch interpolated linearly between its points: a bound that includes "
-           f"the interpolation's error).  Stopping plus continuation: {d['fast_s']:.1f} + {c['seconds']:.1f} = "
-           f"{d['fast_s'] + c['seconds']:.1f} s against the goal of < {DIAGRAM_GOAL_S:g} s on 2 cores: "
-           f"{'met' if d['fast_s'] + c['seconds'] < DIAGRAM_GOAL_S else '**not met**'}.  The "
+           f"the interpolation's error).", "",
+           f"**Stopping plus continuation against the goal of < {DIAGRAM_GOAL_S:g} s on 2 cores.**  One after the "
+           f"other, each on the pool of 2: {d['fast_s']:.1f} + {c['seconds']:.1f} = {d['fast_s'] + c['seconds']:.1f} s "
+           f"({'met' if d['fast_s'] + c['seconds'] < DIAGRAM_GOAL_S else 'not met'}).  As one job on one "
+           f"`ProcessPoolExecutor(2)` (the two legs submitted first, then the diagram's chunks, which the worker done "
+           f"with the short leg starts at once): **{j['seconds']:.1f} s, "
+           f"{'met' if j['seconds'] < DIAGRAM_GOAL_S else 'not met'}**; the same diagram ({j['same_diagram']}, every "
+           f"section value equal) and the same branches ({j['same_branches']}) as the runs apart.  The "
            f"{d['speeds'] - d['stopped']} speeds that do not stop (chaotic, of a period above "
            f"{d['stop'].max_period}, or still in a transient) run all their {d['revolutions']} revolutions, which "
            f"no stopping rule may shorten: those speeds alone, the same way, take {d['unstopped_s']:.1f} s.", "",

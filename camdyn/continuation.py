@@ -14,7 +14,12 @@ as ``(x / s, lambda / |end - start|)`` (s the size of the motion, as in :mod:`ca
   ``max_j |P_j(x) - x_j| / s_j <= tol``: it keeps the derivatives of the last point, one run
   per iteration, while the residual shrinks by ``CHORD_CONTRACTION`` per iteration, and takes
   Newton's step (the derivatives at the current z) when it does not; the derivatives are
-  evaluated once more at the converged orbit, for its tangent and its multipliers;
+  evaluated once more at the converged orbit, for its tangent and its multipliers.  Each run
+  of the corrector is sampled along the orbit for the largest gap (below), which leaves its
+  end state unchanged to the bit (:meth:`camdyn.section_map.StroboscopicMap.run`), so the
+  converged orbit is run once: that run gives its gap, and P_n(x) to the Jacobian provider
+  (:func:`camdyn.section_map.jacobian_at`), which runs only its columns: a step of k chord
+  iterations costs k + 1 runs, and 2 n + 2 = 6 more for the derivatives by finite differences;
 * **derivatives**: dP/dx from any Jacobian provider (:func:`camdyn.section_map.finite_differences`
   by default; the variational equations can replace it); dP/dlambda by central differences in
   lambda with the step ``h = rtol^(1/3) max(|lambda|, |end - start|)``, the rule of
@@ -63,7 +68,7 @@ import numpy as np
 
 from .cam import ConstantSpeed
 from .engine.config import SolverOptions
-from .engine.driver import integrate
+from .engine.driver import Trajectory
 from .engine.loop import ALPHA, ALPHA_DOT
 from .errors import CamdynError, ParameterError
 from .model import Model
@@ -71,7 +76,7 @@ from .orbits import ShootingSettings, newton, periodic_orbit
 from .outcome import ActionableOutcome
 from .rig import PARAMETERS, Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
+from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences, jacobian_at
 
 #: the parameter name of the cam speed (rev/min); any other is a rig parameter (SI)
 SPEED = "speed_rpm"
@@ -230,15 +235,38 @@ class _Scaled(NamedTuple):
     J: np.ndarray
 
 
-def _residual(problem: Problem, lam: float, x, mode, periods: int, scale) -> np.ndarray:
-    """G scaled, (P_n(x; lambda) - x) / s: one run (raises MapFailure)."""
-    return (problem.section_map(lam, mode, periods)(x) - x) / scale
+class _Run(NamedTuple):
+    """One run of P_n from x over the orbit's n T (:func:`_orbit_run`): the map, P_n(x), the
+    run's samples, and the revolutions' starts (s) among them."""
+
+    section_map: StroboscopicMap
+    P: np.ndarray
+    trajectory: Trajectory
+    starts: np.ndarray
 
 
-def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale) -> _Scaled:
-    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure)."""
+def _orbit_run(problem: Problem, lam: float, x, mode, periods: int) -> _Run:
+    """P_n(x; lambda) by one run sampled GAP_SAMPLES times per period and at the revolutions'
+    starts (raises MapFailure).  The samples do not change P_n(x), bit for bit
+    (:meth:`StroboscopicMap.run`), so every run of the corrector is this one: the run that
+    converges gives the orbit's largest gap (:func:`_gap`), and P_n(x) to the Jacobian
+    provider, without a run of their own."""
     section_map = problem.section_map(lam, mode, periods)
-    P, J = problem.jacobian(section_map, scale)(x)
+    t0, t1 = section_map.t_span
+    T = section_map.model.period
+    samples = np.linspace(t0, t1, GAP_SAMPLES * periods + 1)
+    starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
+    t_eval = np.unique(np.concatenate([samples, starts]))
+    value, tr = section_map.run(x, t_eval)
+    return _Run(section_map, value.state, tr, starts)
+
+
+def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale, P=None) -> _Scaled:
+    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure); ``P``: P_n(x) when the
+    caller has run it, told to the provider (:func:`~camdyn.section_map.jacobian_at`: a run
+    less by finite differences)."""
+    section_map = problem.section_map(lam, mode, periods)
+    P, J = jacobian_at(problem.jacobian(section_map, scale), x, P)
     h = problem.options.rtol ** (1.0 / 3.0) * max(abs(lam), problem.span)
     plus = problem.section_map(lam + h, mode, periods)(x)
     minus = problem.section_map(lam - h, mode, periods)(x)
@@ -255,26 +283,37 @@ def _tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
     return t if float(t @ previous) >= 0 else -t
 
 
-def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
+class _Corrected(NamedTuple):
+    """The corrector's orbit, before its derivatives: z (scaled), the run that converged there
+    (:func:`_orbit_run`), and the iterations taken."""
+
+    z: np.ndarray
+    run: _Run
+    iterations: int
+
+
+def _correct(problem, z_pred, direction, A, mode, periods, scale, settings) -> _Corrected | None:
     """The chord method on G(z) = 0, direction . (z - z_pred) = 0, from the derivatives ``A`` of
     the last point: one run per iteration while the residual shrinks by CHORD_CONTRACTION or
-    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 3 runs
-    with finite differences).  Returns (z, evaluation at z, iterations), or None when it fails
-    (a run fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION,
-    or max_corrector is reached)."""
+    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 2 runs
+    more with finite differences, told P_n(x) from the iteration's run).  Returns the converged
+    orbit without its derivatives (:func:`_completed` adds them), or None when it fails (a run
+    fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION, or
+    max_corrector is reached)."""
     z, last, fresh = z_pred.copy(), math.inf, False
     for it in range(settings.max_corrector + 1):
         lam, x = z[2] * problem.span, z[:2] * scale
         try:                           # MapFailure, or a rig value the rig refuses
-            G = _residual(problem, lam, x, mode, periods, scale)
+            run = _orbit_run(problem, lam, x, mode, periods)
+            G = (run.P - x) / scale
             r = float(np.max(np.abs(G)))
             if r <= settings.tol:
-                return z, _evaluate(problem, lam, x, mode, periods, scale), it
+                return _Corrected(z, run, it)
             if fresh and not r <= NEWTON_CONTRACTION * last:
                 return None
             fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
             if fresh:
-                A = _evaluate(problem, lam, x, mode, periods, scale).A
+                A = _evaluate(problem, lam, x, mode, periods, scale, run.P).A
         except CamdynError:
             return None
         if not math.isfinite(r) or (it >= 2 and r > last):
@@ -289,21 +328,12 @@ def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
     return None
 
 
-def _gap(problem: Problem, lam: float, x, mode: int, periods: int):
-    """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end mode."""
-    model = problem.model(lam)
-    T = model.period
-    t0 = problem.phase_fraction * T
-    t1 = t0 + periods * T
-    samples = np.linspace(t0, t1, GAP_SAMPLES * periods + 1)
-    starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
-    t_eval = np.unique(np.concatenate([samples, starts]))
-    tr = integrate(model, (t0, t1), x, t_eval, problem.options, mode=mode, backend=problem.backend)
-    if not tr.outcome.ok or tr.t.size != t_eval.size:
-        raise MapFailure(f"the run along the orbit failed: {tr.outcome.message}", tr.outcome)
-    psi = model.outputs_at(tr.mode, tr.t, tr.y[ALPHA], tr.y[ALPHA_DOT], problem.backend)[model.kernels.OUT_PSI_I]
-    alpha_revs = tr.y[0, np.searchsorted(t_eval, starts)]
-    return _refined_max(psi), alpha_revs, int(tr.end_mode)
+def _gap(run: _Run):
+    """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end
+    mode, from the samples of its run."""
+    model, tr = run.section_map.model, run.trajectory
+    psi = model.outputs_at(tr.mode, tr.t, tr.y[ALPHA], tr.y[ALPHA_DOT], run.section_map.backend)[model.kernels.OUT_PSI_I]
+    return _refined_max(psi), tr.y[ALPHA, np.searchsorted(tr.t, run.starts)], int(tr.end_mode)
 
 
 def _refined_max(v: np.ndarray) -> float:
@@ -315,10 +345,11 @@ def _refined_max(v: np.ndarray) -> float:
     return float(b - (a - c) ** 2 / (8 * curvature)) if curvature < 0 else float(b)
 
 
-def _point(problem, z, ev, tangent, mode, periods, scale, iterations) -> Point:
-    lam, x = float(z[2] * problem.span), z[:2] * scale
-    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
-    return Point(lam, x.copy(), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))), iterations, ev.A)
+def _point(lam: float, x, run: _Run, ev: _Scaled, tangent, iterations: int) -> Point:
+    """The orbit (lam, x) as a Point: its gap from its run, its derivatives ``ev``."""
+    gap, alphas, end_mode = _gap(run)
+    return Point(lam, np.array(x, dtype=float), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))),
+                 iterations, ev.A)
 
 
 def _z(problem, p: Point, scale) -> np.ndarray:
@@ -327,15 +358,27 @@ def _z(problem, p: Point, scale) -> np.ndarray:
 
 def _step(problem, p: Point, ds, periods, scale, settings) -> Point | None:
     """The point at arclength ds from p along its tangent, corrected; None when it fails."""
+    found = _corrected(problem, p, ds, periods, scale, settings)
+    return None if found is None else _completed(problem, p, found, periods, scale)
+
+
+def _corrected(problem, p: Point, ds, periods, scale, settings) -> _Corrected | None:
+    """The orbit at arclength ds from p along its tangent, corrected, without its derivatives;
+    None when the corrector fails."""
     z_pred = _z(problem, p, scale) + ds * p.tangent
-    found = _correct(problem, z_pred, p.tangent, p.derivatives, p.mode, periods, scale, settings)
-    if found is None:
-        return None
-    z, ev, it = found
+    return _correct(problem, z_pred, p.tangent, p.derivatives, p.mode, periods, scale, settings)
+
+
+def _completed(problem, p: Point, found: _Corrected, periods, scale) -> Point | None:
+    """The corrected orbit as a Point of p's branch: its derivatives (the provider told P_n(x)
+    from the run that converged: 2 n + 2 runs by finite differences) and its tangent, oriented
+    along p's; None when a run fails (or the rig refuses the value)."""
+    lam, x = float(found.z[2] * problem.span), found.z[:2] * scale
     try:
-        return _point(problem, z, ev, _tangent(ev.A, p.tangent), p.mode, periods, scale, it)
-    except MapFailure:
+        ev = _evaluate(problem, lam, x, p.mode, periods, scale, found.run.P)
+    except CamdynError:
         return None
+    return _point(lam, x, found.run, ev, _tangent(ev.A, p.tangent), found.iterations)
 
 
 # --- detection -----------------------------------------------------------------------------------
@@ -478,11 +521,9 @@ def _follow(problem, branch: Branch, index: int, first: Point, scale, settings, 
 
 def _first_point(problem, lam, x, mode, periods, scale, direction: float) -> Point:
     """The point (lam, x) with its tangent oriented toward increasing lambda times ``direction``."""
-    ev = _evaluate(problem, lam, x, mode, periods, scale)
-    tangent = _tangent(ev.A, np.array([0.0, 0.0, direction]))
-    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
-    return Point(lam, np.asarray(x, dtype=float).copy(), ev.J, tangent, gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), 0, ev.A)
+    run = _orbit_run(problem, lam, x, mode, periods)
+    ev = _evaluate(problem, lam, x, mode, periods, scale, run.P)
+    return _point(lam, x, run, ev, _tangent(ev.A, np.array([0.0, 0.0, direction])), 0)
 
 
 def _switch(problem, e: Point, p: Point, q: Point, periods: int, scale, settings):

@@ -194,6 +194,49 @@ def test_any_jacobian_provider_plugs_in(pd_branch):
     assert ds["multiplier_real"].values[0] == pytest.approx(pd_branch["multiplier_real"].values[i], abs=1e-4)
 
 
+@pytest.fixture(scope="module")
+def contact_start():
+    """The first point of the benchmark's leg up from 0.8 x the contact-loss speed (the benchmark
+    rig, line contact 16 mm: permanent contact, section at T/2), its problem and scale."""
+    from camdyn import continuation as C
+    rig = RIG.replace(l_lambda=0.016)
+    loss = camdyn.contact_loss_speed(rig)
+    problem = C.Problem(rig, SCENE, "speed_rpm", 0.8 * loss, 1.6 * loss, phase_fraction=0.5)
+    first, scale = C._start(problem, 20, ContinuationSettings())
+    assert first is not None, scale
+    return problem, first, scale
+
+
+def _counting(monkeypatch):
+    """The engine runs made from now on (every run of a map goes through section_map's integrate)."""
+    import camdyn.section_map as SM
+    runs, real = [], SM.integrate
+    monkeypatch.setattr(SM, "integrate", lambda *a, **k: runs.append(1) or real(*a, **k))
+    return runs
+
+
+def test_a_converged_point_runs_its_orbit_once(contact_start, monkeypatch):
+    """A step's orbit is run once: the corrector's last run gives the point's largest gap and
+    P_n(x) to the provider, which does not run it again (camdyn.continuation._orbit_run).  So a
+    step that converges in k chord iterations costs k + 1 runs and its derivatives 2 n + 2 = 6
+    (4 finite-difference columns, lambda +- h), against k + 1 + 7 + 1 before; the first point 1 + 6."""
+    from camdyn import continuation as C
+    problem, first, scale = contact_start
+    evaluations = []
+    real_evaluate = C._evaluate
+    monkeypatch.setattr(C, "_evaluate", lambda *a: evaluations.append(1) or real_evaluate(*a))
+    runs = _counting(monkeypatch)
+    q = C._step(problem, first, 1e-3, 1, scale, ContinuationSettings())
+    assert q is not None and len(evaluations) == 1          # a chord step, derivatives at the point only
+    assert len(runs) == q.iterations + 1 + 6
+    # the gap comes from the corrector's run: the same as a run of its own (the samples' end is P_n(x))
+    again = C._orbit_run(problem, q.lam, q.x, first.mode, 1)
+    assert C._gap(again)[0] == q.max_gap and np.array_equal(C._gap(again)[1], q.alpha_revolutions)
+    del runs[:]
+    C._first_point(problem, first.lam, first.x, first.mode, 1, scale, 1.0)
+    assert len(runs) == 1 + 6
+
+
 def test_a_rig_parameter_is_continued_at_a_fixed_speed():
     ds = continue_orbit(RIG, SCENE, "k_s", 2000.0, 2400.0, speed_rpm=1600.0)
     assert ds.attrs["parameter"] == "k_s" and ds["lambda"].attrs["units"] == "N/m"
@@ -314,7 +357,11 @@ class _AnalyticProblem:
 def _continued(f, start, end, monkeypatch):
     """Follow the fixed point x = 0 of f from start to end: the branch and its events."""
     from camdyn import continuation as C
-    monkeypatch.setattr(C, "_gap", lambda problem, lam, x, mode, periods: (-1.0, np.array([x[0]]), 0))
+
+    def run(problem, lam, x, mode, periods):          # P_n(x) alone: no engine run to sample
+        return C._Run(None, problem.section_map(lam, mode)(x), None, np.zeros(0))
+    monkeypatch.setattr(C, "_orbit_run", run)
+    monkeypatch.setattr(C, "_gap", lambda run: (-1.0, np.zeros(1), 0))
     problem, scale, settings = _AnalyticProblem(f, start, end), np.ones(2), ContinuationSettings()
     first = C._first_point(problem, start, np.zeros(2), 0, 1, scale, 1.0)
     branch, events = C.Branch(1), []

@@ -34,7 +34,7 @@ angle along the branch.
 
 **Detection.**  At every point the Floquet multipliers mu (eigenvalues of dP_n/dx) give test
 functions whose sign change between two points marks an event, located in arclength (secant
-trials with the Illinois rule, :func:`_locate`):
+trials with the Illinois rule, :func:`_locate`; grazing's below):
 
 * ``fold``: the lambda-component of the tangent changes sign (a multiplier passes +1 and the
   branch turns back);
@@ -48,7 +48,15 @@ trials with the Illinois rule, :func:`_locate`):
 * ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
   over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
   generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
-  parabola through the largest sample and its neighbours.
+  parabola through the largest sample and its neighbours.  It has a corner at the event (the
+  contact's deflection before, the flight's height after), so a secant across the bracket
+  crawls in from the flat side; but on the contact side (gap < 0) it is smooth, the contact
+  orbit continuing through the event: the trials aim at the root of the secant through the
+  two latest contact-side trials, short of it while it still moves and then just past it, so
+  that the bracket closes from both sides (:func:`_locate_grazing`: 7 trials where bisection
+  took 14 on the leg up from 0.8 x the contact-loss speed of ``benchmarks/sweep_stop.py``).
+  A trial needs the gap alone: its orbit is corrected without derivatives (6 runs less each),
+  which only the two bracketing points get.
 
 At a period doubling the branch of period 2 n T is switched to: Newton's method on P_2n from
 x* +/- eps v (v the eigenvector of the multiplier near -1) on the side where P_n is unstable,
@@ -98,10 +106,16 @@ CHORD_CONTRACTION = 0.25
 #: by this factor ends the corrector as failed: Newton's step converges quadratically where the
 #: map is smooth and the prediction is near, so the step is too long or the map not smooth there
 #: (past a grazing); the step is retried shorter instead of spending max_corrector Newton steps
-#: (2 n + 3 runs each with finite differences) on it
+#: (2 n + 2 runs each with finite differences, besides the iteration's own) on it
 NEWTON_CONTRACTION = 0.5
 #: an event's location stops after this many trials (each shrinks the bracket)
 MAX_BISECTIONS = 40
+#: a grazing's trial aims this fraction of locate_tol past the root extrapolated from the contact
+#: side, and no nearer the far end of the bracket than the rest of locate_tol: with the root known
+#: to within this fraction of locate_tol (the secant's error shrinks superlinearly on the smooth
+#: contact side), one trial lands past the event and the next, a locate_tol from it, before it:
+#: the bracket closes from both sides in two trials (:func:`_grazing_trial`)
+GRAZING_PAST = 0.25
 #: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
 SWITCH_OFFSETS = (1e-3, 1e-2, 3e-2, 1e-1)
 
@@ -394,33 +408,107 @@ def _changed(a: float, b: float) -> bool:
     return math.isfinite(a) and math.isfinite(b) and a * b < 0
 
 
+@dataclass
+class _Bracket:
+    """An event's bracket [lo, hi] in arclength from p: the test function's values at its ends
+    (their signs: p's at lo), the orbits there (after: None while hi is q's step or a failed
+    one), and ``kept``: how many trials in a row kept hi (> 0) or lo (< 0), for the Illinois rule."""
+
+    lo: float
+    hi: float
+    f_lo: float
+    f_hi: float
+    before: object
+    after: object = None
+    kept: int = 0
+
+    def narrow(self, s: float, f: float, orbit) -> None:
+        """Move the end on the side of the trial at s (f there; NaN, a failed step: past the
+        event, the map is not smooth beyond a grazing) to it, halving the value kept at the
+        other end when it was kept before (the Illinois rule)."""
+        if math.isfinite(f) and math.copysign(1.0, f) == math.copysign(1.0, self.f_lo):
+            self.lo, self.f_lo, self.before = s, f, orbit
+            self.f_hi, self.kept = (self.f_hi / 2.0, self.kept + 1) if self.kept > 0 else (self.f_hi, 1)
+        else:
+            self.hi, self.f_hi, self.after = s, f, orbit
+            self.f_lo, self.kept = (self.f_lo / 2.0, self.kept - 1) if self.kept < 0 else (self.f_lo, -1)
+
+
 def _locate(problem, p: Point, q: Point, ds: float, kind: str, periods, scale, settings):
     """The sign change of ``kind``'s test function f between p and q (``ds`` apart in arclength),
     bracketed in arclength from p to ``locate_tol``: the points on both sides of the event
     (after: None when the far end is a failure).  The next trial is the secant root of the
     bracket, with the Illinois rule (the value kept at an end twice in a row is halved, so that
     both ends close in: superlinear for a smooth f) and kept ``locate_tol`` / 2 inside it; the
-    midpoint where an end has no value, and always for grazing (its f, the largest gap, has a
-    corner at the event: about the contact's deflection before it, the flight's height after,
-    and secant trials crawl in from the flat side).  A step whose corrector fails counts as past
-    the event (the map is not smooth beyond a grazing)."""
-    f0 = _tests(p)[kind]
-    sign0 = math.copysign(1.0, f0)
-    lo, hi, before, after = 0.0, ds, p, None
-    f_lo, f_hi, kept = f0, _tests(q)[kind], 0
+    midpoint where an end has no value.  Grazing has its own trials (:func:`_locate_grazing`)."""
+    if kind == "grazing":
+        return _locate_grazing(problem, p, q, ds, periods, scale, settings)
+    bracket = _Bracket(0.0, ds, _tests(p)[kind], _tests(q)[kind], p)
     for _ in range(MAX_BISECTIONS):
-        if hi - lo <= settings.locate_tol:
+        if bracket.hi - bracket.lo <= settings.locate_tol:
             break
-        s = 0.5 * (lo + hi) if kind == "grazing" else _trial(lo, hi, f_lo, f_hi, settings.locate_tol)
+        s = _trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, settings.locate_tol)
         r = _step(problem, p, s, periods, scale, settings)
-        f = math.nan if r is None else _tests(r)[kind]
-        if math.isfinite(f) and math.copysign(1.0, f) == sign0:
-            lo, f_lo, before = s, f, r
-            f_hi, kept = (f_hi / 2.0, kept + 1) if kept > 0 else (f_hi, 1)
-        else:
-            hi, f_hi, after = s, f, r
-            f_lo, kept = (f_lo / 2.0, kept - 1) if kept < 0 else (f_lo, -1)
-    return before, after
+        bracket.narrow(s, math.nan if r is None else _tests(r)[kind], r)
+    return bracket.before, bracket.after
+
+
+def _locate_grazing(problem, p: Point, q: Point, ds: float, periods, scale, settings):
+    """The grazing between p and q bracketed as :func:`_locate` does, the trials aimed from the
+    contact side (:func:`_grazing_trial`): its test function, the largest gap, has a corner at
+    the event (the contact's deflection before it, the flight's height after), so secant trials
+    across the bracket crawl in from the flat side, while on the contact side (gap < 0) it is
+    smooth, the contact orbit continuing through the event.  A trial needs the gap alone: it is
+    a corrected orbit without derivatives (6 runs less by finite differences); the two points
+    returned get theirs (after: None when a run fails there, as for a failed step; before: p
+    then, the bracket's start, the location lost for that rare case)."""
+    bracket = _Bracket(0.0, ds, p.max_gap, q.max_gap, p)
+    contact = [(0.0, p.max_gap) if p.max_gap < 0 else (ds, q.max_gap)]
+    far = 1.0 if p.max_gap < 0 else -1.0
+    for _ in range(MAX_BISECTIONS):
+        if bracket.hi - bracket.lo <= settings.locate_tol:
+            break
+        s = _grazing_trial(bracket.lo, bracket.hi, contact[-3:], far, settings.locate_tol)
+        r = _corrected(problem, p, s, periods, scale, settings)
+        f = math.nan if r is None else _gap(r.run)[0]
+        if f < 0:
+            contact.append((s, f))
+        bracket.narrow(s, f, r)
+    before = bracket.before if bracket.before is p else _completed(problem, p, bracket.before, periods, scale)
+    after = None if bracket.after is None else _completed(problem, p, bracket.after, periods, scale)
+    return before or p, after
+
+
+def _grazing_trial(lo: float, hi: float, contact: list, far: float, tol: float) -> float:
+    """The next trial of a grazing's location in [lo, hi], from the latest contact-side points
+    ``contact`` (arclength, largest gap < 0; ``far``: +1 when the far side is hi, -1 when lo).
+
+    The root of the secant through the last two is the estimate; its change from the estimate
+    of the two before bounds its error (the secant's error shrinks superlinearly).  The trial
+    is that much short of it, to land on the contact side and improve it (halfway to it when
+    that is past the contact end), and once it has settled (a change below GRAZING_PAST tol)
+    GRAZING_PAST tol past it, to land on the far side.  It stays GRAZING_PAST tol from the
+    contact end and (1 - GRAZING_PAST) tol from the far end, so that every trial shrinks the
+    bracket by as much and one landing on the contact side next to the far end closes it.  The
+    midpoint with one contact-side point, or an estimate outside (lo, hi)."""
+    root = _secant_root(contact[-2:])
+    if not lo < root < hi:
+        return 0.5 * (lo + hi)
+    change = abs(root - _secant_root(contact[-3:-1])) if len(contact) > 2 else 0.0
+    short = change if change > GRAZING_PAST * tol else 0.0      # NaN (a flat secant before): not short
+    near = lo if far > 0 else hi                                # the contact end
+    u = (root - near) * far                                     # the estimate's distance from it
+    aim = u + GRAZING_PAST * tol - short
+    aim = aim if aim > 0 else 0.5 * u
+    return near + far * min(max(aim, GRAZING_PAST * tol), hi - lo - (1.0 - GRAZING_PAST) * tol)
+
+
+def _secant_root(points: list) -> float:
+    """The root of the line through two points (s, f); NaN with fewer, or a flat line."""
+    if len(points) < 2 or points[0][1] == points[1][1]:
+        return math.nan
+    (s0, f0), (s1, f1) = points
+    return s1 - f1 * (s1 - s0) / (f1 - f0)
 
 
 def _trial(lo: float, hi: float, f_lo: float, f_hi: float, tol: float) -> float:

@@ -14,7 +14,12 @@ as ``(x / s, lambda / |end - start|)`` (s the size of the motion, as in :mod:`ca
   ``max_j |P_j(x) - x_j| / s_j <= tol``: it keeps the derivatives of the last point, one run
   per iteration, while the residual shrinks by ``CHORD_CONTRACTION`` per iteration, and takes
   Newton's step (the derivatives at the current z) when it does not; the derivatives are
-  evaluated once more at the converged orbit, for its tangent and its multipliers;
+  evaluated once more at the converged orbit, for its tangent and its multipliers.  Each run
+  of the corrector is sampled along the orbit for the largest gap (below), which leaves its
+  end state unchanged to the bit (:meth:`camdyn.section_map.StroboscopicMap.run`), so the
+  converged orbit is run once: that run gives its gap, and P_n(x) to the Jacobian provider
+  (:func:`camdyn.section_map.jacobian_at`), which runs only its columns: a step of k chord
+  iterations costs k + 1 runs, and 2 n + 2 = 6 more for the derivatives by finite differences;
 * **derivatives**: dP/dx from any Jacobian provider (:func:`camdyn.section_map.finite_differences`
   by default; the variational equations can replace it); dP/dlambda by central differences in
   lambda with the step ``h = rtol^(1/3) max(|lambda|, |end - start|)``, the rule of
@@ -29,7 +34,7 @@ angle along the branch.
 
 **Detection.**  At every point the Floquet multipliers mu (eigenvalues of dP_n/dx) give test
 functions whose sign change between two points marks an event, located in arclength (secant
-trials with the Illinois rule, :func:`_locate`):
+trials with the Illinois rule, :func:`_locate`; grazing's below):
 
 * ``fold``: the lambda-component of the tangent changes sign (a multiplier passes +1 and the
   branch turns back);
@@ -43,7 +48,15 @@ trials with the Illinois rule, :func:`_locate`):
 * ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
   over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
   generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
-  parabola through the largest sample and its neighbours.
+  parabola through the largest sample and its neighbours.  It has a corner at the event (the
+  contact's deflection before, the flight's height after), so a secant across the bracket
+  crawls in from the flat side; but on the contact side (gap < 0) it is smooth, the contact
+  orbit continuing through the event: the trials aim at the root of the secant through the
+  two latest contact-side trials, short of it while it still moves and then just past it, so
+  that the bracket closes from both sides (:func:`_locate_grazing`: 7 trials where bisection
+  took 14 on the leg up from 0.8 x the contact-loss speed of ``benchmarks/sweep_stop.py``).
+  A trial needs the gap alone: its orbit is corrected without derivatives (6 runs less each),
+  which only the two bracketing points get.
 
 At a period doubling the branch of period 2 n T is switched to: Newton's method on P_2n from
 x* +/- eps v (v the eigenvector of the multiplier near -1) on the side where P_n is unstable,
@@ -63,7 +76,7 @@ import numpy as np
 
 from .cam import ConstantSpeed
 from .engine.config import SolverOptions
-from .engine.driver import integrate
+from .engine.driver import Trajectory
 from .engine.loop import ALPHA, ALPHA_DOT
 from .errors import CamdynError, ParameterError
 from .model import Model
@@ -71,7 +84,7 @@ from .orbits import ShootingSettings, newton, periodic_orbit
 from .outcome import ActionableOutcome
 from .rig import PARAMETERS, Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
+from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences, jacobian_at
 
 #: the parameter name of the cam speed (rev/min); any other is a rig parameter (SI)
 SPEED = "speed_rpm"
@@ -93,10 +106,16 @@ CHORD_CONTRACTION = 0.25
 #: by this factor ends the corrector as failed: Newton's step converges quadratically where the
 #: map is smooth and the prediction is near, so the step is too long or the map not smooth there
 #: (past a grazing); the step is retried shorter instead of spending max_corrector Newton steps
-#: (2 n + 3 runs each with finite differences) on it
+#: (2 n + 2 runs each with finite differences, besides the iteration's own) on it
 NEWTON_CONTRACTION = 0.5
 #: an event's location stops after this many trials (each shrinks the bracket)
 MAX_BISECTIONS = 40
+#: a grazing's trial aims this fraction of locate_tol past the root extrapolated from the contact
+#: side, and no nearer the far end of the bracket than the rest of locate_tol: with the root known
+#: to within this fraction of locate_tol (the secant's error shrinks superlinearly on the smooth
+#: contact side), one trial lands past the event and the next, a locate_tol from it, before it:
+#: the bracket closes from both sides in two trials (:func:`_grazing_trial`)
+GRAZING_PAST = 0.25
 #: branch switching tries these offsets along the eigenvector (in units of the motion's scale)
 SWITCH_OFFSETS = (1e-3, 1e-2, 3e-2, 1e-1)
 
@@ -230,15 +249,38 @@ class _Scaled(NamedTuple):
     J: np.ndarray
 
 
-def _residual(problem: Problem, lam: float, x, mode, periods: int, scale) -> np.ndarray:
-    """G scaled, (P_n(x; lambda) - x) / s: one run (raises MapFailure)."""
-    return (problem.section_map(lam, mode, periods)(x) - x) / scale
+class _Run(NamedTuple):
+    """One run of P_n from x over the orbit's n T (:func:`_orbit_run`): the map, P_n(x), the
+    run's samples, and the revolutions' starts (s) among them."""
+
+    section_map: StroboscopicMap
+    P: np.ndarray
+    trajectory: Trajectory
+    starts: np.ndarray
 
 
-def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale) -> _Scaled:
-    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure)."""
+def _orbit_run(problem: Problem, lam: float, x, mode, periods: int) -> _Run:
+    """P_n(x; lambda) by one run sampled GAP_SAMPLES times per period and at the revolutions'
+    starts (raises MapFailure).  The samples do not change P_n(x), bit for bit
+    (:meth:`StroboscopicMap.run`), so every run of the corrector is this one: the run that
+    converges gives the orbit's largest gap (:func:`_gap`), and P_n(x) to the Jacobian
+    provider, without a run of their own."""
     section_map = problem.section_map(lam, mode, periods)
-    P, J = problem.jacobian(section_map, scale)(x)
+    t0, t1 = section_map.t_span
+    T = section_map.model.period
+    samples = np.linspace(t0, t1, GAP_SAMPLES * periods + 1)
+    starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
+    t_eval = np.unique(np.concatenate([samples, starts]))
+    value, tr = section_map.run(x, t_eval)
+    return _Run(section_map, value.state, tr, starts)
+
+
+def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale, P=None) -> _Scaled:
+    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure); ``P``: P_n(x) when the
+    caller has run it, told to the provider (:func:`~camdyn.section_map.jacobian_at`: a run
+    less by finite differences)."""
+    section_map = problem.section_map(lam, mode, periods)
+    P, J = jacobian_at(problem.jacobian(section_map, scale), x, P)
     h = problem.options.rtol ** (1.0 / 3.0) * max(abs(lam), problem.span)
     plus = problem.section_map(lam + h, mode, periods)(x)
     minus = problem.section_map(lam - h, mode, periods)(x)
@@ -255,26 +297,37 @@ def _tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
     return t if float(t @ previous) >= 0 else -t
 
 
-def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
+class _Corrected(NamedTuple):
+    """The corrector's orbit, before its derivatives: z (scaled), the run that converged there
+    (:func:`_orbit_run`), and the iterations taken."""
+
+    z: np.ndarray
+    run: _Run
+    iterations: int
+
+
+def _correct(problem, z_pred, direction, A, mode, periods, scale, settings) -> _Corrected | None:
     """The chord method on G(z) = 0, direction . (z - z_pred) = 0, from the derivatives ``A`` of
     the last point: one run per iteration while the residual shrinks by CHORD_CONTRACTION or
-    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 3 runs
-    with finite differences).  Returns (z, evaluation at z, iterations), or None when it fails
-    (a run fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION,
-    or max_corrector is reached)."""
+    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 2 runs
+    more with finite differences, told P_n(x) from the iteration's run).  Returns the converged
+    orbit without its derivatives (:func:`_completed` adds them), or None when it fails (a run
+    fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION, or
+    max_corrector is reached)."""
     z, last, fresh = z_pred.copy(), math.inf, False
     for it in range(settings.max_corrector + 1):
         lam, x = z[2] * problem.span, z[:2] * scale
         try:                           # MapFailure, or a rig value the rig refuses
-            G = _residual(problem, lam, x, mode, periods, scale)
+            run = _orbit_run(problem, lam, x, mode, periods)
+            G = (run.P - x) / scale
             r = float(np.max(np.abs(G)))
             if r <= settings.tol:
-                return z, _evaluate(problem, lam, x, mode, periods, scale), it
+                return _Corrected(z, run, it)
             if fresh and not r <= NEWTON_CONTRACTION * last:
                 return None
             fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
             if fresh:
-                A = _evaluate(problem, lam, x, mode, periods, scale).A
+                A = _evaluate(problem, lam, x, mode, periods, scale, run.P).A
         except CamdynError:
             return None
         if not math.isfinite(r) or (it >= 2 and r > last):
@@ -289,21 +342,12 @@ def _correct(problem, z_pred, direction, A, mode, periods, scale, settings):
     return None
 
 
-def _gap(problem: Problem, lam: float, x, mode: int, periods: int):
-    """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end mode."""
-    model = problem.model(lam)
-    T = model.period
-    t0 = problem.phase_fraction * T
-    t1 = t0 + periods * T
-    samples = np.linspace(t0, t1, GAP_SAMPLES * periods + 1)
-    starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
-    t_eval = np.unique(np.concatenate([samples, starts]))
-    tr = integrate(model, (t0, t1), x, t_eval, problem.options, mode=mode, backend=problem.backend)
-    if not tr.outcome.ok or tr.t.size != t_eval.size:
-        raise MapFailure(f"the run along the orbit failed: {tr.outcome.message}", tr.outcome)
-    psi = model.outputs_at(tr.mode, tr.t, tr.y[ALPHA], tr.y[ALPHA_DOT], problem.backend)[model.kernels.OUT_PSI_I]
-    alpha_revs = tr.y[0, np.searchsorted(t_eval, starts)]
-    return _refined_max(psi), alpha_revs, int(tr.end_mode)
+def _gap(run: _Run):
+    """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end
+    mode, from the samples of its run."""
+    model, tr = run.section_map.model, run.trajectory
+    psi = model.outputs_at(tr.mode, tr.t, tr.y[ALPHA], tr.y[ALPHA_DOT], run.section_map.backend)[model.kernels.OUT_PSI_I]
+    return _refined_max(psi), tr.y[ALPHA, np.searchsorted(tr.t, run.starts)], int(tr.end_mode)
 
 
 def _refined_max(v: np.ndarray) -> float:
@@ -315,10 +359,11 @@ def _refined_max(v: np.ndarray) -> float:
     return float(b - (a - c) ** 2 / (8 * curvature)) if curvature < 0 else float(b)
 
 
-def _point(problem, z, ev, tangent, mode, periods, scale, iterations) -> Point:
-    lam, x = float(z[2] * problem.span), z[:2] * scale
-    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
-    return Point(lam, x.copy(), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))), iterations, ev.A)
+def _point(lam: float, x, run: _Run, ev: _Scaled, tangent, iterations: int) -> Point:
+    """The orbit (lam, x) as a Point: its gap from its run, its derivatives ``ev``."""
+    gap, alphas, end_mode = _gap(run)
+    return Point(lam, np.array(x, dtype=float), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))),
+                 iterations, ev.A)
 
 
 def _z(problem, p: Point, scale) -> np.ndarray:
@@ -327,15 +372,27 @@ def _z(problem, p: Point, scale) -> np.ndarray:
 
 def _step(problem, p: Point, ds, periods, scale, settings) -> Point | None:
     """The point at arclength ds from p along its tangent, corrected; None when it fails."""
+    found = _corrected(problem, p, ds, periods, scale, settings)
+    return None if found is None else _completed(problem, p, found, periods, scale)
+
+
+def _corrected(problem, p: Point, ds, periods, scale, settings) -> _Corrected | None:
+    """The orbit at arclength ds from p along its tangent, corrected, without its derivatives;
+    None when the corrector fails."""
     z_pred = _z(problem, p, scale) + ds * p.tangent
-    found = _correct(problem, z_pred, p.tangent, p.derivatives, p.mode, periods, scale, settings)
-    if found is None:
-        return None
-    z, ev, it = found
+    return _correct(problem, z_pred, p.tangent, p.derivatives, p.mode, periods, scale, settings)
+
+
+def _completed(problem, p: Point, found: _Corrected, periods, scale) -> Point | None:
+    """The corrected orbit as a Point of p's branch: its derivatives (the provider told P_n(x)
+    from the run that converged: 2 n + 2 runs by finite differences) and its tangent, oriented
+    along p's; None when a run fails (or the rig refuses the value)."""
+    lam, x = float(found.z[2] * problem.span), found.z[:2] * scale
     try:
-        return _point(problem, z, ev, _tangent(ev.A, p.tangent), p.mode, periods, scale, it)
-    except MapFailure:
+        ev = _evaluate(problem, lam, x, p.mode, periods, scale, found.run.P)
+    except CamdynError:
         return None
+    return _point(lam, x, found.run, ev, _tangent(ev.A, p.tangent), found.iterations)
 
 
 # --- detection -----------------------------------------------------------------------------------
@@ -351,33 +408,107 @@ def _changed(a: float, b: float) -> bool:
     return math.isfinite(a) and math.isfinite(b) and a * b < 0
 
 
+@dataclass
+class _Bracket:
+    """An event's bracket [lo, hi] in arclength from p: the test function's values at its ends
+    (their signs: p's at lo), the orbits there (after: None while hi is q's step or a failed
+    one), and ``kept``: how many trials in a row kept hi (> 0) or lo (< 0), for the Illinois rule."""
+
+    lo: float
+    hi: float
+    f_lo: float
+    f_hi: float
+    before: object
+    after: object = None
+    kept: int = 0
+
+    def narrow(self, s: float, f: float, orbit) -> None:
+        """Move the end on the side of the trial at s (f there; NaN, a failed step: past the
+        event, the map is not smooth beyond a grazing) to it, halving the value kept at the
+        other end when it was kept before (the Illinois rule)."""
+        if math.isfinite(f) and math.copysign(1.0, f) == math.copysign(1.0, self.f_lo):
+            self.lo, self.f_lo, self.before = s, f, orbit
+            self.f_hi, self.kept = (self.f_hi / 2.0, self.kept + 1) if self.kept > 0 else (self.f_hi, 1)
+        else:
+            self.hi, self.f_hi, self.after = s, f, orbit
+            self.f_lo, self.kept = (self.f_lo / 2.0, self.kept - 1) if self.kept < 0 else (self.f_lo, -1)
+
+
 def _locate(problem, p: Point, q: Point, ds: float, kind: str, periods, scale, settings):
     """The sign change of ``kind``'s test function f between p and q (``ds`` apart in arclength),
     bracketed in arclength from p to ``locate_tol``: the points on both sides of the event
     (after: None when the far end is a failure).  The next trial is the secant root of the
     bracket, with the Illinois rule (the value kept at an end twice in a row is halved, so that
     both ends close in: superlinear for a smooth f) and kept ``locate_tol`` / 2 inside it; the
-    midpoint where an end has no value, and always for grazing (its f, the largest gap, has a
-    corner at the event: about the contact's deflection before it, the flight's height after,
-    and secant trials crawl in from the flat side).  A step whose corrector fails counts as past
-    the event (the map is not smooth beyond a grazing)."""
-    f0 = _tests(p)[kind]
-    sign0 = math.copysign(1.0, f0)
-    lo, hi, before, after = 0.0, ds, p, None
-    f_lo, f_hi, kept = f0, _tests(q)[kind], 0
+    midpoint where an end has no value.  Grazing has its own trials (:func:`_locate_grazing`)."""
+    if kind == "grazing":
+        return _locate_grazing(problem, p, q, ds, periods, scale, settings)
+    bracket = _Bracket(0.0, ds, _tests(p)[kind], _tests(q)[kind], p)
     for _ in range(MAX_BISECTIONS):
-        if hi - lo <= settings.locate_tol:
+        if bracket.hi - bracket.lo <= settings.locate_tol:
             break
-        s = 0.5 * (lo + hi) if kind == "grazing" else _trial(lo, hi, f_lo, f_hi, settings.locate_tol)
+        s = _trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, settings.locate_tol)
         r = _step(problem, p, s, periods, scale, settings)
-        f = math.nan if r is None else _tests(r)[kind]
-        if math.isfinite(f) and math.copysign(1.0, f) == sign0:
-            lo, f_lo, before = s, f, r
-            f_hi, kept = (f_hi / 2.0, kept + 1) if kept > 0 else (f_hi, 1)
-        else:
-            hi, f_hi, after = s, f, r
-            f_lo, kept = (f_lo / 2.0, kept - 1) if kept < 0 else (f_lo, -1)
-    return before, after
+        bracket.narrow(s, math.nan if r is None else _tests(r)[kind], r)
+    return bracket.before, bracket.after
+
+
+def _locate_grazing(problem, p: Point, q: Point, ds: float, periods, scale, settings):
+    """The grazing between p and q bracketed as :func:`_locate` does, the trials aimed from the
+    contact side (:func:`_grazing_trial`): its test function, the largest gap, has a corner at
+    the event (the contact's deflection before it, the flight's height after), so secant trials
+    across the bracket crawl in from the flat side, while on the contact side (gap < 0) it is
+    smooth, the contact orbit continuing through the event.  A trial needs the gap alone: it is
+    a corrected orbit without derivatives (6 runs less by finite differences); the two points
+    returned get theirs (after: None when a run fails there, as for a failed step; before: p
+    then, the bracket's start, the location lost for that rare case)."""
+    bracket = _Bracket(0.0, ds, p.max_gap, q.max_gap, p)
+    contact = [(0.0, p.max_gap) if p.max_gap < 0 else (ds, q.max_gap)]
+    far = 1.0 if p.max_gap < 0 else -1.0
+    for _ in range(MAX_BISECTIONS):
+        if bracket.hi - bracket.lo <= settings.locate_tol:
+            break
+        s = _grazing_trial(bracket.lo, bracket.hi, contact[-3:], far, settings.locate_tol)
+        r = _corrected(problem, p, s, periods, scale, settings)
+        f = math.nan if r is None else _gap(r.run)[0]
+        if f < 0:
+            contact.append((s, f))
+        bracket.narrow(s, f, r)
+    before = bracket.before if bracket.before is p else _completed(problem, p, bracket.before, periods, scale)
+    after = None if bracket.after is None else _completed(problem, p, bracket.after, periods, scale)
+    return before or p, after
+
+
+def _grazing_trial(lo: float, hi: float, contact: list, far: float, tol: float) -> float:
+    """The next trial of a grazing's location in [lo, hi], from the latest contact-side points
+    ``contact`` (arclength, largest gap < 0; ``far``: +1 when the far side is hi, -1 when lo).
+
+    The root of the secant through the last two is the estimate; its change from the estimate
+    of the two before bounds its error (the secant's error shrinks superlinearly).  The trial
+    is that much short of it, to land on the contact side and improve it (halfway to it when
+    that is past the contact end), and once it has settled (a change below GRAZING_PAST tol)
+    GRAZING_PAST tol past it, to land on the far side.  It stays GRAZING_PAST tol from the
+    contact end and (1 - GRAZING_PAST) tol from the far end, so that every trial shrinks the
+    bracket by as much and one landing on the contact side next to the far end closes it.  The
+    midpoint with one contact-side point, or an estimate outside (lo, hi)."""
+    root = _secant_root(contact[-2:])
+    if not lo < root < hi:
+        return 0.5 * (lo + hi)
+    change = abs(root - _secant_root(contact[-3:-1])) if len(contact) > 2 else 0.0
+    short = change if change > GRAZING_PAST * tol else 0.0      # NaN (a flat secant before): not short
+    near = lo if far > 0 else hi                                # the contact end
+    u = (root - near) * far                                     # the estimate's distance from it
+    aim = u + GRAZING_PAST * tol - short
+    aim = aim if aim > 0 else 0.5 * u
+    return near + far * min(max(aim, GRAZING_PAST * tol), hi - lo - (1.0 - GRAZING_PAST) * tol)
+
+
+def _secant_root(points: list) -> float:
+    """The root of the line through two points (s, f); NaN with fewer, or a flat line."""
+    if len(points) < 2 or points[0][1] == points[1][1]:
+        return math.nan
+    (s0, f0), (s1, f1) = points
+    return s1 - f1 * (s1 - s0) / (f1 - f0)
 
 
 def _trial(lo: float, hi: float, f_lo: float, f_hi: float, tol: float) -> float:
@@ -478,11 +609,9 @@ def _follow(problem, branch: Branch, index: int, first: Point, scale, settings, 
 
 def _first_point(problem, lam, x, mode, periods, scale, direction: float) -> Point:
     """The point (lam, x) with its tangent oriented toward increasing lambda times ``direction``."""
-    ev = _evaluate(problem, lam, x, mode, periods, scale)
-    tangent = _tangent(ev.A, np.array([0.0, 0.0, direction]))
-    gap, alphas, end_mode = _gap(problem, lam, x, mode, periods)
-    return Point(lam, np.asarray(x, dtype=float).copy(), ev.J, tangent, gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), 0, ev.A)
+    run = _orbit_run(problem, lam, x, mode, periods)
+    ev = _evaluate(problem, lam, x, mode, periods, scale, run.P)
+    return _point(lam, x, run, ev, _tangent(ev.A, np.array([0.0, 0.0, direction])), 0)
 
 
 def _switch(problem, e: Point, p: Point, q: Point, periods: int, scale, settings):

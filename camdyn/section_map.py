@@ -16,10 +16,13 @@ the mode's law where it does not hold.
 A *Jacobian provider* is any callable ``x -> (P(x), dP/dx)``; :func:`finite_differences`
 makes one by central differences of the map; :func:`camdyn.tangent.variational` one by the
 variational equations with saltation matrices, without change to the shooting
-(:mod:`camdyn.orbits`).
+(:mod:`camdyn.orbits`).  A caller that has just run the map at x (the continuation's corrector)
+tells the provider P(x) through :func:`jacobian_at`, so that the finite differences do not run
+it again only to return it.
 """
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import dataclass
 from typing import Protocol
@@ -27,7 +30,7 @@ from typing import Protocol
 import numpy as np
 
 from .engine.config import LOOK_AHEAD, SolverOptions
-from .engine.driver import integrate
+from .engine.driver import Trajectory, integrate
 from .engine.kernels import python_kernels
 from .engine.problem import Problem
 from .engine.rules import across, initial_mode
@@ -125,16 +128,31 @@ class StroboscopicMap:
 
     def evaluate(self, x) -> MapValue:
         """P_n(x) with the start and end modes; raises :class:`MapFailure` when the run fails."""
+        return self.run(x, np.array([self.t_span[1]]))[0]
+
+    def run(self, x, t_eval) -> tuple[MapValue, Trajectory]:
+        """P_n(x) as :meth:`evaluate` gives it, and the run's samples at ``t_eval`` (increasing,
+        within :attr:`t_span`, the last at its end t0 + n T).
+
+        The value is the last sample, the same to the bit as :meth:`evaluate`'s, which is this
+        run sampled at t0 + n T alone: the engine's steps do not depend on the sample times
+        (each sample is read off its step's interpolant; checked in tests/test_orbits.py).
+        So a caller that needs the orbit's samples (the continuation's largest gap) and P_n(x)
+        runs it once.  Raises :class:`MapFailure` when the run fails."""
         x = np.asarray(x, dtype=float)
         if x.shape != (2,) or not np.all(np.isfinite(x)):
             raise ParameterError("x", x, "two finite numbers (alpha rad, alpha_dot rad/s)")
-        m = self.start_mode(x)
         t0, t1 = self.t_span
-        tr = integrate(self.model, (t0, t1), x, np.array([t1]), self.options, mode=m, backend=self.backend)
-        if not tr.outcome.ok or tr.t.size != 1:
+        t_eval = np.asarray(t_eval, dtype=float)
+        if t_eval.ndim != 1 or not t_eval.size or t_eval[0] < t0 or t_eval[-1] != t1 \
+                or not (t_eval[1:] > t_eval[:-1]).all():
+            raise ParameterError("t_eval", t_eval, f"increasing times in [{t0:.6g}, {t1:.6g}] s ending at {t1:.6g}")
+        m = self.start_mode(x)
+        tr = integrate(self.model, (t0, t1), x, t_eval, self.options, mode=m, backend=self.backend)
+        if not tr.outcome.ok or tr.t.size != t_eval.size:
             raise MapFailure(f"the run from {tuple(map(float, x))} over {self.periods} period(s) failed: "
                              f"{tr.outcome.message}", tr.outcome)
-        return MapValue(tr.y[:2, -1].copy(), m, int(tr.end_mode), int(tr.stats["steps"]))
+        return MapValue(tr.y[:2, -1].copy(), m, int(tr.end_mode), int(tr.stats["steps"])), tr
 
     def __call__(self, x) -> np.ndarray:
         """P_n(x), the state after n periods."""
@@ -144,9 +162,24 @@ class StroboscopicMap:
 class JacobianProvider(Protocol):
     """The interface of a Jacobian provider: ``x -> (P(x), dP/dx at x)``, raising
     :class:`MapFailure` where P cannot be evaluated (finite differences, or later the
-    variational equations with saltation matrices)."""
+    variational equations with saltation matrices).
 
-    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+    A provider may also take the keyword ``P``: P(x) when the caller already has it (from a
+    run of the map at x it made anyway); the provider then returns that P and need not run the
+    map for it.  Callers pass it through :func:`jacobian_at`, which calls a provider that does
+    not take it with x alone: a provider written for ``x`` alone keeps working."""
+
+    def __call__(self, x: np.ndarray, P: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+def jacobian_at(provider, x, P=None) -> tuple[np.ndarray, np.ndarray]:
+    """``provider(x)``, told the map's value ``P`` at x when it is known and the provider takes
+    the keyword ``P`` (:class:`JacobianProvider`): :func:`finite_differences` then spares its
+    base run (4 runs instead of 5); the variational provider does not take it, as its one run
+    gives the switches it needs besides P."""
+    if P is not None and "P" in inspect.signature(provider).parameters:
+        return provider(x, P=P)
+    return provider(x)
 
 
 def finite_difference_steps(x, scale, rtol: float) -> np.ndarray:
@@ -167,7 +200,9 @@ def finite_differences(section_map: StroboscopicMap, scale, step_factor: float =
 
     ``scale`` (per state component: rad, rad/s) is the size of the motion, below which the
     step does not shrink (see :func:`finite_difference_steps`); ``step_factor`` multiplies every
-    step (to check the Jacobian against a second step size).  Each call costs 2 n + 1 = 5 runs.
+    step (to check the Jacobian against a second step size).  Each call costs 2 n + 1 = 5 runs,
+    4 when told P(x) (the keyword ``P``, :func:`jacobian_at`): the columns are central
+    differences, which do not use the base run.
     """
     scale = np.asarray(scale, dtype=float)
     if scale.shape != (2,) or not np.all(np.isfinite(scale)) or not np.all(scale > 0):
@@ -175,9 +210,9 @@ def finite_differences(section_map: StroboscopicMap, scale, step_factor: float =
     if not (isinstance(step_factor, (int, float)) and 0 < step_factor < 1e6):
         raise ParameterError("step_factor", step_factor, "0 < step_factor < 1e6")
 
-    def provider(x):
+    def provider(x, P=None):
         x = np.asarray(x, dtype=float)
-        base = section_map(x)
+        base = section_map(x) if P is None else np.array(P, dtype=float)
         h = step_factor * finite_difference_steps(x, scale, section_map.options.rtol)
         J = np.empty((2, 2))
         for j in range(2):

@@ -194,6 +194,49 @@ def test_any_jacobian_provider_plugs_in(pd_branch):
     assert ds["multiplier_real"].values[0] == pytest.approx(pd_branch["multiplier_real"].values[i], abs=1e-4)
 
 
+@pytest.fixture(scope="module")
+def contact_start():
+    """The first point of the benchmark's leg up from 0.8 x the contact-loss speed (the benchmark
+    rig, line contact 16 mm: permanent contact, section at T/2), its problem and scale."""
+    from camdyn import continuation as C
+    rig = RIG.replace(l_lambda=0.016)
+    loss = camdyn.contact_loss_speed(rig)
+    problem = C.Problem(rig, SCENE, "speed_rpm", 0.8 * loss, 1.6 * loss, phase_fraction=0.5)
+    first, scale = C._start(problem, 20, ContinuationSettings())
+    assert first is not None, scale
+    return problem, first, scale
+
+
+def _counting(monkeypatch):
+    """The engine runs made from now on (every run of a map goes through section_map's integrate)."""
+    import camdyn.section_map as SM
+    runs, real = [], SM.integrate
+    monkeypatch.setattr(SM, "integrate", lambda *a, **k: runs.append(1) or real(*a, **k))
+    return runs
+
+
+def test_a_converged_point_runs_its_orbit_once(contact_start, monkeypatch):
+    """A step's orbit is run once: the corrector's last run gives the point's largest gap and
+    P_n(x) to the provider, which does not run it again (camdyn.continuation._orbit_run).  So a
+    step that converges in k chord iterations costs k + 1 runs and its derivatives 2 n + 2 = 6
+    (4 finite-difference columns, lambda +- h), against k + 1 + 7 + 1 before; the first point 1 + 6."""
+    from camdyn import continuation as C
+    problem, first, scale = contact_start
+    evaluations = []
+    real_evaluate = C._evaluate
+    monkeypatch.setattr(C, "_evaluate", lambda *a: evaluations.append(1) or real_evaluate(*a))
+    runs = _counting(monkeypatch)
+    q = C._step(problem, first, 1e-3, 1, scale, ContinuationSettings())
+    assert q is not None and len(evaluations) == 1          # a chord step, derivatives at the point only
+    assert len(runs) == q.iterations + 1 + 6
+    # the gap comes from the corrector's run: the same as a run of its own (the samples' end is P_n(x))
+    again = C._orbit_run(problem, q.lam, q.x, first.mode, 1)
+    assert C._gap(again)[0] == q.max_gap and np.array_equal(C._gap(again)[1], q.alpha_revolutions)
+    del runs[:]
+    C._first_point(problem, first.lam, first.x, first.mode, 1, scale, 1.0)
+    assert len(runs) == 1 + 6
+
+
 def test_a_rig_parameter_is_continued_at_a_fixed_speed():
     ds = continue_orbit(RIG, SCENE, "k_s", 2000.0, 2400.0, speed_rpm=1600.0)
     assert ds.attrs["parameter"] == "k_s" and ds["lambda"].attrs["units"] == "N/m"
@@ -275,6 +318,65 @@ def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f
     assert _trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.parametrize("lo, hi, contact, far, expected", [
+    (0.2, 0.7, [(0.2, -1.0)], 1.0, 0.45),                                # one contact-side point: the midpoint
+    (0.2, 0.7, [(0.0, -2.0), (0.2, -1.0)], 1.0, 0.4 + 2.5e-4),           # root 0.4: tol / 4 past it
+    (0.2, 0.7, [(0.0, -2.0), (0.1, -1.5), (0.2, -1.0)], 1.0, 0.4 + 2.5e-4),   # the root settled: past it
+    (0.2, 0.7, [(0.0, -1.0), (0.1, -0.8), (0.2, -0.5)], 1.0, 0.2 + 1 / 6 + 2.5e-4 - (0.5 - 0.2 - 1 / 6)),
+    # ... root 0.3667 moved 0.1333 from 0.5: short by that
+    (0.2, 0.7, [(0.0, -1.0), (0.1, -0.9), (0.2, -0.5)], 1.0, 0.2 + 0.125 / 2),   # moved more than to lo: halfway
+    (0.6, 0.7, [(0.5, -1.0), (0.6, -0.5)], 1.0, 0.65),                   # root 0.7, not inside: the midpoint
+    (0.6, 0.7, [(0.5, -0.1996), (0.6, -0.0996)], 1.0, 0.7 - 7.5e-4),     # root 0.6996: no nearer hi than 0.75 tol
+    (0.2, 0.7, [(0.7, -1.0), (0.5, -0.5)], -1.0, 0.3 - 2.5e-4),          # contact side at hi: past root 0.3 toward lo
+])
+def test_each_grazing_trial_aims_from_the_contact_side(lo, hi, contact, far, expected):
+    """camdyn.continuation._grazing_trial (tol = 1e-3): past the contact-side secant's root by
+    tol / 4 (GRAZING_PAST), short of it by its change while that exceeds tol / 4, never nearer
+    the far end than 0.75 tol nor the contact end than tol / 4; the midpoint otherwise."""
+    from camdyn.continuation import _grazing_trial
+    assert _grazing_trial(lo, hi, contact, far, 1e-3) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def grazing_step():
+    """Two orbits of the benchmark rig's contact branch (line contact 16 mm, section at T/2) on
+    either side of its grazing at 0.999998 x the contact-loss speed L: p at 0.995 L in permanent
+    contact, q 0.6 of the range 0.995-1.005 L on, at 1.001 L, in flight."""
+    from camdyn import continuation as C
+    loss = camdyn.contact_loss_speed(RIG.replace(l_lambda=0.016))
+    problem = C.Problem(RIG.replace(l_lambda=0.016), SCENE, "speed_rpm", 0.995 * loss, 1.005 * loss, phase_fraction=0.5)
+    p, scale = C._start(problem, 20, ContinuationSettings())
+    q = C._step(problem, p, 0.6, 1, scale, ContinuationSettings())
+    assert p.max_gap < 0 < q.max_gap
+    return problem, p, q, scale
+
+
+def test_grazing_is_located_where_bisection_locates_it_in_fewer_trials(grazing_step, monkeypatch):
+    """The contact-side secant trials against the former rule, bisection (the midpoint as every
+    trial), between the same two orbits: both brackets hold the grazing within locate_tol of
+    arclength, so their points agree to twice that; measured 8 trials against 20, and the
+    located orbits 1.0e-7 of the range apart."""
+    from camdyn import continuation as C
+    problem, p, q, scale = grazing_step
+    settings = ContinuationSettings()
+    trials = []
+    corrected = C._corrected
+    monkeypatch.setattr(C, "_corrected", lambda *a: trials.append(a[2]) or corrected(*a))
+    located = C._locate(problem, p, q, 0.6, "grazing", 1, scale, settings)
+    secant = len(trials)
+    monkeypatch.setattr(C, "_grazing_trial", lambda lo, hi, *_: 0.5 * (lo + hi))
+    del trials[:]
+    bisected = C._locate(problem, p, q, 0.6, "grazing", 1, scale, settings)
+    assert len(trials) == 20                   # log2(0.6 / locate_tol) = 19.2: the bracket halved 20 times
+    assert secant <= len(trials) // 2
+    tol = settings.locate_tol * problem.span   # in lambda: |d lambda / ds| <= the range (the tangent is a unit vector)
+    for before, after in (located, bisected):
+        assert before.max_gap < 0 < after.max_gap
+        assert 0 < after.lam - before.lam <= tol
+        assert np.all(np.isfinite(before.jacobian)) and np.all(np.isfinite(after.jacobian))   # the event's multipliers
+    assert abs(located[1].lam - bisected[1].lam) <= 2 * tol
+
+
 # --- the detectors on maps whose bifurcations are known in closed form -----------------------------
 class _AnalyticMap:
     """P(x; lambda) in closed form, with the interface the continuation reads of a map."""
@@ -314,7 +416,11 @@ class _AnalyticProblem:
 def _continued(f, start, end, monkeypatch):
     """Follow the fixed point x = 0 of f from start to end: the branch and its events."""
     from camdyn import continuation as C
-    monkeypatch.setattr(C, "_gap", lambda problem, lam, x, mode, periods: (-1.0, np.array([x[0]]), 0))
+
+    def run(problem, lam, x, mode, periods):          # P_n(x) alone: no engine run to sample
+        return C._Run(None, problem.section_map(lam, mode)(x), None, np.zeros(0))
+    monkeypatch.setattr(C, "_orbit_run", run)
+    monkeypatch.setattr(C, "_gap", lambda run: (-1.0, np.zeros(1), 0))
     problem, scale, settings = _AnalyticProblem(f, start, end), np.ones(2), ContinuationSettings()
     first = C._first_point(problem, start, np.zeros(2), 0, 1, scale, 1.0)
     branch, events = C.Branch(1), []

@@ -21,7 +21,7 @@ import camdyn
 from camdyn.errors import ParameterError
 from camdyn.model import Model
 from camdyn.orbits import OrbitOutcome, ShootingSettings, newton, periodic_orbit
-from camdyn.section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
+from camdyn.section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences, jacobian_at
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -182,6 +182,27 @@ def test_a_given_mode_is_refused_outside_its_domain_and_the_initial_rule_chooses
     assert StroboscopicMap(model).start_mode(model.static_state()) != model.mode("free")
 
 
+@pytest.mark.parametrize("case", ["contact", "impacting"])
+def test_the_maps_value_is_the_same_to_the_bit_when_the_run_is_sampled(request, case):
+    """StroboscopicMap.run: the run sampled along the orbit (the continuation's 257 samples of
+    the largest gap) ends where the map's run sampled at t0 + n T alone does, to the bit and in
+    as many steps (the engine's steps do not depend on the sample times), from the fixed point
+    and from states off it (the corrector's iterates)."""
+    orbit = request.getfixturevalue(case)
+    speed = 600.0 if case == "contact" else 1500.0
+    P = _map(speed, orbit)
+    t0, t1 = P.t_span
+    t_eval = np.linspace(t0, t1, 257)
+    for dx in (np.zeros(2), 1e-7 * orbit.scale, -3e-7 * orbit.scale):   # within the contact modes
+        x = orbit.state + dx
+        sampled, tr = P.run(x, t_eval)
+        alone = P.evaluate(x)
+        assert np.array_equal(sampled.state, alone.state) and sampled.steps == alone.steps
+        assert tr.t.size == t_eval.size and np.array_equal(tr.y[:2, -1], alone.state)
+    with pytest.raises(ParameterError, match="t_eval"):
+        P.run(orbit.state, t_eval[:-1])                # not ending at t0 + n T: no map value
+
+
 @pytest.mark.parametrize("kw, name", [(dict(periods=0), "periods"), (dict(periods=1.5), "periods"),
                                       (dict(phase=-0.01), "phase"), (dict(phase=0.2), "phase"),
                                       (dict(mode=99), "mode"), (dict(options=None), "options")])
@@ -226,6 +247,24 @@ def test_central_differences_are_exact_on_a_quadratic_map():
     J = finite_differences(FakeMap(_quadratic), np.ones(2))(X_STAR)[1]
     # central differences of a quadratic are exact up to rounding (~eps / h = 1e-13)
     np.testing.assert_allclose(J, A, atol=1e-9)
+
+
+def test_a_provider_told_p_spares_its_base_run_and_gives_the_same_jacobian():
+    """finite_differences' provider told P(x) (the keyword P, through jacobian_at) returns that P
+    and the same J to the bit (the columns are central differences, which never read the base
+    run) with 4 runs of the map instead of 5; a provider of x alone is called with x alone."""
+    calls = []
+    P = FakeMap(lambda x: calls.append(1) or _quadratic(x))
+    provider = finite_differences(P, np.ones(2))
+    x = X_STAR + [0.1, -0.2]
+    base, J = provider(x)
+    assert len(calls) == 5
+    known = np.array([7.0, 8.0])                       # not P(x): shows that the provider returns what it is told
+    told, J_told = jacobian_at(provider, x, known)
+    assert len(calls) == 5 + 4
+    assert np.array_equal(told, known) and np.array_equal(J_told, J)
+    seen = []
+    assert jacobian_at(lambda x: seen.append(x) or (base, J), x, known)[0] is base and len(seen) == 1
 
 
 def test_newton_finds_a_known_fixed_point_and_its_multipliers():

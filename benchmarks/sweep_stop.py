@@ -34,11 +34,16 @@ DOCS = Path(__file__).resolve().parent.parent / "docs"
 SHOOT_GOAL_S, DIAGRAM_GOAL_S = 0.05, 5.0
 
 
+def _bifurcation(pool, grid, revolutions: int, stop):
+    """The benchmark's diagram on ``pool`` (the second half of the revolutions as the section)."""
+    return S.bifurcation(RIG, SCENE, grid, revolutions=revolutions, transient_revolutions=revolutions // 2,
+                         executor=pool, progress=False, rtol=RTOL, atol=ATOL, stop=stop)
+
+
 def _diagram(grid, revolutions: int, stop) -> tuple:
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:
-        ds = S.bifurcation(RIG, SCENE, grid, revolutions=revolutions, transient_revolutions=revolutions // 2,
-                           executor=pool, progress=False, rtol=RTOL, atol=ATOL, stop=stop)
+        ds = _bifurcation(pool, grid, revolutions, stop)
     return ds, time.perf_counter() - t0
 
 
@@ -117,8 +122,7 @@ def together(grid, loss: float, revolutions: int) -> dict:
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:
         legs = [pool.submit(_leg, (start * loss, end * loss, phase)) for start, end, phase in LEGS]
-        ds = S.bifurcation(RIG, SCENE, grid, revolutions=revolutions, transient_revolutions=revolutions // 2,
-                           executor=pool, progress=False, rtol=RTOL, atol=ATOL, stop=camdyn.StopWhenPeriodic())
+        ds = _bifurcation(pool, grid, revolutions, camdyn.StopWhenPeriodic())
         done = [leg.result() for leg in legs]
     return {"seconds": time.perf_counter() - t0, "diagram": ds, "legs": done}
 

@@ -151,11 +151,11 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
     kept = switches[switches.t <= end]         # the run's last piece may go on past its last sample
     last = kept[kept.t > end - cycle]
     cycles = int(math.ceil((t_end - end) / cycle))
-    more = Switches.joined([kept, last.repeated(cycle, cycles)])
+    continued = Switches.joined([kept, last.repeated(cycle, cycles)])
     outputs = {k: grown(v, k in ACCUMULATED) for k, v in result.outputs.items()}
     return dataclasses.replace(result, t=t_eval.copy(), alpha=grown(result.alpha), alpha_dot=grown(result.alpha_dot),
                                Theta=grown(result.Theta, True), regime=grown(result.regime), outputs=outputs,
-                               switches=more[more.t <= t_end])
+                               switches=continued[continued.t <= t_end])
 
 
 __all__ = ["StopWhenPeriodic", "Watch", "per_revolution", "extend"]

@@ -346,3 +346,37 @@ def test_pieces_join_into_the_same_run(method, monkeypatch):
     scale = max(np.abs(cut.work_in).max(), cut.dissipated_contact.max(), cut.dissipated_friction.max())
     assert np.abs(balance).max() < 1e-6 * scale
     np.testing.assert_allclose(cut.work_in, whole.work_in, rtol=0, atol=1e-6 * scale)
+
+
+# --- the reach rule leaves every run unchanged ---------------------------------------------------
+
+def _reach_cases(loss, eq):
+    """Hard cases for the reach rule: grazing hops, a bouncing cascade, the memoryless D/E
+    switch at a loose tolerance (the gap rate turning at every step), a Coulomb reversal with
+    stick-slip, impacting motion, chaos-range speed."""
+    memoryless = camdyn.Scene(damping="D", friction="coulomb", damping_switch="memoryless")
+    oscillating = camdyn.Scene(damping="D", friction="coulomb", motion="oscillating")
+    return {
+        "grazing": (RIG, D_COULOMB, dict(speed_rpm=1.001 * loss, revolutions=4, rtol=1e-8)),
+        "cascade": (RIG, D_FREE, dict(speed_rpm=0, t_end=0.1, y0=(eq.alpha + 2e-5, 0.0))),
+        "memoryless_loose": (RIG, memoryless, dict(speed_rpm=300, t_end=0.02, rtol=1e-5, atol=1e-9)),
+        "reversal": (PRELOADED, oscillating, dict(cam=camdyn.Oscillating(math.pi, 40), t_end=0.45)),
+        "impacting": (RIG, D_COULOMB, dict(speed_rpm=1.3 * loss, revolutions=3, rtol=1e-6)),
+        "chaos_range": (RIG, D_COULOMB, dict(speed_rpm=2.2 * loss, revolutions=6, rtol=1e-7)),
+    }
+
+
+@pytest.mark.parametrize("case", ["grazing", "cascade", "memoryless_loose", "reversal", "impacting", "chaos_range"])
+def test_reach_rule_changes_no_run(loss, eq, case):
+    """A step cleared by the reach rule (camdyn.engine.rules, *Reach*) skips its interpolant and
+    interior samples, and an excursion out of reach is not searched: on these hard cases the
+    runs are bit for bit those that sample every step (reach_factor = inf), switches and
+    samples.  Any step the rule wrongly cleared would show as a missing or moved switch."""
+    rig, scene, kw = _reach_cases(loss, eq)[case]
+    runs = [camdyn.simulate(rig, scene, sample_rate_Hz=5000, events=EventSettings(reach_factor=f), **kw)
+            for f in (math.inf, EventSettings().reach_factor)]
+    assert runs[0].ok and len(runs[0].switches) > 0
+    assert list(runs[1].switches) == list(runs[0].switches)  # times, surfaces, modes, states
+    np.testing.assert_array_equal(runs[1].alpha, runs[0].alpha)
+    np.testing.assert_array_equal(runs[1].alpha_dot, runs[0].alpha_dot)
+    assert runs[1].stats["nfev"] <= runs[0].stats["nfev"]

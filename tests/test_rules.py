@@ -204,6 +204,72 @@ def test_rate_tells_rounding_noise_at_a_restart_from_a_crossing():
     assert w == 0 and t == pytest.approx(1 - 1e-9, abs=1e-13)
 
 
+# --------------------------------------------------------------------------- reach
+def _clear(functions, directions, t0=0.0, t1=1.0, rates=None, factor=2.0, work=None):
+    """rules.clear_of_surfaces over a clock step [t0, t1] (alpha = t, alpha_dot = 1,
+    alpha_ddot = 0): (clear, work)."""
+    prob = clock_problem(functions, directions, rates)
+    y0, y1, n0, n1, _ = clock_step(t0, t1)
+    work = rules.scratch(8, 8) if work is None else work
+    clear = rules.clear_of_surfaces(prob, 0, t0, t1, y0, y1, n0, n1, 0.0, 0.0, settings(reach_factor=factor),
+                                    False, work)
+    return clear, work
+
+
+@pytest.mark.parametrize("g, rate, clear", [
+    (lambda a: a + 2.5, lambda a: 1.0, True),     # |g| >= 2.5 > 2 |rate| h = 2 at both ends
+    (lambda a: a + 1.5, lambda a: 1.0, False),    # 1.5 < 2: within reach (though it never crosses)
+    (lambda a: -3 * a - 6.5, lambda a: -3.0, True),   # 6.5 and 9.5 > 2 * 3 * 1 = 6
+    (lambda a: (a - 0.5) ** 2 - 1e-4, lambda a: 2 * (a - 0.5), False),   # the micro-hop: |g| 0.25 < 2 at the ends
+    (lambda a: math.nan, lambda a: 1.0, False),
+], ids=["far", "near", "far-steep", "hop", "nan"])
+def test_a_step_is_cleared_only_where_every_surface_is_out_of_reach(g, rate, clear):
+    """The reach rule (rules, *Reach*) with factor 2, on a surface with a declared rate."""
+    assert _clear([g, rate], [+1, None], rates={0: 1})[0] is clear
+
+
+def test_without_a_declared_rate_the_rate_along_the_motion_is_used():
+    """g = 3 alpha + c has no declared rate: its rate along the motion (3, by a forward
+    difference along the field) decides, so c = 6.5 is clear (6.5 > 2 * 3 * 1) and c = 5.5 not."""
+    assert _clear([lambda a: 3 * a + 6.5], [-1])[0] is True
+    assert _clear([lambda a: 3 * a + 5.5], [-1])[0] is False
+    prob = clock_problem([lambda a: 3 * a + 1.0], [None])
+    assert rules.rate_along_motion(prob, 0, 0, 2.0, 2.0, 1.0, 0.0, 7.0, 0.1) == pytest.approx(3.0, rel=1e-8)
+
+
+def test_a_cleared_step_leaves_the_values_first_crossing_would():
+    """After a clear step, work's G_PREV and R_PREV hold the values at its end, as
+    first_crossing leaves them after a step without crossing; M_PREV the rates there."""
+    fs = [lambda a: a + 5.0, lambda a: 1.0 + 0 * a, lambda a: -2 * a - 9.0]
+    clear, work = _clear(fs, [+1, None, -1], rates={0: 1})
+    assert clear
+    prob = clock_problem(fs, [+1, None, -1], {0: 1})
+    y0, y1, n0, n1, Q = clock_step(0.0, 1.0)
+    ref = rules.scratch(8, 8)
+    assert rules.first_crossing(prob, 0, 0.0, 1.0, y0, y1, n0, n1, Q, settings(), False, ref)[0] == -1
+    np.testing.assert_array_equal(work[[rules.G_PREV, rules.R_PREV], :2], ref[[rules.G_PREV, rules.R_PREV], :2])
+    np.testing.assert_allclose(work[rules.M_PREV, :2], [1.0, -2.0], rtol=1e-8)
+
+
+def test_an_excursion_out_of_reach_is_not_searched():
+    """A maximum of g far below the surface (-10 at t = 0.3, rate turning between samples):
+    with the reach rule the extremum is not located (no surface evaluations beyond the
+    samples'); with reach_factor inf it is, and the verdict is the same: no crossing."""
+    calls = []
+    g = lambda a: calls.append(a) or -10.0 - (a - 0.3) ** 2  # noqa: E731
+    rate = lambda a: -2 * (a - 0.3)  # noqa: E731
+    prob = clock_problem([g, rate], [+1, None], {0: 1})
+    y0, y1, n0, n1, Q = clock_step(0.0, 1.0)
+    verdicts = []
+    for factor in (2.0, math.inf):
+        calls.clear()
+        verdicts.append(rules.first_crossing(prob, 0, 0.0, 1.0, y0, y1, n0, n1, Q, settings(reach_factor=factor),
+                                             False, rules.scratch(8, 8))[0])
+        verdicts.append(len(calls))
+    assert verdicts[0] == verdicts[2] == -1
+    assert verdicts[1] == 5 < verdicts[3]    # the 5 samples; the search adds evaluations
+
+
 # --------------------------------------------------------------------------- targets
 def _choice(g_values, candidates):
     """rules.target over one transition whose candidates test the given surface values
@@ -244,7 +310,10 @@ def test_chatter_is_many_switches_with_no_progress():
                                            ({"xtol": 1e-17}, "xtol"), ({"xtol": 1.0}, "xtol"),
                                            ({"xtol": math.nan}, "xtol"), ({"interior_points": -1}, "interior_points"),
                                            ({"interior_points": 2.5}, "interior_points"),
-                                           ({"max_events": 0}, "max_events"), ({"max_events": 1e6}, "max_events")])
+                                           ({"max_events": 0}, "max_events"), ({"max_events": 1e6}, "max_events"),
+                                           ({"reach_factor": 0.5}, "reach_factor"),
+                                           ({"reach_factor": math.nan}, "reach_factor"),
+                                           ({"reach_factor": True}, "reach_factor")])
 def test_event_settings_validated(kwargs, field):
     with pytest.raises(ParameterError, match=field):
         EventSettings(**kwargs)
@@ -252,5 +321,5 @@ def test_event_settings_validated(kwargs, field):
 
 def test_event_settings_defaults():
     s = EventSettings()
-    assert (s.xtol, s.interior_points, s.max_events) == (1e-14, 3, 1_000_000)
-    EventSettings(xtol=1e-6, interior_points=0, max_events=1)
+    assert (s.xtol, s.interior_points, s.max_events, s.reach_factor) == (1e-14, 3, 1_000_000, 2.0)
+    EventSettings(xtol=1e-6, interior_points=0, max_events=1, reach_factor=math.inf)

@@ -31,6 +31,10 @@ CROSSING_RETRIES = 1
 CONTACT_STEP_RADIANS = 0.1
 #: exactly on a surface, the side is read this long (relative) later along the motion
 LOOK_AHEAD = 1e-9
+#: a watched surface is out of reach of zero over a span of time T when |value| > this * |rate| * T
+#: at both ends (EventSettings.reach_factor): 2 lets the rate inside the span reach twice its
+#: values at the ends
+REACH_FACTOR = 2.0
 #: |alpha| beyond this is the singular 90 degrees of Eq. 11 (tan, sec)
 ANGLE_LIMIT = math.pi / 2 - 0.02
 METHODS = tuple(TABLEAUS)
@@ -47,11 +51,19 @@ class EventSettings:
     watched surface inside every step besides its ends, so that an excursion out and back
     within one step (a micro-hop) is still seen when a sample falls inside it; ``>= 0``.
     ``max_events``: the most regime switches one run may have; ``>= 1``.
+
+    ``reach_factor``: the interior samples are taken only in a step where some watched surface
+    may reach zero, and an excursion's extremum is located only where it may: a surface of value
+    g moving at rate r at both ends of a span of time T is out of reach when ``|g| >
+    reach_factor * |r| * T`` at both (with a rate that stays between its values at the ends, 1
+    would be exact; the factor allows the rate to overshoot them); ``>= 1``, ``math.inf`` to
+    sample every step (camdyn.engine.rules, *Reach*).
     """
 
     xtol: float = 1e-14
     interior_points: int = 3
     max_events: int = 1_000_000
+    reach_factor: float = REACH_FACTOR
 
     def __post_init__(self) -> None:
         if isinstance(self.xtol, bool) or not isinstance(self.xtol, (int, float)) or not (4 * _EPS <= self.xtol < 1):
@@ -60,6 +72,9 @@ class EventSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
                 raise ParameterError(name, value, f"an integer >= {low}")
+        factor = self.reach_factor
+        if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not factor >= 1:
+            raise ParameterError("reach_factor", factor, "a number >= 1 (math.inf: interior samples in every step)")
 
 
 @dataclass(frozen=True)
@@ -95,6 +110,7 @@ class Settings(NamedTuple):
     max_step: float
     xtol: float
     interior_points: int
+    reach_factor: float
     max_events: int
     angle_limit: float
     chatter_switches: int
@@ -111,5 +127,5 @@ def settings(options: SolverOptions, contact_frequency: float) -> Settings:
     ev = options.events
     step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
     return Settings(float(options.rtol), float(options.atol), float(options.max_step), float(ev.xtol),
-                    int(ev.interior_points), int(ev.max_events), ANGLE_LIMIT, CHATTER_SWITCHES, CHATTER_WINDOW,
+                    int(ev.interior_points), float(ev.reach_factor), int(ev.max_events), ANGLE_LIMIT, CHATTER_SWITCHES, CHATTER_WINDOW,
                     step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))

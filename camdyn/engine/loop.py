@@ -1,13 +1,15 @@
 """The hybrid loop: steps, crossings, switches and samples, compiled or interpreted.
 
 From the start state, the loop steps mode m's field with the method (:mod:`.stepper`), checks
-m's transitions on each accepted step (:mod:`.rules`), and at a crossing restarts from the
-state at the located time in the mode the transition leads to.  That restart state is one
-step of the method to the located time (the method's order; the interpolant's error, an order
-lower and larger at loose tolerances, would otherwise be carried into the next mode at every
-switch); when that state is not yet across the surface, the run goes on in the same mode from
-it, up to ``crossing_retries`` steps in a row (then it restarts from the interpolant's state,
-across by construction, so time always advances).  The first step after contact starts is
+m's transitions on each accepted step (:mod:`.rules`: a step whose ends put every watched
+surface out of reach of zero is cleared from its ends; the others are sampled on the step's
+interpolant, which is computed only for them, for samples and for the energy ledger), and at a
+crossing restarts from the state at the located time in the mode the transition leads to.
+That restart state is one step of the method to the located time (the method's order; the
+interpolant's error, an order lower and larger at loose tolerances, would otherwise be carried
+into the next mode at every switch); when that state is not yet across the surface, the run
+goes on in the same mode from it, up to ``crossing_retries`` steps in a row (then it restarts
+from the interpolant's state, across by construction, so time always advances).  The first step after contact starts is
 capped at ``contact_step``.
 
 :func:`run` is written once (:mod:`.jit`): :func:`run_compiled` is the same code compiled
@@ -27,8 +29,8 @@ from ..derive.vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
-from .rules import (NONFINITE, across, chattering, first_crossing, initial_mode, left_at_start, scratch,
-                    switch, zero_at_start)
+from .rules import (NONFINITE, across, chattering, clear_of_surfaces, first_crossing, initial_mode, left_at_start,
+                    scratch, switch, zero_at_start)
 from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -193,6 +195,7 @@ def run(prob, method, cfg, start, samples):
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
     h_last, retries, capped = -1.0, 0, False
+    screen = cfg.reach_factor < math.inf  # clear a step from its ends (rules.clear_of_surfaces)
     while t < t_end and outcome == SUCCESS:
         h_abs, f = _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K)
         nfev += f
@@ -211,20 +214,26 @@ def run(prob, method, cfg, start, samples):
                 outcome = NONFINITE_STATE
                 break
             h = t_new - t
-            if watched or ledger or (i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_new):
+            interpolant = ledger or (i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_new)
+            if interpolant:
                 nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
             w, t_cross = -1, t_new
             if watched:
                 on_surface = not have_start or zero_at_start(work, n_watched)
-                w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
-                if w == NONFINITE:
-                    outcome = NONFINITE_STATE
-                    break
-                if w < 0:
-                    t_cross = t_new
-                    if on_surface:
-                        w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
-                        t_cross = t if w >= 0 else t_new
+                screened = screen and clear_of_surfaces(prob, m, t, t_new, y0, y1, n0, n1, K[0, 1], K[n, 1], cfg,
+                                                        have_start, work)
+                if not screened:  # (the screen, when it ran, left the values at t in work)
+                    if not interpolant:
+                        nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
+                    w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start or screen, work)
+                    if w == NONFINITE:
+                        outcome = NONFINITE_STATE
+                        break
+                    if w < 0:
+                        t_cross = t_new
+                        if on_surface:
+                            w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
+                            t_cross = t if w >= 0 else t_new
                 have_start = True
             if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
                 i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)

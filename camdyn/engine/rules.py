@@ -4,8 +4,9 @@ The automaton is data (:mod:`camdyn.engine.tables`, from ``camdyn.derive.automat
 small functions are its semantics, called by the loop (:mod:`camdyn.engine.loop`) after every
 accepted step, compiled or interpreted (:mod:`camdyn.engine.jit`):
 
-*Crossings.*  Mode m watches the surfaces of its transitions.  Each is sampled at the step's
-start, at ``interior_points`` equally spaced times on the interpolant, and at its end.  A
+*Crossings.*  Mode m watches the surfaces of its transitions.  In a step the reach rule does
+not clear (*Reach*, below), each is sampled at the step's start, at ``interior_points``
+equally spaced times on the interpolant, and at its end.  A
 transition fires where its surface's value crosses zero in its direction: +1 from < 0 to
 >= 0, -1 from > 0 to <= 0; a value exactly 0 at a sample never *starts* a crossing (a run
 restarts on the far side of the surface it just crossed, and must not cross it again).  The
@@ -21,6 +22,15 @@ extremum is located and, if the value there is across, the crossing out and back
 step (a micro-hop) is found.  A sign change that starts moving *away* from the watched
 direction can only follow a turn of the rate; if the rate never turns, it is rounding noise
 (a restart just across the surface, where the gap is ~1e-19 m), not a crossing.
+
+*Reach.*  A surface of value g moving at rate r at both ends of a span of time T is out of reach
+of zero over it when ``|g| > reach_factor * |r| * T`` at both ends (:func:`beyond_reach`; exact,
+with a factor 1, when the rate stays between its values at the ends).  A step in which every
+watched surface is out of reach has no crossing: it is cleared from its ends alone
+(:func:`clear_of_surfaces`), without its interpolant or interior samples.  An excursion whose
+extremum is out of reach of the samples around it is not located.  The rate at a step's end is
+the declared rate (``RATE_OF_SURFACE``) where the surface has one, else the surface's derivative
+along the motion, by a forward difference along the field.
 
 *Targets.*  A transition enters its first candidate whose conditions hold: (surface, sign)
 holds where sign * value >= 0, the value taken under the candidate's laws; exactly 0, the value
@@ -48,18 +58,22 @@ NONFINITE = -2
 
 #: rows of first_crossing's work array (:func:`scratch`): per watched transition of the mode
 #: (k = w - watch_start[m]), its surface's value and rate at the previous sample; per surface,
-#: its value at the current sample; the output of the kernel surface_with_rate (value, rate)
-G_PREV, R_PREV, VALUES, WITH_RATE = 0, 1, 2, 3
+#: its value at the current sample; the output of the kernel surface_with_rate (value, rate);
+#: per watched transition, its surface's rate along the motion at the previous step's end
+#: (:func:`clear_of_surfaces`)
+G_PREV, R_PREV, VALUES, WITH_RATE, M_PREV = 0, 1, 2, 3, 4
+WORK_ROWS = 5
 
 
 @allocating
 def scratch(n_transitions, n_surfaces):
-    """The work array of :func:`first_crossing`: rows G_PREV, R_PREV, VALUES, WITH_RATE (at least
-    2 long).  One array, not four: fewer arguments to pass down.  (np.empty and a loop, no
-    np.zeros or max of ints: each compiles one more overload on a cold start.)"""
+    """The work array of :func:`first_crossing` and :func:`clear_of_surfaces`: rows G_PREV,
+    R_PREV, VALUES, WITH_RATE, M_PREV (at least 2 long).  One array, not five: fewer arguments
+    to pass down.  (np.empty and a loop, no np.zeros or max of ints: each compiles one more
+    overload on a cold start.)"""
     n = n_transitions if n_transitions > n_surfaces else n_surfaces
-    work = np.empty((4, n if n > 2 else 2))
-    for r in range(4):
+    work = np.empty((WORK_ROWS, n if n > 2 else 2))
+    for r in range(WORK_ROWS):
         for k in range(work.shape[1]):
             work[r, k] = 0.0
     return work
@@ -187,12 +201,15 @@ def extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb):
 
 
 @jitable
-def hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb):
+def hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, reach):
     """(t_ext, g_ext) when surface s crosses zero and comes back inside (ta, tb), else (-1, 0).
 
     Both ends are on the watched side; if the rate turns from approaching zero to leaving it,
-    the extremum is located and the value read there.  A rate exactly 0 at an end is no turn."""
+    and the extremum is not out of reach (:func:`beyond_reach` with factor ``reach``), the
+    extremum is located and the value read there.  A rate exactly 0 at an end is no turn."""
     if not _turns(direction, ga, ra, rb):
+        return -1.0, 0.0
+    if beyond_reach(ga, ra, tb - ta, reach) and beyond_reach(gb, rb, tb - ta, reach):
         return -1.0, 0.0
     up = ga < 0.0
     t_ext, g_ext = extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb)
@@ -232,7 +249,7 @@ def _turns(direction, ga, ra, rb):
 
 
 @jitable
-def _crossing_in(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, xtol):
+def _crossing_in(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, cfg):
     """The far-side time of transition's surface s crossing zero in ``direction`` inside
     (ta, tb] of the step [t, t + h], or -1.0: a sign change (unless it is rounding noise, see
     :func:`turned_back`) or a hidden excursion (:func:`hidden_excursion`), located."""
@@ -241,12 +258,106 @@ def _crossing_in(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, r
         if rate >= 0:
             lo, glo, genuine = turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb)
         if genuine:
-            return locate(prob, m, s, t, h, y0, y1, Q, lo, tb, glo, gb, xtol)[0]
+            return locate(prob, m, s, t, h, y0, y1, Q, lo, tb, glo, gb, cfg.xtol)[0]
     elif rate >= 0 and _turns(direction, ga, ra, rb):
-        t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb)
+        t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb,
+                                        cfg.reach_factor)
         if t_ext >= 0.0:
-            return locate(prob, m, s, t, h, y0, y1, Q, ta, t_ext, ga, g_ext, xtol)[0]
+            return locate(prob, m, s, t, h, y0, y1, Q, ta, t_ext, ga, g_ext, cfg.xtol)[0]
     return -1.0
+
+
+@jitable
+def sample_surfaces(prob, m, t, a, ad, work):
+    """Mode m's sampled surfaces (Tables.sampled) at the state into work's VALUES row: a surface
+    with a declared rate together with that rate, in one kernel call (``surface_with_rate``)."""
+    tab = prob.tables
+    data, pair = tab.data, work[WITH_RATE]
+    for q in range(data[tab.sampled_start + m], data[tab.sampled_start + m + 1]):
+        s = data[tab.sampled + q]
+        rate = data[tab.surface_rate + s]
+        if rate >= 0:
+            prob.kernels.surface_with_rate(m, s, t, a, ad, prob.p, pair)
+            work[VALUES, s], work[VALUES, rate] = pair[WITH_RATE_VALUE], pair[WITH_RATE_RATE]
+        else:
+            work[VALUES, s] = prob.kernels.surface(m, s, t, a, ad, prob.p)
+
+
+# --- reach ----------------------------------------------------------------------------------
+#: the forward difference of a rate along the motion steps this fraction of the span it serves:
+#: its rounding error then stays near 1e-10 |value| / span, far below what reach compares
+MOTION_DIFFERENCE = 1e-6
+
+
+@jitable
+def beyond_reach(g, r, span, factor):
+    """Whether a surface of value g moving at rate r stays clear of zero over ``span`` seconds by
+    the reach rule (module docstring, *Reach*): |g| > factor |r| span.  False for a NaN."""
+    return abs(g) > factor * abs(r) * span
+
+
+@jitable
+def rate_along_motion(prob, m, s, t, a, ad, add, g, span):
+    """Surface s's derivative in time along mode m's motion at the state (alpha_ddot = add,
+    value g there): a forward difference along the field, over MOTION_DIFFERENCE * span."""
+    tt = t + MOTION_DIFFERENCE * span
+    d = tt - t
+    if not d > 0.0:
+        return math.inf
+    return (value(prob, m, s, tt, a + d * ad, ad + d * add) - g) / d
+
+
+@jitable
+def _rate_of(prob, m, s, rate, t, a, ad, add, span, work):
+    """Watched surface s's rate along the motion from work's VALUES at the state: its declared
+    rate where it has one, else :func:`rate_along_motion`."""
+    if rate >= 0:
+        return work[VALUES, rate]
+    return rate_along_motion(prob, m, s, t, a, ad, add, work[VALUES, s], span)
+
+
+@jitable
+def clear_of_surfaces(prob, m, t0, t1, y0, y1, n0, n1, add0, add1, cfg, have_start, work):
+    """Whether every surface mode m watches is out of reach of zero over the step [t0, t1]
+    (module docstring, *Reach*): then no transition crosses in it, and it needs neither its
+    interpolant nor interior samples.  add0, add1: alpha_ddot at its ends.
+
+    ``have_start``: work's G_PREV, R_PREV and M_PREV hold the values at t0; if not, they are
+    computed here (so that :func:`first_crossing` may then be told it has them).  On return,
+    M_PREV holds the rates at t1; G_PREV and R_PREV hold the values at t1 if the step is clear,
+    else still those at t0.
+    """
+    tab = prob.tables
+    data = tab.data
+    w0, w1 = data[tab.watch_start + m], data[tab.watch_start + m + 1]
+    h = t1 - t0
+    if not have_start:
+        sample_surfaces(prob, m, t0, y0, y1, work)
+        for w in range(w0, w1):
+            s = data[tab.surface + w]
+            rate = data[tab.surface_rate + s]
+            work[G_PREV, w - w0] = work[VALUES, s]
+            work[R_PREV, w - w0] = work[VALUES, rate] if rate >= 0 else 0.0
+            work[M_PREV, w - w0] = _rate_of(prob, m, s, rate, t0, y0, y1, add0, h, work)
+    sample_surfaces(prob, m, t1, n0, n1, work)
+    factor = cfg.reach_factor
+    clear = True
+    for w in range(w0, w1):
+        k = w - w0
+        s = data[tab.surface + w]
+        rate = data[tab.surface_rate + s]
+        ga, gb = work[G_PREV, k], work[VALUES, s]
+        mb = _rate_of(prob, m, s, rate, t1, n0, n1, add1, h, work)
+        if not (ga * gb > 0.0 and beyond_reach(ga, work[M_PREV, k], h, factor) and beyond_reach(gb, mb, h, factor)):
+            clear = False
+        work[M_PREV, k] = mb
+    if clear:
+        for w in range(w0, w1):
+            s = data[tab.surface + w]
+            rate = data[tab.surface_rate + s]
+            work[G_PREV, w - w0] = work[VALUES, s]
+            work[R_PREV, w - w0] = work[VALUES, rate] if rate >= 0 else 0.0
+    return clear
 
 
 @jitable
@@ -256,15 +367,13 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
     Returns (w, t): the transition's row and the located far-side time; w = -1 when nothing
     crosses, NONFINITE when a value is not finite.  ``have_start``: work's rows G_PREV and
     R_PREV already hold the values at t0 (the previous step's end); with no crossing, they
-    hold the values at t1 on return.  A surface with a declared rate is sampled with its rate in
-    one kernel call (``surface_with_rate``; Tables.sampled).  (Runs once per step: the kernels
-    are called here directly, and only the rare crossing found is a call, :func:`_crossing_in`.)
+    hold the values at t1 on return.  The samples are :func:`sample_surfaces`'.  (Runs on the
+    steps :func:`clear_of_surfaces` does not clear: only a sample that may hide a crossing
+    calls the locating helpers, :func:`_crossing_in`.)
     """
     tab = prob.tables
-    data, kernel, with_rate, p = tab.data, prob.kernels.surface, prob.kernels.surface_with_rate, prob.p
-    pair = work[WITH_RATE]
+    data = tab.data
     w0, w1 = data[tab.watch_start + m], data[tab.watch_start + m + 1]
-    q0, q1 = data[tab.sampled_start + m], data[tab.sampled_start + m + 1]
     h = t1 - t0
     n_int = cfg.interior_points
     best_w, best_t = -1, math.inf
@@ -282,14 +391,7 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
             a, ad = n0, n1
         else:
             a, ad = dense_eval(tb, t0, h, y0, y1, Q)
-        for q in range(q0, q1):
-            s = data[tab.sampled + q]
-            rate = data[tab.surface_rate + s]
-            if rate >= 0:
-                with_rate(m, s, tb, a, ad, p, pair)
-                work[VALUES, s], work[VALUES, rate] = pair[WITH_RATE_VALUE], pair[WITH_RATE_RATE]
-            else:
-                work[VALUES, s] = kernel(m, s, tb, a, ad, p)
+        sample_surfaces(prob, m, tb, a, ad, work)
         for w in range(w0, w1):
             k = w - w0
             if (found >> k) & 1:
@@ -303,7 +405,7 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
                 if not (math.isfinite(ga) and math.isfinite(gb)):
                     return NONFINITE, tb
                 if _changes(direction, ga, gb, rate, ra, rb):
-                    tk = _crossing_in(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, cfg.xtol)
+                    tk = _crossing_in(prob, m, s, rate, direction, t0, h, y0, y1, Q, ta, tb, ga, gb, ra, rb, cfg)
                     if tk >= 0.0:
                         found |= 1 << k
                         if tk < best_t:

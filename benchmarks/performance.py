@@ -409,12 +409,12 @@ def _engine_partial(prob, method, cfg, m, t, t_end, y0, y1, level):
     work = rules.scratch(tab.n_transitions, tab.n_surfaces)
     K[0, 0], K[0, 1] = y1, rhs(m, t, y0, y1, p)
     h = stepper.initial_step(rhs, p, m, t, y0, y1, K[0, 1], t_end, method, cfg)
-    steps, crossings, have_start, n = 0, 0, False, method.n_stages
+    steps, crossings, have_start, n, err = 0, 0, False, method.n_stages, stepper.ERR_FLOOR
     while t < t_end:
-        _, t_new, n0, n1, h_next, _, _ = stepper.step(rhs, p, m, t, y0, y1, h, t_end, method, K, cfg)
+        _, t_new, n0, n1, h_next, _, _, err = stepper.step(rhs, p, m, t, y0, y1, h, t_end, method, K, cfg, err)
         steps += 1
         if level == 3:
-            if not rules.clear_of_surfaces(prob, m, t, t_new, y0, y1, n0, n1, K[0, 1], K[n, 1], cfg, have_start, work):
+            if not rules.clear_of_surfaces(prob, m, t, t_new, n0, n1, K[n, 1], cfg, have_start, work):
                 crossings += 1
             have_start = True
         elif level >= 1:

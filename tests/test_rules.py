@@ -205,15 +205,17 @@ def test_rate_tells_rounding_noise_at_a_restart_from_a_crossing():
 
 
 # --------------------------------------------------------------------------- reach
-def _clear(functions, directions, t0=0.0, t1=1.0, rates=None, factor=2.0, work=None):
-    """rules.clear_of_surfaces over a clock step [t0, t1] (alpha = t, alpha_dot = 1,
-    alpha_ddot = 0): (clear, work)."""
+def _clear(functions, directions, rates=None, factor=2.0):
+    """rules.clear_of_surfaces over the clock step [0, 1] (alpha = t, alpha_dot = 1, alpha_ddot
+    = 0), after the step [-1, 0] as the loop runs it (the first after a start: never clear,
+    then first_crossing, which must find no crossing there): (clear, work)."""
     prob = clock_problem(functions, directions, rates)
-    y0, y1, n0, n1, _ = clock_step(t0, t1)
-    work = rules.scratch(8, 8) if work is None else work
-    clear = rules.clear_of_surfaces(prob, 0, t0, t1, y0, y1, n0, n1, 0.0, 0.0, settings(reach_factor=factor),
-                                    False, work)
-    return clear, work
+    cfg, work = settings(reach_factor=factor), rules.scratch(8, 8)
+    y0, y1, n0, n1, Q = clock_step(-1.0, 0.0)
+    assert not rules.clear_of_surfaces(prob, 0, -1.0, 0.0, n0, n1, 0.0, cfg, False, work)
+    assert rules.first_crossing(prob, 0, -1.0, 0.0, y0, y1, n0, n1, Q, cfg, False, work)[0] in (-1, rules.NONFINITE)
+    y0, y1, n0, n1, _ = clock_step(0.0, 1.0)
+    return rules.clear_of_surfaces(prob, 0, 0.0, 1.0, n0, n1, 0.0, cfg, True, work), work
 
 
 @pytest.mark.parametrize("g, rate, clear", [
@@ -247,6 +249,7 @@ def test_a_cleared_step_leaves_the_values_first_crossing_would():
     y0, y1, n0, n1, Q = clock_step(0.0, 1.0)
     ref = rules.scratch(8, 8)
     assert rules.first_crossing(prob, 0, 0.0, 1.0, y0, y1, n0, n1, Q, settings(), False, ref)[0] == -1
+    assert rules.clear_of_surfaces(prob, 0, 0.0, 1.0, n0, n1, 0.0, settings(), False, ref) is False  # no start
     np.testing.assert_array_equal(work[[rules.G_PREV, rules.R_PREV], :2], ref[[rules.G_PREV, rules.R_PREV], :2])
     np.testing.assert_allclose(work[rules.M_PREV, :2], [1.0, -2.0], rtol=1e-8)
 

@@ -220,12 +220,10 @@ def run(prob, method, cfg, start, samples):
             w, t_cross = -1, t_new
             if watched:
                 on_surface = not have_start or zero_at_start(work, n_watched)
-                screened = screen and clear_of_surfaces(prob, m, t, t_new, y0, y1, n0, n1, K[0, 1], K[n, 1], cfg,
-                                                        have_start, work)
-                if not screened:  # (the screen, when it ran, left the values at t in work)
+                if not (screen and clear_of_surfaces(prob, m, t, t_new, n0, n1, K[n, 1], cfg, have_start, work)):
                     if not interpolant:
                         nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
-                    w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start or screen, work)
+                    w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
                     if w == NONFINITE:
                         outcome = NONFINITE_STATE
                         break

@@ -308,46 +308,32 @@ def rate_along_motion(prob, m, s, t, a, ad, add, g, span):
 
 
 @jitable
-def _rate_of(prob, m, s, rate, t, a, ad, add, span, work):
-    """Watched surface s's rate along the motion from work's VALUES at the state: its declared
-    rate where it has one, else :func:`rate_along_motion`."""
-    if rate >= 0:
-        return work[VALUES, rate]
-    return rate_along_motion(prob, m, s, t, a, ad, add, work[VALUES, s], span)
-
-
-@jitable
-def clear_of_surfaces(prob, m, t0, t1, y0, y1, n0, n1, add0, add1, cfg, have_start, work):
+def clear_of_surfaces(prob, m, t0, t1, n0, n1, add1, cfg, have_start, work):
     """Whether every surface mode m watches is out of reach of zero over the step [t0, t1]
     (module docstring, *Reach*): then no transition crosses in it, and it needs neither its
-    interpolant nor interior samples.  add0, add1: alpha_ddot at its ends.
+    interpolant nor interior samples.  n0, n1, add1: alpha, alpha_dot, alpha_ddot at its end.
 
-    ``have_start``: work's G_PREV, R_PREV and M_PREV hold the values at t0; if not, they are
-    computed here (so that :func:`first_crossing` may then be told it has them).  On return,
-    M_PREV holds the rates at t1; G_PREV and R_PREV hold the values at t1 if the step is clear,
-    else still those at t0.
+    Reads the values at t0 from work's G_PREV and M_PREV: a step with ``have_start`` False
+    (the first after a start or restart) is never clear.  On return, M_PREV holds the rates at
+    t1; G_PREV and R_PREV hold the values at t1 if the step is clear (as first_crossing leaves
+    them after a step without crossing), else still those at t0.
     """
     tab = prob.tables
     data = tab.data
     w0, w1 = data[tab.watch_start + m], data[tab.watch_start + m + 1]
     h = t1 - t0
-    if not have_start:
-        sample_surfaces(prob, m, t0, y0, y1, work)
-        for w in range(w0, w1):
-            s = data[tab.surface + w]
-            rate = data[tab.surface_rate + s]
-            work[G_PREV, w - w0] = work[VALUES, s]
-            work[R_PREV, w - w0] = work[VALUES, rate] if rate >= 0 else 0.0
-            work[M_PREV, w - w0] = _rate_of(prob, m, s, rate, t0, y0, y1, add0, h, work)
-    sample_surfaces(prob, m, t1, n0, n1, work)
     factor = cfg.reach_factor
-    clear = True
+    sample_surfaces(prob, m, t1, n0, n1, work)
+    clear = have_start
     for w in range(w0, w1):
         k = w - w0
         s = data[tab.surface + w]
         rate = data[tab.surface_rate + s]
         ga, gb = work[G_PREV, k], work[VALUES, s]
-        mb = _rate_of(prob, m, s, rate, t1, n0, n1, add1, h, work)
+        if rate >= 0:
+            mb = work[VALUES, rate]
+        else:
+            mb = rate_along_motion(prob, m, s, t1, n0, n1, add1, gb, h)
         if not (ga * gb > 0.0 and beyond_reach(ga, work[M_PREV, k], h, factor) and beyond_reach(gb, mb, h, factor)):
             clear = False
         work[M_PREV, k] = mb

@@ -22,7 +22,9 @@ list: :func:`run_mode`), and its trajectory is checked against the engine's.
 The engine is timed as it runs (a step whose ends put every watched surface out of reach of
 zero is cleared from them, without interpolant or interior samples: camdyn.engine.rules,
 *Reach*) and doing the floor's work, every step sampled (``EventSettings(reach_factor=inf)``):
-the loop's overhead, the ratio the issue's target bounds, is the second against the floor.
+the loop's overhead, the ratio the issue's target bounds, is the second against the floor.  The
+engine runs here with the floor's step-size controller, SciPy's (``step_control="scipy"``; camdyn's
+default is the PI controller), so that both take the same steps.
 """
 from __future__ import annotations
 
@@ -298,7 +300,7 @@ def engine_args(model: Model, run: SlidingRun, interior_points: int | None = Non
     K = model.kernels
     events = EventSettings(interior_points=run.interior_points if interior_points is None else interior_points,
                            reach_factor=reach_factor)
-    options = SolverOptions("DOP853", run.rtol, run.atol, events=events)
+    options = SolverOptions("DOP853", run.rtol, run.atol, events=events, step_control="scipy")  # the floor's
     prob = Problem(compiled_kernels(K), tables(K), np.ascontiguousarray(model.p, dtype=float))
     y0 = model.static_state()
     t_eval = run.t_eval()
@@ -470,7 +472,7 @@ def measure(run: SlidingRun = SlidingRun(), rounds: int = 30) -> FloorReport:
     n = min(r.n_samples, fa.t_eval.size)
     diff = float(np.max(np.abs(eng.samples.y[0, :n] - fa.out[0, :n])))
     fns = {k: v.fn for k, v in vs.items()}
-    options = SolverOptions("DOP853", run.rtol, run.atol)
+    options = SolverOptions("DOP853", run.rtol, run.atol, step_control="scipy")
     y0, t_eval = model.static_state(), run.t_eval()
     fns["integrate()"] = lambda: integrate(model, (0.0, run.t_end), y0, t_eval, options)
     fns["integrate()"]()

@@ -60,13 +60,16 @@ DOCS, IMG = ROOT / "docs", ROOT / "docs" / "img"
 RIG = camdyn.example_rig()
 ATOL_PER_RTOL = 1e-4           # atol = 1e-4 rtol throughout
 REFERENCE_RTOL = 1e-12         # engine DOP853: the reference; engine RK45: its check
-#: camdyn's runs: label -> (method, reach factor of the crossing check); the last is the engine
-#: sampling every step's interpolant at its interior points (EventSettings(reach_factor=inf)), as
-#: it did before the reach rule, to show what the rule saves against the peers, which locate no events
-CAMDYN = {"camdyn compiled DOP853": ("DOP853", EventSettings().reach_factor),
-          "camdyn compiled RK45": ("RK45", EventSettings().reach_factor),
-          "camdyn DOP853, every step sampled": ("DOP853", math.inf)}
-MAIN, EVERY = "camdyn compiled DOP853", "camdyn DOP853, every step sampled"
+#: camdyn's runs: label -> (method, reach factor of the crossing check, step-size controller);
+#: the first two as camdyn runs by default; "every step sampled" the engine sampling every step's
+#: interpolant at its interior points (EventSettings(reach_factor=inf)), as it did before the reach
+#: rule, to show what the rule saves against the peers, which locate no events; "SciPy's step
+#: control" the engine with SciPy's step-size controller instead of the default PI one
+_REACH, _CONTROL = EventSettings().reach_factor, SolverOptions().step_control
+CAMDYN = {"camdyn compiled DOP853": ("DOP853", _REACH, _CONTROL), "camdyn compiled RK45": ("RK45", _REACH, _CONTROL),
+          "camdyn DOP853, every step sampled": ("DOP853", math.inf, _CONTROL),
+          "camdyn DOP853, SciPy's step control": ("DOP853", _REACH, "scipy")}
+MAIN, EVERY, SCIPY = "camdyn compiled DOP853", "camdyn DOP853, every step sampled", "camdyn DOP853, SciPy's step control"
 
 
 @dataclass(frozen=True)
@@ -144,13 +147,13 @@ class Sample(NamedTuple):
     switches: int
 
 
-def camdyn_runner(case: Case, model: Model, method: str, rtol: float,
-                  reach_factor: float = EventSettings().reach_factor) -> Callable[[], Sample]:
+def camdyn_runner(case: Case, model: Model, method: str, rtol: float, reach_factor: float = _REACH,
+                  step_control: str = _CONTROL) -> Callable[[], Sample]:
     """driver.integrate() on a model built once (as the peers' runners are): the work measured is
     integration, event location and sampling, not model set-up or output kernels."""
     t_eval, y0 = case.t_eval(), model.static_state()
     options = SolverOptions(method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL,
-                            events=EventSettings(reach_factor=reach_factor))
+                            events=EventSettings(reach_factor=reach_factor), step_control=step_control)
 
     def run() -> Sample:
         tr = integrate(model, (0.0, case.t_end), y0, t_eval, options)
@@ -300,7 +303,7 @@ def prepare(case: Case, peers: dict) -> Prepared:
 
 def solvers(pc: Prepared, peers: dict, rtol: float, skip: set) -> dict[str, Callable[[], Sample]]:
     """Every solver's runner at rtol (those in ``skip`` left out)."""
-    out = {label: camdyn_runner(pc.case, pc.model, method, rtol, reach) for label, (method, reach) in CAMDYN.items()}
+    out = {label: camdyn_runner(pc.case, pc.model, method, rtol, *how) for label, (method, *how) in CAMDYN.items()}
     if peers.get("numbalsoda"):
         for m in ("DOP853", "LSODA"):
             out[f"numbalsoda {m}"] = numbalsoda_runner(pc.case, pc.model, pc.nbs_rhs, m, rtol)
@@ -712,7 +715,8 @@ def floor_lines(fs: dict) -> list[str]:
              "whose ends put every watched surface out of reach of zero cleared from them, without interpolant "
              "or interior samples: camdyn.engine.rules, *Reach*) and doing the floor's work, every step sampled "
              "(`EventSettings(reach_factor=inf)`); the loop's overhead, which the issue's target bounds, is the "
-             "second against the floor.", "",
+             "second against the floor.  Here the engine uses the floor's step-size controller, SciPy's "
+             "(`step_control=\"scipy\"`; camdyn's default is the PI controller), so that both take the same steps.", "",
              f"Run: line contact (l_lambda = {RIG.l_lambda * 1e3:g} mm), damping D, Coulomb, `example_rig()`, "
              f"{run.speed_rpm:+g} rev/min, {run.t_end:g} s from the static equilibrium, rtol {run.rtol:.0e}, "
              f"atol {run.atol:.0e}, samples at {run.fs:g} Hz (the work-precision scene sliding_de below).  "
@@ -852,15 +856,17 @@ def target_lines(results: list) -> list[str]:
              "The issue's goal: ahead of numbalsoda at equal error at every tolerance on every scene.  Per scene, "
              "over the tolerances measured (\"never\" counts as ahead):", "",
              "| scene | x numbalsoda min-max | tolerances where behind numbalsoda | ahead at every tolerance | "
-             "x fastest peer min-max | x numbalsoda, every step sampled, min-max |", "|---|---|---|---|---|---|"]
+             "x fastest peer min-max | x numbalsoda, every step sampled, min-max | x numbalsoda, SciPy's step "
+             "control, min-max |", "|---|---|---|---|---|---|---|"]
     for res in results:
         rows = ratios(res)
         nbs = [r.numbalsoda for r in rows if r.nbs_reached]
         behind = [f"{r.rtol:.0e} ({r.numbalsoda:.2f})" for r in rows if r.nbs_reached and r.numbalsoda < 1]
         peer = [r.peer for r in rows if math.isfinite(r.peer)]
-        bare = [v for v in versus(res, EVERY, "numbalsoda") if math.isfinite(v)]
+        every = [v for v in versus(res, EVERY, "numbalsoda") if math.isfinite(v)]
+        scipy = [v for v in versus(res, SCIPY, "numbalsoda") if math.isfinite(v)]
         lines.append(f"| {res['case'].key} | {_span(nbs)} | {', '.join(behind) or 'none'} | "
-                     f"{'yes' if rows and not behind else 'no'} | {_span(peer)} | {_span(bare)} |")
+                     f"{'yes' if rows and not behind else 'no'} | {_span(peer)} | {_span(every)} | {_span(scipy)} |")
     return lines + [""] + summary_lines(results) + [""]
 
 
@@ -893,9 +899,10 @@ def numbalsoda_summary(results: list, label: str = MAIN, peer_prefix: str = "num
 
 
 def summary_lines(results: list) -> list[str]:
-    """The Targets section's summary: camdyn as it runs, sampling every step, and its DOP853 against
-    numbalsoda's (the same method): where the difference lies."""
+    """The Targets section's summary: camdyn as it runs, sampling every step, with SciPy's step
+    control, and its DOP853 against numbalsoda's (the same method): where the difference lies."""
     return [f"- {numbalsoda_summary(results)}", f"- {numbalsoda_summary(results, EVERY)}",
+            f"- {numbalsoda_summary(results, SCIPY)}",
             f"- {numbalsoda_summary(results, MAIN, 'numbalsoda DOP853')}",
             f"- {numbalsoda_summary(results, MAIN, 'numbalsoda LSODA')}"]
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from .cam import CamMotion, cam_motion
 from .derive.vocabulary import CAM_THETA
-from .engine.config import EventSettings, SolverOptions
+from .engine.config import STEP_CONTROL, EventSettings, SolverOptions
 from .engine.driver import BACKENDS, Trajectory, integrate
 from .engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
 from .engine.switches import Switches
@@ -49,7 +49,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              atol: float = 1e-12, max_step: float = math.inf,
              events: EventSettings | None = None, energy_ledger: bool = False,
              backend: str = "compiled", progress: Callable[[float], None] | None = None,
-             stop=None) -> Result:
+             stop=None, step_control: str = STEP_CONTROL) -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -58,7 +58,10 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     rad/s), by default the static equilibrium (alpha*, 0) as in Section 4.
     The outputs are sampled at ``sample_rate_Hz``.  ``method`` (``"DOP853"`` or
     ``"RK45"``) integrates each mode of the scene's hybrid automaton; every switch is
-    located on the dense output.  Check ``result.ok``: a run that could not finish says why.
+    located on the dense output.  ``step_control``: the step-size controller, ``"pi"`` (default:
+    proportional-integral, fewer rejected steps where the error estimate jumps, as in a contact
+    mode's ring-down) or ``"scipy"`` (SciPy's: the steps are ``solve_ivp``'s on a smooth stretch);
+    docs/performance.md measures both.  Check ``result.ok``: a run that could not finish says why.
     ``energy_ledger=True`` also integrates the work of the cam drive and the energy
     dissipated by contact damping and by friction (``result.work_in``,
     ``result.dissipated_contact``, ``result.dissipated_friction``), so that
@@ -93,7 +96,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     duration = run_duration(cam, model.equilibrium.vartheta, t_end, revolutions)
     check_start(t_start, y0)
     t_eval = t_start + np.arange(sample_count(duration, sample_rate_Hz)) / float(sample_rate_Hz)
-    options = solver_options(method, rtol, atol, max_step, events, energy_ledger)
+    options = solver_options(method, rtol, atol, max_step, events, energy_ledger, step_control)
     if scene.follower == "quasistatic":
         return _quasi_static(model, t_eval, backend, y0=y0, energy_ledger=energy_ledger, stop=stop)
     y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
@@ -223,9 +226,9 @@ def check_start(t_start, y0) -> None:
             raise ParameterError("y0", y0, "two finite numbers (alpha rad, alpha_dot rad/s)")
 
 
-def solver_options(method, rtol, atol, max_step, events, energy_ledger) -> SolverOptions:
+def solver_options(method, rtol, atol, max_step, events, energy_ledger, step_control=STEP_CONTROL) -> SolverOptions:
     """simulate's solver keywords as validated :class:`SolverOptions`."""
-    return SolverOptions(method, rtol, atol, max_step, events or EventSettings(), bool(energy_ledger))
+    return SolverOptions(method, rtol, atol, max_step, events or EventSettings(), bool(energy_ledger), step_control)
 
 
 def _result(model: Model, traj, backend: str) -> Result:

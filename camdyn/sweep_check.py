@@ -68,7 +68,8 @@ def check_settings(spec: SweepSpec) -> None:
         if a[name] is not None:
             _positive(name, a[name])
     check_start(a["t_start"], a["y0"])
-    solver_options(a["method"], a["rtol"], a["atol"], a["max_step"], a["events"], a["energy_ledger"])
+    solver_options(a["method"], a["rtol"], a["atol"], a["max_step"], a["events"], a["energy_ledger"],
+                   a["step_control"])
 
 
 def check_by_running(spec: SweepSpec, index: int) -> None:

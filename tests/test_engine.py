@@ -324,3 +324,23 @@ def test_a_run_that_will_compile_the_loop_says_so_once(monkeypatch):
     assert not cache.loop_cached()
     with pytest.warns(camdyn.CompileNotice, match="compiles its integration loop.*filterwarnings"):
         camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, t_end=1e-4)
+
+
+def test_pi_step_control_rejects_fewer_attempts_at_the_same_accuracy():
+    """The sliding run's start-up transient (line contact, damping D, Coulomb, +300 rev/min,
+    rtol 1e-8): the DOP853 error estimate dips and jumps with the contact vibration's phase, so
+    SciPy's controller grows the step after a dip and is rejected (measured: 350 rejected attempts
+    for 1869 steps); the PI controller damps that growth (measured: 46).  Both stay within 1e-9
+    rad of a run at rtol 1e-12 (measured 9e-11 and 6e-12: the bound leaves a factor 10)."""
+    rig, scene = camdyn.example_rig(), camdyn.Scene(damping="D", friction="coulomb")
+    kw = dict(speed_rpm=300, t_end=0.2, sample_rate_Hz=5000)
+    ref = camdyn.simulate(rig, scene, rtol=1e-12, atol=1e-16, **kw)
+    runs = {c: camdyn.simulate(rig, scene, rtol=1e-8, atol=1e-12, step_control=c, **kw) for c in ("scipy", "pi")}
+    assert runs["pi"].stats["rejected_steps"] < 0.5 * runs["scipy"].stats["rejected_steps"]
+    for r in runs.values():
+        assert r.ok and np.max(np.abs(r.alpha - ref.alpha)) < 1e-9
+
+
+def test_step_control_is_validated():
+    with pytest.raises(ParameterError, match="step_control"):
+        SolverOptions(step_control="PID")

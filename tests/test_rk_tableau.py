@@ -47,9 +47,10 @@ def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
     K = np.empty((method.n_rows, 2))
     K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t0, y0, y1, prob.p)
     h = stepper.initial_step(prob.kernels.rhs, prob.p, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
-    t, n, nfev = t0, 0, 2
+    t, n, nfev, err = t0, 0, 2, stepper.ERR_FLOOR
     while t < t_end:
-        status, t, y0, y1, h, f, _ = stepper.step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K, cfg)
+        status, t, y0, y1, h, f, _, err = stepper.step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K,
+                                                       cfg, err)
         nfev += f
         times[n] = t
         n += 1
@@ -173,3 +174,28 @@ def test_measured_order_of_convergence(name, order, dense_order):
 def test_spacing_is_numpys_distance_to_the_next_float(t):
     """The step-size floor's unit (stepper.spacing, from frexp) is np.nextafter(t, inf) - t exactly."""
     assert stepper.spacing(t) == np.nextafter(t, np.inf) - t
+
+
+# --- the step-size controllers (stepper.CONTROLS) ------------------------------------------------
+@pytest.mark.parametrize("err, err_prev, rejected", [(0.43, 0.2, 0), (1e-3, 0.5, 0), (0.9, 1e-4, 0), (0.3, 0.3, 1)])
+def test_scipy_control_is_scipys_formula_and_pi_reads_the_previous_error(err, err_prev, rejected):
+    """SciPy's controller ignores the previous error (bitwise the formula of scipy's
+    RungeKutta._step_impl); the PI controller multiplies err^(-0.7/k) by err_prev^(0.4/k)."""
+    exponent = -1 / 8
+    scipy_factor = min(stepper.MAX_FACTOR, stepper.SAFETY * err ** exponent)
+    if rejected:
+        scipy_factor = min(1.0, scipy_factor)
+    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *stepper.CONTROLS["scipy"]) == scipy_factor
+    pi = min(stepper.MAX_FACTOR, stepper.SAFETY * err ** (-0.7 / 8) * err_prev ** (0.4 / 8))
+    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *stepper.CONTROLS["pi"]) == pytest.approx(
+        min(1.0, pi) if rejected else pi, rel=1e-15)
+
+
+def test_a_step_after_a_dip_of_the_error_grows_less_under_pi():
+    """After err_prev = 0.4, a step whose estimate dips to 1e-3 (an erratic estimate) grows the
+    next step 2.1x under SciPy's controller and 1.6x under PI; err 0 grows it MAX_FACTOR."""
+    scipy_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *stepper.CONTROLS["scipy"])
+    pi_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *stepper.CONTROLS["pi"])
+    assert 1.0 < pi_f < scipy_f
+    assert stepper.accepted_factor(0.0, 0.4, 0, -1 / 8, *stepper.CONTROLS["pi"]) == stepper.MAX_FACTOR
+    assert stepper.rejected_factor(float("nan"), -1 / 8) == stepper.MIN_FACTOR

@@ -37,20 +37,24 @@ def test_undamped_frictionless_conserves_energy(eq, push):
     """No damping, no friction, cam at rest: E = T + V_s + V_c is constant, across impacts too.
 
     Bound: 1e3 * rtol of the motion's energy scale (DOP853's global error over ~200
-    contact periods; measured 1.5e-6 at rtol 1e-8); tightening rtol by 100 must shrink it.
+    contact periods; measured 2.5e-7 at rtol 1e-8, 8.5e-7 with SciPy's step control);
+    tightening rtol by 100 must shrink it, unless it has reached the drift's floor, the
+    energy measure's own error: the drift at rtol 1e-12 (measured 8.7e-8 of the sliding case's
+    scale, the same at rtol 1e-10, 1e-11 and 1e-12 with either step control, so 1.5 x it is
+    the floor reached).
     """
     y0 = (eq.alpha + push, 0.0) if push else (eq.alpha, -0.5)
     scale = 0.5 * eq.stiffness * push**2 if push else 0.5 * RIG.I_Pb * 0.5**2
     drift = {}
-    for rtol in (1e-8, 1e-10):
+    for rtol in (1e-8, 1e-10, 1e-12):
         r = camdyn.simulate(RIG, FRICTIONLESS, speed_rpm=0, t_end=0.1, y0=y0, sample_rate_Hz=20_000,
                             rtol=rtol, atol=1e-16 if push else 1e-14)
         assert r.ok
         drift[rtol] = np.ptp(r.energy) / scale
-    if not push:
-        assert r.impacts().size > 10
+        if not push:
+            assert r.impacts().size > 10
     assert drift[1e-8] < 1e3 * 1e-8
-    assert drift[1e-10] < drift[1e-8] / 5
+    assert drift[1e-10] < drift[1e-8] / 5 or drift[1e-10] < 1.5 * drift[1e-12]
 
 
 @pytest.fixture(scope="module")

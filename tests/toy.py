@@ -31,7 +31,8 @@ def module(surfaces, transitions, initial, n_modes=2, rates=None, contact=None):
 
 
 def settings(interior_points=3, xtol=1e-14, **kw) -> Settings:
-    base = dict(rtol=1e-8, atol=1e-12, max_step=math.inf, xtol=xtol, interior_points=interior_points,
+    base = dict(rtol=1e-8, atol=1e-12, max_step=math.inf, control_a=1.0, control_b=0.0, xtol=xtol,
+                interior_points=interior_points,
                 reach_factor=REACH_FACTOR,
                 max_events=10_000, angle_limit=1e9, chatter_switches=20, chatter_window=1e-9, contact_step=0.0,
                 crossing_retries=1, look_ahead=1e-9, ledger=False)

@@ -31,7 +31,7 @@ from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
 from .rules import (NONFINITE, across, chattering, clear_of_surfaces, first_crossing, initial_mode, left_at_start,
                     scratch, switch, zero_at_start)
-from .stepper import ACCEPTED, dense_coefficients, dense_eval, initial_step, step, step_impl
+from .stepper import ACCEPTED, ERR_FLOOR, dense_coefficients, dense_eval, initial_step, step, step_impl
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
 
@@ -194,7 +194,7 @@ def run(prob, method, cfg, start, samples):
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
-    h_last, retries, capped = -1.0, 0, False
+    h_last, retries, capped, err_prev = -1.0, 0, False, ERR_FLOOR
     screen = cfg.reach_factor < math.inf  # clear a step from its ends (rules.clear_of_surfaces)
     while t < t_end and outcome == SUCCESS:
         h_abs, f = _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K)
@@ -203,7 +203,8 @@ def run(prob, method, cfg, start, samples):
         watched = n_watched > 0
         have_start = False
         while t < t_end:
-            status, t_new, n0, n1, h_next, f, rej = step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg)
+            status, t_new, n0, n1, h_next, f, rej, err_prev = step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg,
+                                                                   err_prev)
             nfev += f
             rejected += rej
             if status != ACCEPTED:

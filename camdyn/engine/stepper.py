@@ -5,7 +5,9 @@ The state is ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot, rhs(m, t,
 alpha_dot, p))`` in mode m (the generated kernel, a numba ``cfunc`` when compiled).  The split
 is SciPy's ``RungeKutta``: :func:`step_impl` computes one attempt (stages and solution),
 :func:`error_norm` its error, and :func:`step` does the bookkeeping (accept or reject, the next
-step size) as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's.
+step size) as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's; or,
+with the PI controller (:data:`CONTROLS`), the next step size also reads the previous accepted
+step's error.
 :func:`dense_coefficients` and :func:`dense_eval` are the interpolant (``RkDenseOutput`` /
 ``Dop853DenseOutput`` in power form).  The method is a :class:`~camdyn.engine.tableau.Method`;
 the stage buffer ``K`` has one row per stage, the FSAL stage and the interpolant's extra stages.
@@ -23,6 +25,16 @@ from .jit import jitable
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
+#: the step-size controllers (SolverOptions.step_control), as the coefficients (a, b) of the next
+#: step's factor SAFETY err^(-a/k) err_prev^(b/k), k the error estimate's order + 1 (the
+#: method's exponent is -1/k): "scipy", SciPy's integral controller (the accepted step's error
+#: alone: the steps are SciPy's); "pi", the proportional-integral controller (a = 0.7, b = 0.4:
+#: Gustafsson, ACM TOMS 17, 1991; Hairer & Wanner, Solving ODEs II, Sec. IV.2), which also reads
+#: the previous accepted step's error and so damps the growth after a step whose estimate dipped
+CONTROLS = {"scipy": (1.0, 0.0), "pi": (0.7, 0.4)}
+#: the previous error a run's first step reads, and the least one any step passes on (Hairer's
+#: DOPRI codes' FACOLD): a tiny estimate does not unleash the next step's growth
+ERR_FLOOR = 1e-4
 
 #: step() status codes
 ACCEPTED, TOO_SMALL = 0, 1
@@ -105,11 +117,36 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
 
 
 @jitable
-def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
-    """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry.
+def accepted_factor(err, err_prev, rejected, exponent, a, b):
+    """The next step size over the accepted one's: SAFETY err^(a exponent) err_prev^(-b exponent)
+    (CONTROLS; b = 0: SciPy's), at most MAX_FACTOR, and at most 1 right after a rejection."""
+    if err == 0.0:
+        factor = MAX_FACTOR
+    else:
+        factor = SAFETY * err ** (a * exponent)
+        if b != 0.0:
+            factor *= err_prev ** (-b * exponent)
+        factor = min(MAX_FACTOR, factor)
+    return min(1.0, factor) if rejected else factor
 
-    Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections);
-    K then holds the accepted attempt's stages with f(t_new, y_new) in row n_stages.
+
+@jitable
+def rejected_factor(err, exponent):
+    """The retry's step size over the rejected attempt's (SciPy's; NaN or inf: a stage left the
+    domain of a law, retry five times smaller)."""
+    if math.isfinite(err):
+        return max(MIN_FACTOR, SAFETY * err ** exponent)
+    return MIN_FACTOR
+
+
+@jitable
+def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev):
+    """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry; ``err_prev``: the
+    previous accepted step's error (ERR_FLOOR at a run's start), read by the PI controller.
+
+    Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections, err), err
+    the accepted step's error for the next step (at least ERR_FLOOR); K then holds the accepted
+    attempt's stages with f(t_new, y_new) in row n_stages.
     """
     exponent = method.exponent
     min_step = 10.0 * spacing(t)
@@ -121,7 +158,7 @@ def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
     rejected = 0
     while True:
         if h_abs < min_step:
-            return TOO_SMALL, t, y0, y1, h_abs, nfev, rejected
+            return TOO_SMALL, t, y0, y1, h_abs, nfev, rejected, err_prev
         t_new = t + h_abs
         if t_new - t_bound > 0:
             t_new = t_bound
@@ -131,14 +168,9 @@ def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg):
         nfev += method.n_stages
         err = error_norm(K, h, y0, y1, n0, n1, cfg.rtol, cfg.atol, method)
         if err < 1.0:
-            factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** exponent)
-            if rejected:
-                factor = min(1.0, factor)
-            return ACCEPTED, t_new, n0, n1, h_abs * factor, nfev, rejected
-        if math.isfinite(err):
-            h_abs *= max(MIN_FACTOR, SAFETY * err ** exponent)
-        else:  # a stage left the domain of a law (NaN/inf): retry smaller
-            h_abs *= MIN_FACTOR
+            factor = accepted_factor(err, err_prev, rejected, exponent, cfg.control_a, cfg.control_b)
+            return ACCEPTED, t_new, n0, n1, h_abs * factor, nfev, rejected, max(err, ERR_FLOOR)
+        h_abs *= rejected_factor(err, exponent)
         rejected += 1
 
 

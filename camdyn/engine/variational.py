@@ -19,7 +19,7 @@ from numba import njit
 from ..derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import jitable
-from .stepper import MAX_FACTOR, MIN_FACTOR, SAFETY, spacing
+from .stepper import accepted_factor, rejected_factor, spacing
 
 cache.install()
 
@@ -111,11 +111,10 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
             else:
                 s5, s3 = np.sum((e5 / scale) ** 2), np.sum((e3 / scale) ** 2)
                 err = 0.0 if s5 == 0.0 and s3 == 0.0 else h * s5 / math.sqrt((s5 + 0.01 * s3) * N_AUGMENTED)
-            if err < 1.0:
-                factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** method.exponent)
-                h_abs = h * (min(1.0, factor) if rejected else factor)
+            if err < 1.0:  # SciPy's controller (stepper.CONTROLS["scipy"])
+                h_abs = h * accepted_factor(err, 1.0, rejected, method.exponent, 1.0, 0.0)
                 break
-            h_abs = h * (max(MIN_FACTOR, SAFETY * err ** method.exponent) if math.isfinite(err) else MIN_FACTOR)
+            h_abs = h * rejected_factor(err, method.exponent)
             rejected = True
         t, y = t_new, y_new
         K[0] = K[n]

@@ -843,7 +843,10 @@ def ratio_lines(results: list) -> list[str]:
 
 
 def _span(values: list) -> str:
-    return f"{fmt(min(values, default=math.nan), '.2f')}-{fmt(max(values, default=math.nan), '.2f')}"
+    """min-max of the finite ratios; none: the peer never reached camdyn's error at any point."""
+    if not values:
+        return "never reached"
+    return f"{fmt(min(values), '.2f')}-{fmt(max(values), '.2f')}"
 
 
 def target_lines(results: list) -> list[str]:

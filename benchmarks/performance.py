@@ -69,7 +69,8 @@ _REACH, _CONTROL = EventSettings().reach_factor, SolverOptions().step_control
 CAMDYN = {"camdyn compiled DOP853": ("DOP853", _REACH, _CONTROL), "camdyn compiled RK45": ("RK45", _REACH, _CONTROL),
           "camdyn DOP853, every step sampled": ("DOP853", math.inf, _CONTROL),
           "camdyn DOP853, SciPy's step control": ("DOP853", _REACH, "scipy")}
-MAIN, EVERY, SCIPY = "camdyn compiled DOP853", "camdyn DOP853, every step sampled", "camdyn DOP853, SciPy's step control"
+MAIN, EVERY, SCIPY = ("camdyn compiled DOP853", "camdyn DOP853, every step sampled",
+                      "camdyn DOP853, SciPy's step control")
 
 
 @dataclass(frozen=True)
@@ -803,9 +804,8 @@ def engine_time_lines(fs: dict) -> list[str]:
               "made directly (all in a compiled loop).  By default every compiled call increments and decrements, "
               "atomically, the reference count of each array it is passed, those in tuples included; the "
               "engine's helpers are compiled without reference counting (they borrow their caller's arrays), "
-              "the automaton's tables, the method and first_crossing's work are one array each, and "
-              "first_crossing calls the surface kernels directly at each sample (only a sample that may hide a "
-              "crossing calls the locating helpers).", "",
+              "the automaton's tables, the method and first_crossing's work are one array each, and only a "
+              "sample that may hide a crossing calls the locating helpers.", "",
               f"`integrate()` on the same run (Python set-up of the tables, method and settings, and the "
               f"Trajectory, included): {rep.integrate_s * 1e3:.2f} ms against "
               f"{min(rep.times[floor.ENGINE]) * 1e3:.2f} ms for `run_compiled` alone."]

@@ -139,5 +139,5 @@ def settings(options: SolverOptions, contact_frequency: float) -> Settings:
     step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
     a, b = CONTROLS[options.step_control]
     return Settings(float(options.rtol), float(options.atol), float(options.max_step), a, b, float(ev.xtol),
-                    int(ev.interior_points), float(ev.reach_factor), int(ev.max_events), ANGLE_LIMIT, CHATTER_SWITCHES, CHATTER_WINDOW,
-                    step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))
+                    int(ev.interior_points), float(ev.reach_factor), int(ev.max_events), ANGLE_LIMIT,
+                    CHATTER_SWITCHES, CHATTER_WINDOW, step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))

@@ -9,8 +9,8 @@ That restart state is one step of the method to the located time (the method's o
 interpolant's error, an order lower and larger at loose tolerances, would otherwise be carried
 into the next mode at every switch); when that state is not yet across the surface, the run
 goes on in the same mode from it, up to ``crossing_retries`` steps in a row (then it restarts
-from the interpolant's state, across by construction, so time always advances).  The first step after contact starts is
-capped at ``contact_step``.
+from the interpolant's state, across by construction, so time always advances).  The first
+step after contact starts is capped at ``contact_step``.
 
 :func:`run` is written once (:mod:`.jit`): :func:`run_compiled` is the same code compiled
 (numba, cached on disk; the kernels arrive as first-class functions, so one compiled loop

@@ -144,7 +144,7 @@ def continued(loss: float, fast) -> dict:
         events += [(kind, lam / loss) for kind, lam, _, _ in events_table(ds)]
         out[phase] = ds
     ds = out[0.0]
-    on = (ds["branch"].values == 0) & ds["stable"].values.astype(bool)
+    on = (ds["point_branch"].values == 0) & ds["stable"].values.astype(bool)
     lam, alpha = ds["lambda"].values[on], ds["alpha_revolution"].values[on, 0]
     order = np.argsort(lam)
     grid = fast["speed_rpm"].values

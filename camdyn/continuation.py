@@ -80,11 +80,12 @@ from .engine.driver import Trajectory
 from .engine.loop import ALPHA, ALPHA_DOT
 from .errors import CamdynError, ParameterError
 from .model import Model
-from .orbits import ShootingSettings, newton, periodic_orbit
+from .orbits import OrbitOutcome, ShootingSettings, newton, periodic_orbit, sorted_multipliers
 from .outcome import ActionableOutcome
 from .rig import PARAMETERS, Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences, jacobian_at
+from .derivatives import Column, Unresolved, finite_differences, resolved_difference
+from .section_map import DEFAULT_OPTIONS, MapFailure, MapValue, StroboscopicMap, derivative_at
 
 #: the parameter name of the cam speed (rev/min); any other is a rig parameter (SI)
 SPEED = "speed_rpm"
@@ -204,8 +205,8 @@ class Problem:
 class Point(NamedTuple):
     """One orbit on a branch: lambda, x at the section, dP_n/dx, the unit tangent (scaled), the
     largest gap (m), alpha at the revolutions' starts (the brute-force diagram's section), the
-    mode at the section, the scaled residual, the corrector's steps, and the scaled derivatives
-    of G there."""
+    mode at the section, the scaled residual, the corrector's steps, the scaled derivatives
+    of G there, and how they were obtained (:class:`Derivation`)."""
 
     lam: float
     x: np.ndarray
@@ -217,17 +218,24 @@ class Point(NamedTuple):
     residual: float
     iterations: int
     derivatives: np.ndarray     # the scaled [dG/dx, dG/dlambda] (2 x 3) at the point: the next corrector's
+    derivation: "Derivation"
+
+    @property
+    def resolved(self) -> bool:
+        return self.derivation.resolved
 
 
 @dataclass
 class Branch:
-    """A continued branch: its points (in order), period, parent (-1: none), and outcome."""
+    """A continued branch: its points (in order), period, parent (-1: none), the event it was
+    switched to at (an index into the events; -1: none), and outcome."""
 
     periods: int
     points: list = field(default_factory=list)
     outcome: ContinuationOutcome | None = None
     message: str = ""
     parent: int = -1
+    origin: int = -1
 
 
 class Event(NamedTuple):
@@ -241,22 +249,38 @@ class Event(NamedTuple):
     max_gap: float
 
 
+class Derivation(NamedTuple):
+    """How a point's derivatives were obtained: the provider of dP/dx, the central-difference
+    steps (alpha rad, alpha_dot rad/s, lambda; NaN where not by differences), whether both
+    dP/dx and dP/dlambda are resolved (:mod:`camdyn.derivatives`), and a note (a fallback, or why not)."""
+
+    provider: str
+    steps: np.ndarray
+    resolved: bool
+    note: str
+
+
 class _Scaled(NamedTuple):
-    """G(z) scaled, the scaled Jacobian [dG/dx, dG/dlambda] (2 x 3), and dP/dx unscaled."""
+    """G(z) scaled, the scaled Jacobian [dG/dx, dG/dlambda] (2 x 3), dP/dx unscaled, and how."""
 
     G: np.ndarray
     A: np.ndarray
     J: np.ndarray
+    derivation: Derivation
 
 
 class _Run(NamedTuple):
-    """One run of P_n from x over the orbit's n T (:func:`_orbit_run`): the map, P_n(x), the
-    run's samples, and the revolutions' starts (s) among them."""
+    """One run of P_n from x over the orbit's n T (:func:`_orbit_run`): the map, its value
+    (P_n(x) and the run's switches), the run's samples, and the revolutions' starts (s) among them."""
 
     section_map: StroboscopicMap
-    P: np.ndarray
+    value: MapValue
     trajectory: Trajectory
     starts: np.ndarray
+
+    @property
+    def P(self) -> np.ndarray:
+        return self.value.state
 
 
 def _orbit_run(problem: Problem, lam: float, x, mode, periods: int) -> _Run:
@@ -272,23 +296,42 @@ def _orbit_run(problem: Problem, lam: float, x, mode, periods: int) -> _Run:
     starts = T * (np.arange(periods) + (1 if t0 > 0 else 0))    # the k T in [t0, t1)
     t_eval = np.unique(np.concatenate([samples, starts]))
     value, tr = section_map.run(x, t_eval)
-    return _Run(section_map, value.state, tr, starts)
+    return _Run(section_map, value, tr, starts)
 
 
-def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale, P=None) -> _Scaled:
-    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure); ``P``: P_n(x) when the
-    caller has run it, told to the provider (:func:`~camdyn.section_map.jacobian_at`: a run
-    less by finite differences)."""
+def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale, base: MapValue) -> _Scaled:
+    """P_n(x; lambda) - x and its derivatives, scaled (raises MapFailure); ``base``: the map's
+    value at (x, lambda), from the caller's run, told to the provider (a run less by finite
+    differences) and the base of the difference in lambda (:func:`_d_lambda`)."""
     section_map = problem.section_map(lam, mode, periods)
-    P, J = jacobian_at(problem.jacobian(section_map, scale), x, P)
-    h = problem.options.rtol ** (1.0 / 3.0) * max(abs(lam), problem.span)
-    plus = problem.section_map(lam + h, mode, periods)(x)
-    minus = problem.section_map(lam - h, mode, periods)(x)
-    dP_dlam = (plus - minus) / (2.0 * h)
+    d = derivative_at(problem.jacobian(section_map, scale), x, base)
+    dP_dlam, h, note = _d_lambda(problem, lam, x, mode, periods, scale, base)
     A = np.empty((2, 3))
-    A[:, :2] = (J - np.eye(2)) * scale[None, :] / scale[:, None]
+    A[:, :2] = (d.jacobian - np.eye(2)) * scale[None, :] / scale[:, None]
     A[:, 2] = dP_dlam * problem.span / scale
-    return _Scaled((P - x) / scale, A, J)
+    if not np.all(np.isfinite(A)):
+        raise MapFailure(f"no derivatives at {problem.parameter} = {lam:.8g}: {d.note or note}")
+    notes = "; ".join(n for n in (d.note, note) if n)
+    how = Derivation(d.provider, np.append(d.steps, h), d.resolved and not note, notes)
+    return _Scaled((d.value - x) / scale, A, d.jacobian, how)
+
+
+def _d_lambda(problem: Problem, lam: float, x, mode, periods: int, scale, base: MapValue):
+    """dP_n/dlambda at (x, lambda) by a central difference under the rule of
+    :mod:`camdyn.derivatives` (the runs at lambda +- h make the base run's switches and two steps
+    agree; h from ``rtol^(1/3) max(|lambda|, span)`` down to the floor ``rtol^(1/2)`` of that):
+    (derivative, step, '') or, when unresolved, the secant across the largest step that ran (a
+    direction for the predictor and corrector, no derivative) and the reason."""
+    def evaluate(offset: float) -> MapValue:
+        return problem.section_map(lam + offset, mode, periods).evaluate(x)
+    column = Column.of(max(abs(lam), problem.span), problem.span / scale, problem.options.rtol)
+    try:
+        difference, h = resolved_difference(evaluate, base, column)
+        return difference, h, ""
+    except Unresolved as why:
+        if why.secant is None:
+            raise
+        return *why.secant, f"d/d{problem.parameter}: {why}"
 
 
 def _tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
@@ -327,7 +370,7 @@ def _correct(problem, z_pred, direction, A, mode, periods, scale, settings) -> _
                 return None
             fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
             if fresh:
-                A = _evaluate(problem, lam, x, mode, periods, scale, run.P).A
+                A = _evaluate(problem, lam, x, mode, periods, scale, run.value).A
         except CamdynError:
             return None
         if not math.isfinite(r) or (it >= 2 and r > last):
@@ -363,7 +406,7 @@ def _point(lam: float, x, run: _Run, ev: _Scaled, tangent, iterations: int) -> P
     """The orbit (lam, x) as a Point: its gap from its run, its derivatives ``ev``."""
     gap, alphas, end_mode = _gap(run)
     return Point(lam, np.array(x, dtype=float), ev.J, tangent, gap, alphas, end_mode, float(np.max(np.abs(ev.G))),
-                 iterations, ev.A)
+                 iterations, ev.A, ev.derivation)
 
 
 def _z(problem, p: Point, scale) -> np.ndarray:
@@ -389,7 +432,7 @@ def _completed(problem, p: Point, found: _Corrected, periods, scale) -> Point | 
     along p's; None when a run fails (or the rig refuses the value)."""
     lam, x = float(found.z[2] * problem.span), found.z[:2] * scale
     try:
-        ev = _evaluate(problem, lam, x, p.mode, periods, scale, found.run.P)
+        ev = _evaluate(problem, lam, x, p.mode, periods, scale, found.run.value)
     except CamdynError:
         return None
     return _point(lam, x, found.run, ev, _tangent(ev.A, p.tangent), found.iterations)
@@ -397,7 +440,10 @@ def _completed(problem, p: Point, found: _Corrected, periods, scale) -> Point | 
 
 # --- detection -----------------------------------------------------------------------------------
 def _tests(p: Point) -> dict[str, float]:
-    """The test functions at a point (2 x 2 monodromy: det(M -+ I) = det M -+ tr M + 1)."""
+    """The test functions at a point (2 x 2 monodromy: det(M -+ I) = det M -+ tr M + 1).  Where
+    the point's derivatives are unresolved they come from the differences across the first step
+    (:mod:`camdyn.derivatives`): a sign change next to such a point is located but named a
+    ``multiplier_jump``, never a bifurcation (:func:`_smooth`)."""
     M = p.jacobian
     det, tr = float(np.linalg.det(M)), float(np.trace(M))
     return {"fold": float(p.tangent[2]), "branch_point": det - tr + 1.0, "period_doubling": det + tr + 1.0,
@@ -531,7 +577,7 @@ def _detect(problem, p: Point, q: Point, ds: float, where: tuple[int, int], peri
             continue                                   # the +1 multiplier of the fold itself
         before, after = _locate(problem, p, q, ds, kind, periods, scale, settings)
         e = after or before
-        mu = _multipliers(e.jacobian)
+        mu = sorted_multipliers(e.jacobian) if e.resolved else np.full(2, np.nan, dtype=complex)
         named = kind if _smooth(kind, before, after) else "multiplier_jump"
         events.append((Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap), e, p, q))
     return events
@@ -544,16 +590,13 @@ def _smooth(kind: str, before: Point, after: Point | None) -> bool:
     if kind == "grazing":
         return True
     e = after or before
-    mu = _multipliers(e.jacobian)
+    if not (e.resolved and before.resolved):
+        return False                        # the switches change within a difference step: not smooth
+    mu = sorted_multipliers(e.jacobian)
     distance = {"fold": np.abs(mu - 1.0), "branch_point": np.abs(mu - 1.0), "period_doubling": np.abs(mu + 1.0),
                 "neimark_sacker": np.abs(np.abs(mu) - 1.0)}[kind]
-    jump = 0.0 if after is None else float(np.max(np.abs(mu - _multipliers(before.jacobian))))
+    jump = 0.0 if after is None else float(np.max(np.abs(mu - sorted_multipliers(before.jacobian))))
     return float(np.min(distance)) < CRITICAL and jump < CRITICAL
-
-
-def _multipliers(J: np.ndarray) -> np.ndarray:
-    mu = np.linalg.eigvals(J).astype(complex)
-    return mu[np.argsort(-np.abs(mu))]
 
 
 # --- following a branch ----------------------------------------------------------------------------
@@ -610,7 +653,7 @@ def _follow(problem, branch: Branch, index: int, first: Point, scale, settings, 
 def _first_point(problem, lam, x, mode, periods, scale, direction: float) -> Point:
     """The point (lam, x) with its tangent oriented toward increasing lambda times ``direction``."""
     run = _orbit_run(problem, lam, x, mode, periods)
-    ev = _evaluate(problem, lam, x, mode, periods, scale, run.P)
+    ev = _evaluate(problem, lam, x, mode, periods, scale, run.value)
     return _point(lam, x, run, ev, _tangent(ev.A, np.array([0.0, 0.0, direction])), 0)
 
 
@@ -623,7 +666,7 @@ def _switch(problem, e: Point, p: Point, q: Point, periods: int, scale, settings
     mu, V = np.linalg.eig(e.jacobian)
     v = V[:, int(np.argmin(np.abs(mu + 1.0)))].real
     v = v / np.max(np.abs(v / scale))
-    for side in sorted((p, q), key=lambda r: -np.max(np.abs(_multipliers(r.jacobian)))):
+    for side in sorted((p, q), key=lambda r: -np.max(np.abs(sorted_multipliers(r.jacobian)))):
         try:
             doubled = problem.section_map(side.lam, side.mode, 2 * periods)
             single = problem.section_map(side.lam, side.mode, periods)
@@ -652,7 +695,7 @@ def _start(problem: Problem, warmup_revolutions: int, settings):
                            phase=problem.phase_fraction * model.period, warmup_revolutions=warmup_revolutions,
                            settings=ShootingSettings(settings.tol, 20), options=problem.options,
                            jacobian=problem.jacobian, backend=problem.backend)
-    if not orbit.ok:
+    if not (orbit.ok or orbit.outcome is OrbitOutcome.MULTIPLIERS_UNRESOLVED):   # the orbit, not its multipliers
         return None, orbit.message
     direction = math.copysign(1.0, problem.end - problem.start)
     try:
@@ -661,6 +704,16 @@ def _start(problem: Problem, warmup_revolutions: int, settings):
     except MapFailure as failure:
         return None, str(failure)
     return first, orbit.scale
+
+
+def _note_unresolved(problem: Problem, branch: Branch) -> None:
+    """Say in the branch's message where its derivatives were unresolved (no multipliers, no
+    events of the multipliers told there: :func:`_tests`)."""
+    lost = [p.lam for p in branch.points if not p.resolved]
+    if lost:
+        branch.message += (f"; derivatives unresolved at {len(lost)} of {len(branch.points)} points "
+                           f"({problem.parameter} {min(lost):.8g} to {max(lost):.8g}): no multipliers there, and "
+                           "an event next to them is a multiplier_jump (the switches change within a difference step)")
 
 
 def _run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: int):
@@ -675,8 +728,10 @@ def _run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: i
         branches.append(branch)
         found: list = []
         _follow(problem, branch, index, first, scale, settings, found)
+        first_event = len(events)
         events += [f[0] for f in found]
-        for event, e, p, q in found:
+        _note_unresolved(problem, branch)
+        for k, (event, e, p, q) in enumerate(found):
             if event.kind != "period_doubling" or depth >= settings.switch_depth:
                 continue
             switched = _switch(problem, e, p, q, branch.periods, scale, settings)
@@ -690,7 +745,7 @@ def _run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: i
                                      math.copysign(1.0, lam - event.lam))
             except MapFailure:
                 continue
-            queue.append((Branch(2 * branch.periods, parent=index), start, depth + 1))
+            queue.append((Branch(2 * branch.periods, parent=index, origin=first_event + k), start, depth + 1))
     return branches, events, scale
 
 
@@ -763,42 +818,62 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
 
     Dims: ``point`` (every orbit of every branch, branch by branch, in the order continued),
     ``multiplier`` (2, by decreasing modulus), ``revolution`` (n of the longest period, NaN
-    beyond a point's own), ``event``, ``branch``.  Variables: ``lambda`` (the parameter, its
-    unit), ``alpha`` and ``alpha_dot`` at the section, ``multiplier_real``/``_imag``/``_modulus``,
-    ``stable`` (every ``|mu| < 1``), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
-    permanent contact), ``branch``, ``periods``, ``mode`` (code into attrs ``modes``),
-    ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's revolutions: the
-    points of the brute-force diagram); the events' ``event_kind`` (code into ``event_kinds``),
-    ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``, ``event_point``
-    (the point just before it), ``event_max_gap``, ``event_multiplier_real``/``_imag``; the branches'
-    ``branch_periods``, ``branch_parent`` (-1: none), ``branch_outcome`` (code into
-    ``outcomes``), and the messages as attrs ``branch_<i>_message``; attrs ``scale_alpha`` (rad)
-    and ``scale_alpha_dot`` (rad/s): the size of the motion at the start, the residual's scale.
+    beyond a point's own), ``event``, ``branch`` (a coordinate: 0, 1, ...).  Per point:
+    ``lambda`` (the parameter, its unit), ``alpha`` and ``alpha_dot`` at the section,
+    ``multiplier_real``/``_imag``/``_modulus`` (NaN where unresolved), ``resolved`` (the point's
+    derivatives passed the rule of :mod:`camdyn.derivatives`), ``stable`` (resolved and every
+    ``|mu| < 1``), ``jacobian_provider`` (code into attrs ``providers``), ``difference_step``
+    (the central-difference steps, dim ``difference``: alpha rad, alpha_dot rad/s, lambda; NaN
+    where not by differences), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
+    permanent contact), ``point_branch`` (the branch it is on), ``periods``, ``mode`` (code into
+    attrs ``modes``), ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's
+    revolutions: the points of the brute-force diagram).  Per event: ``event_kind`` (code into
+    ``event_kinds``), ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``,
+    ``event_point`` (the point just before it), ``event_max_gap``, ``event_multiplier_real``/
+    ``_imag``, ``event_alpha_revolution``.  Per branch: ``branch_periods``, ``branch_parent``
+    (-1: none), ``branch_origin`` (the event it was switched to at, -1: none: a period-doubled
+    branch is drawn from there), ``branch_outcome`` (code into ``outcomes``), and the messages as
+    attrs ``branch_<i>_message``; attrs ``scale_alpha`` (rad) and ``scale_alpha_dot`` (rad/s): the
+    size of the motion at the start, the residual's scale.
     """
     import xarray as xr
 
     unit, outcomes = _unit(problem.parameter), list(ContinuationOutcome)
     n_rev = max([b.periods for b in branches] + [1])
-    data = {**_point_variables(problem, branches, unit, n_rev), **_event_variables(problem, branches, events, unit, n_rev),
-            "branch_periods": (("branch",), np.array([b.periods for b in branches], dtype=int), {}),
-            "branch_parent": (("branch",), np.array([b.parent for b in branches], dtype=int),
-                              {"long_name": "the branch it was switched from (-1: none)"}),
-            "branch_outcome": (("branch",), np.array([outcomes.index(b.outcome) for b in branches], dtype=int),
-                               {"long_name": "how the branch ended (index into the attribute outcomes)"})}
+    providers = sorted({p.derivation.provider for b in branches for p in b.points})
+    data = {**_point_variables(problem, branches, unit, n_rev, providers),
+            **_event_variables(problem, branches, events, unit, n_rev), **_branch_variables(branches, outcomes)}
     s = np.full(2, np.nan) if scale is None else np.asarray(scale, dtype=float)
     attrs = {"parameter": problem.parameter, "parameter_units": unit, "start": problem.start, "end": problem.end,
              "speed_rpm": problem.speed_rpm if problem.speed_rpm is not None else math.nan,
              "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
              "modes": " ".join(problem.model(problem.start).kernels.MODES), "event_kinds": " ".join(EVENTS),
-             "outcomes": " ".join(o.name for o in outcomes), "scale_alpha": float(s[0]), "scale_alpha_dot": float(s[1])}
+             "outcomes": " ".join(o.name for o in outcomes), "providers": " ".join(providers),
+             "scale_alpha": float(s[0]), "scale_alpha_dot": float(s[1])}
     for i, b in enumerate(branches):
         attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
-    return xr.Dataset(data, attrs=attrs)
+    return xr.Dataset(data, coords={"branch": np.arange(len(branches))}, attrs=attrs)
 
 
-def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int) -> dict:
+def _branch_variables(branches: list, outcomes: list) -> dict:
+    B = ("branch",)
+    return {
+        "branch_periods": (B, np.array([b.periods for b in branches], dtype=int),
+                           {"long_name": "period n of the branch's orbits, in cam periods"}),
+        "branch_parent": (B, np.array([b.parent for b in branches], dtype=int),
+                          {"long_name": "the branch it was switched from (-1: none)"}),
+        "branch_origin": (B, np.array([b.origin for b in branches], dtype=int),
+                          {"long_name": "the event it was switched to at (index into event; -1: none)"}),
+        "branch_outcome": (B, np.array([outcomes.index(b.outcome) for b in branches], dtype=int),
+                           {"long_name": "how the branch ended (index into the attribute outcomes)"}),
+    }
+
+
+def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, providers: list) -> dict:
     points = [p for b in branches for p in b.points]
-    mu = np.array([_multipliers(p.jacobian) for p in points]).reshape(len(points), 2)
+    resolved = np.array([p.resolved for p in points], dtype=bool)
+    mu = np.array([sorted_multipliers(p.jacobian) for p in points]).reshape(len(points), 2)
+    mu[~resolved] = np.nan
     counts = [len(b.points) for b in branches]
     P, PM = ("point",), ("point", "multiplier")
     return {
@@ -809,11 +884,18 @@ def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int) ->
         "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
         "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
         "multiplier_modulus": (PM, np.abs(mu), {"units": "1", "long_name": "|Floquet multiplier|"}),
-        "stable": (P, np.all(np.abs(mu) < 1.0, axis=1), {"long_name": "every |multiplier| < 1"}),
+        "resolved": (P, resolved, {"long_name": "the derivatives are resolved (camdyn.derivatives): multipliers given"}),
+        "stable": (P, resolved & np.all(np.abs(mu) < 1.0, axis=1),
+                   {"long_name": "resolved and every |multiplier| < 1"}),
+        "jacobian_provider": (P, np.array([providers.index(p.derivation.provider) for p in points], dtype=int),
+                              {"long_name": "the provider of dP/dx (index into the attribute providers)"}),
+        "difference_step": (("point", "difference"), np.array([p.derivation.steps for p in points]).reshape(-1, 3),
+                            {"long_name": "central-difference steps in alpha (rad), alpha_dot (rad/s) and the "
+                                          "parameter (its unit); NaN: not by differences"}),
         "max_gap": (P, np.array([p.max_gap for p in points]),
                     {"units": "m", "long_name": "largest gap psi_i over the orbit (Eq. 6); < 0: deflection, "
                                                 "the follower never leaves the cam"}),
-        "branch": (P, np.repeat(np.arange(len(branches)), counts), {"long_name": "branch index"}),
+        "point_branch": (P, np.repeat(np.arange(len(branches)), counts), {"long_name": "the branch of the point"}),
         "periods": (P, np.repeat([b.periods for b in branches], counts),
                     {"long_name": "period n of the orbit, in cam periods"}),
         "mode": (P, np.array([p.mode for p in points], dtype=int),
@@ -835,7 +917,7 @@ def _event_variables(problem: Problem, branches: list, events: list, unit: str, 
         "event_lambda": (E, np.array([e.lam for e in events]), {"units": unit, "long_name": problem.parameter}),
         "event_alpha": (E, np.array([e.x[0] for e in events]), {"units": "rad"}),
         "event_alpha_dot": (E, np.array([e.x[1] for e in events]), {"units": "rad/s"}),
-        "event_branch": (E, np.array([e.branch for e in events], dtype=int), {"long_name": "branch index"}),
+        "event_branch": (E, np.array([e.branch for e in events], dtype=int), {"long_name": "the branch of the event"}),
         "event_point": (E, np.array([offsets[e.branch] + e.point for e in events], dtype=int),
                         {"long_name": "index of the point just before the event"}),
         "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),

@@ -5,8 +5,9 @@ P_n (:class:`camdyn.section_map.StroboscopicMap`): P_n(x) - x = 0.  :func:`perio
 finds one by Newton's method from a warm start (the state at the section after a short
 simulation), with a backtracking line search; the monodromy matrix M = dP_n/dx at the fixed
 point comes from a Jacobian provider (central finite differences by default,
-:func:`camdyn.section_map.finite_differences`, whose entries carry ~rtol^(2/3) of the motion's
-scale; or the variational equations with saltation matrices, ``jacobian=camdyn.tangent.variational``,
+:func:`camdyn.derivatives.finite_differences`, whose entries carry ~rtol^(2/3) of the motion's
+scale, and which are only taken across perturbed runs that make the base run's switches, else
+shrunk, else replaced by the variational provider, else reported unresolved: :mod:`camdyn.derivatives`; or the variational equations with saltation matrices, ``jacobian=camdyn.tangent.variational``,
 exact to the integration's tolerance and cheaper, but not for damping C and E, whose impact
 laws have an unbounded Jacobian at first contact: see :mod:`camdyn.tangent`), and its eigenvalues are the Floquet multipliers: the orbit is
 asymptotically stable when every multiplier has modulus < 1.
@@ -35,7 +36,8 @@ from .outcome import ActionableOutcome
 from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences
+from .derivatives import finite_differences
+from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, StroboscopicMap, derivative_at
 
 #: samples of the warm-up's last revolution, for the size of the motion (the residual's scale)
 SCALE_SAMPLES = 64
@@ -62,6 +64,11 @@ class OrbitOutcome(ActionableOutcome):
                 "a continuation method is needed")
     MODE_CHANGED = ("the map ends in another mode than it starts in at the fixed point: the section "
                     "is on a switching surface; choose another phase")
+    MULTIPLIERS_UNRESOLVED = ("P_n(x) = x to the stated tolerance, but no Jacobian provider resolved dP_n/dx there "
+                              "(the message says why: perturbed runs cross other surfaces than the orbit at every "
+                              "step above the noise floor, and the variational provider failed or the scene has "
+                              "none): the orbit's state is given, its multipliers are not; tighten rtol (a lower "
+                              "floor) or use jacobian=camdyn.tangent.variational where the scene allows it")
 
 
 @dataclass(frozen=True)
@@ -77,7 +84,10 @@ class PeriodicOrbit:
     ``scale``: s; ``iterations``: Newton steps taken; ``outcome`` and ``message``: how it ended;
     ``map_evaluations`` (runs of P_n outside the provider) and ``jacobian_evaluations`` (provider
     calls: 5 runs each by finite differences, one run and its tangent dynamics by the variational
-    provider) give the cost.
+    provider) give the cost; ``jacobian_provider`` names the provider that gave ``monodromy``
+    (``"finite_differences"``, ``"variational"``, a caller's), ``difference_steps`` its
+    central-difference steps (rad, rad/s; NaN when not by differences) and ``jacobian_note`` what
+    happened on the way (a fallback, or why it is unresolved).
     """
 
     state: np.ndarray
@@ -95,6 +105,9 @@ class PeriodicOrbit:
     map_evaluations: int = 0
     jacobian_evaluations: int = 0
     mode_index: int = -1         # ``mode`` as an index of MODES (-1: no orbit, mode "")
+    jacobian_provider: str = ""
+    difference_steps: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
+    jacobian_note: str = ""
 
     @property
     def ok(self) -> bool:
@@ -170,11 +183,11 @@ def _line_search(section_map, x, dx, r0, scale):
 
 
 class NewtonResult(NamedTuple):
-    """What :func:`newton` returns: the last iterate, dP/dx there, the scaled residual, the steps
-    taken, the outcome, and the cost (line-search map runs, provider calls)."""
+    """What :func:`newton` returns: the last iterate, the provider's derivative there, the scaled
+    residual, the steps taken, the outcome, and the cost (line-search map runs, provider calls)."""
 
     x: np.ndarray               # the last iterate
-    jacobian: np.ndarray | None  # dP/dx there (None when the provider failed)
+    derivative: MapDerivative | None  # P and dP/dx there, and how (None when the provider failed)
     residual: float
     iterations: int
     outcome: OrbitOutcome
@@ -182,37 +195,46 @@ class NewtonResult(NamedTuple):
     jacobian_evaluations: int   # provider calls (each also gives P)
     failure: str = ""           # with RUN_FAILED: why the run failed (the MapFailure's message)
 
+    @property
+    def jacobian(self) -> np.ndarray | None:
+        """dP/dx at the last iterate (None when the provider failed)."""
+        return None if self.derivative is None else self.derivative.jacobian
+
 
 def newton(section_map: StroboscopicMap, jacobian, x0, scale,
            settings: ShootingSettings = ShootingSettings()) -> NewtonResult:
     """Newton's method on P(x) - x = 0 from x0, with the line search of :func:`_line_search`.
-    ``jacobian`` is a provider x -> (P(x), dP/dx)."""
-    x, J, maps, calls = np.asarray(x0, dtype=float), None, 0, 0
+    ``jacobian`` is a provider (:func:`camdyn.section_map.derivative_at`); an unresolved
+    derivative still gives Newton's direction (:attr:`OrbitOutcome.MULTIPLIERS_UNRESOLVED` is
+    decided from the last one, in :func:`periodic_orbit`)."""
+    x, d, maps, calls = np.asarray(x0, dtype=float), None, 0, 0
     try:
         calls += 1
-        Px, J = jacobian(x)
+        d = derivative_at(jacobian, x)
     except MapFailure as failure:
         return NewtonResult(x, None, math.inf, 0, OrbitOutcome.RUN_FAILED, maps, calls, str(failure))
-    r = _residual(Px - x, scale)
+    r = _residual(d.value - x, scale)
     for it in range(settings.max_iterations + 1):
         if r <= settings.tol:
-            return NewtonResult(x, J, r, it, OrbitOutcome.CONVERGED, maps, calls)
+            return NewtonResult(x, d, r, it, OrbitOutcome.CONVERGED, maps, calls)
         if it == settings.max_iterations:
             break
-        dx = _newton_step(J, Px - x, scale)
+        if not np.all(np.isfinite(d.jacobian)):
+            return NewtonResult(x, d, r, it, OrbitOutcome.RUN_FAILED, maps, calls, f"no Newton direction: {d.note}")
+        dx = _newton_step(d.jacobian, d.value - x, scale)
         if dx is None:
-            return NewtonResult(x, J, r, it, OrbitOutcome.SINGULAR, maps, calls)
+            return NewtonResult(x, d, r, it, OrbitOutcome.SINGULAR, maps, calls)
         trial, _, r_new, n = _line_search(section_map, x, dx, r, scale)
         maps += n
         if trial is None:
-            return NewtonResult(x, J, r, it, OrbitOutcome.NEWTON_STALLED, maps, calls)
+            return NewtonResult(x, d, r, it, OrbitOutcome.NEWTON_STALLED, maps, calls)
         try:
             calls += 1
-            Px, J = jacobian(trial)
+            d = derivative_at(jacobian, trial)
         except MapFailure as failure:
             return NewtonResult(trial, None, r_new, it + 1, OrbitOutcome.RUN_FAILED, maps, calls, str(failure))
-        x, r = trial, _residual(Px - trial, scale)
-    return NewtonResult(x, J, r, settings.max_iterations, OrbitOutcome.MAX_ITERATIONS, maps, calls)
+        x, r = trial, _residual(d.value - trial, scale)
+    return NewtonResult(x, d, r, settings.max_iterations, OrbitOutcome.MAX_ITERATIONS, maps, calls)
 
 
 def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, speed_rpm: float | None = None,
@@ -257,22 +279,42 @@ def _failed(model, x, periods, phase, message) -> PeriodicOrbit:
 
 
 def _orbit(section_map: StroboscopicMap, found: NewtonResult, scale) -> PeriodicOrbit:
-    """The result of a Newton search: multipliers and verdict when it converged in one mode."""
-    outcome, message = found.outcome, found.outcome.message
-    if found.failure:
-        message = f"{message}: {found.failure}"
-    if outcome is OrbitOutcome.CONVERGED:
-        end = section_map.evaluate(found.x).end_mode
-        if end != section_map.mode:
-            modes = section_map.model.kernels.MODES
-            outcome = OrbitOutcome.MODE_CHANGED
-            message = f"{outcome.message} (starts in {modes[section_map.mode]!r}, ends in {modes[end]!r})"
+    """The result of a Newton search: multipliers and verdict when it converged in one mode with
+    a resolved derivative."""
+    outcome, message = _verdict(section_map, found)
+    d = found.derivative
     multipliers, stable = np.empty(0, dtype=complex), None
-    if outcome is OrbitOutcome.CONVERGED and np.all(np.isfinite(found.jacobian)):
-        multipliers = np.linalg.eigvals(found.jacobian).astype(complex)
-        multipliers = multipliers[np.argsort(-np.abs(multipliers))]
+    if outcome is OrbitOutcome.CONVERGED and np.all(np.isfinite(d.jacobian)):
+        multipliers = sorted_multipliers(d.jacobian)
         stable = bool(np.max(np.abs(multipliers)) < 1.0)
+    provider = (d.provider, d.steps.copy(), d.note) if d is not None else ("", np.full(2, np.nan), "")
     return PeriodicOrbit(found.x.copy(), section_map.model.kernels.MODES[section_map.mode], section_map.periods,
                          section_map.phase, multipliers, stable, found.residual, found.iterations, outcome, message,
                          found.jacobian, np.asarray(scale, dtype=float).copy(),
-                         found.map_evaluations + 1, found.jacobian_evaluations, section_map.mode)
+                         found.map_evaluations + 1, found.jacobian_evaluations, section_map.mode, *provider)
+
+
+def _verdict(section_map: StroboscopicMap, found: NewtonResult) -> tuple[OrbitOutcome, str]:
+    """How the search ended: Newton's outcome, made MODE_CHANGED when the converged orbit ends in
+    another mode, or MULTIPLIERS_UNRESOLVED when its derivative is not resolved."""
+    outcome, message = found.outcome, found.outcome.message
+    if found.failure:
+        message = f"{message}: {found.failure}"
+    if outcome is not OrbitOutcome.CONVERGED:
+        return outcome, message
+    end = section_map.evaluate(found.x).end_mode
+    if end != section_map.mode:
+        modes = section_map.model.kernels.MODES
+        outcome = OrbitOutcome.MODE_CHANGED
+        return outcome, f"{outcome.message} (starts in {modes[section_map.mode]!r}, ends in {modes[end]!r})"
+    if not found.derivative.resolved:
+        outcome = OrbitOutcome.MULTIPLIERS_UNRESOLVED
+        return outcome, f"{outcome.message}: {found.derivative.note}"
+    return outcome, message
+
+
+def sorted_multipliers(J: np.ndarray) -> np.ndarray:
+    """The eigenvalues of a monodromy matrix J, complex, by decreasing modulus: the Floquet
+    multipliers as every result reports them."""
+    mu = np.linalg.eigvals(J).astype(complex)
+    return mu[np.argsort(-np.abs(mu))]

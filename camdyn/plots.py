@@ -455,13 +455,15 @@ def branches(ds, *, diagram=None, contact_loss_rpm: float | None = None, ax=None
         lam, stable = ds["lambda"].values, ds["stable"].values.astype(bool)
         alphas = ds["alpha_revolution"].values / scale
         colours = ["k", "#2e75b6", "#548235", "#7030a0"]
-        for b in np.unique(ds["branch"].values):
-            idx = np.flatnonzero(ds["branch"].values == b)
+        for b in ds["branch"].values:
+            idx = np.flatnonzero(ds["point_branch"].values == b)
             n = int(ds["periods"].values[idx[0]])
             colour = colours[min(n.bit_length() - 1, len(colours) - 1)]
+            x, y = _from_origin(ds, int(b), lam[idx], alphas[idx, :n], scale)
+            start = x.size - idx.size                     # 1: the branch is drawn from its period doubling
             for i, j, ok in stability_runs(stable[idx]):
-                rows = idx[i:j + 1]
-                ax.plot(lam[rows], alphas[rows, :n], color=colour, lw=1.0, ls="-" if ok else "--")
+                rows = slice(i + start if i else 0, j + start + 1)
+                ax.plot(x[rows], y[rows], color=colour, lw=1.0, ls="-" if ok else "--")
             ax.plot([], [], color=colour, lw=1.0, ls="-", label=f"period {n} T (dashed: unstable)")
         for k, kind in enumerate(kinds):
             sel = ds["event_kind"].values == k
@@ -476,6 +478,19 @@ def branches(ds, *, diagram=None, contact_loss_rpm: float | None = None, ax=None
         if title:
             ax.set_title(title)
     return fig
+
+
+def _from_origin(ds, branch: int, lam: np.ndarray, alphas: np.ndarray, scale: float):
+    """A branch's parameter values and sections, preceded by the event it was switched to at
+    (``branch_origin``: the period doubling, where the doubled orbit's n sections are the parent
+    orbit's, repeated)."""
+    origin = int(ds["branch_origin"].values[branch]) if "branch_origin" in ds else -1
+    if origin < 0:
+        return lam, alphas
+    parent = int(ds["branch_periods"].values[int(ds["branch_parent"].values[branch])])
+    at = ds["event_alpha_revolution"].values[origin, :parent] / scale
+    first = np.tile(at, alphas.shape[1] // parent + 1)[:alphas.shape[1]]
+    return np.concatenate([[ds["event_lambda"].values[origin]], lam]), np.vstack([first, alphas])
 
 
 def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_k: bool = True, ax=None,

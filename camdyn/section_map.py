@@ -13,18 +13,17 @@ run started without a mode).  A given mode is refused for a state outside its do
 a surface the mode watches, by :func:`camdyn.engine.rules.across`): the engine would integrate
 the mode's law where it does not hold.
 
-A *Jacobian provider* is any callable ``x -> (P(x), dP/dx)``; :func:`finite_differences`
-makes one by central differences of the map; :func:`camdyn.tangent.variational` one by the
-variational equations with saltation matrices, without change to the shooting
-(:mod:`camdyn.orbits`).  A caller that has just run the map at x (the continuation's corrector)
-tells the provider P(x) through :func:`jacobian_at`, so that the finite differences do not run
-it again only to return it.
+A *Jacobian provider* gives P_n(x) and dP_n/dx at x as a :class:`MapDerivative`, which says
+how it was obtained and whether it is resolved: :func:`camdyn.derivatives.finite_differences`
+by central differences of the map (under the rule of :mod:`camdyn.derivatives`),
+:func:`camdyn.tangent.variational` by the variational equations with saltation matrices.  A
+caller that has just run the map at x (the continuation's corrector) passes that
+:class:`MapValue` to :func:`derivative_at`, so that the finite differences do not run it again.
 """
 from __future__ import annotations
 
-import inspect
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -58,12 +57,14 @@ class MapFailure(CamdynError):
 @dataclass(frozen=True)
 class MapValue:
     """One evaluation of P_n: the state after n periods, the modes at the start and the end,
-    and the engine's step statistics."""
+    the engine's step count, and the hybrid path the run took: the index of each transition of
+    the automaton it made, in order (the rule of :mod:`camdyn.derivatives` compares them)."""
 
     state: np.ndarray
     start_mode: int
     end_mode: int
     steps: int
+    transitions: tuple = ()
 
 
 class StroboscopicMap:
@@ -152,91 +153,49 @@ class StroboscopicMap:
         if not tr.outcome.ok or tr.t.size != t_eval.size:
             raise MapFailure(f"the run from {tuple(map(float, x))} over {self.periods} period(s) failed: "
                              f"{tr.outcome.message}", tr.outcome)
-        return MapValue(tr.y[:2, -1].copy(), m, int(tr.end_mode), int(tr.stats["steps"])), tr
+        return MapValue(tr.y[:2, -1].copy(), m, int(tr.end_mode), int(tr.stats["steps"]),
+                        tuple(tr.switches.records["transition"].tolist())), tr
 
     def __call__(self, x) -> np.ndarray:
         """P_n(x), the state after n periods."""
         return self.evaluate(x).state
 
 
+@dataclass(frozen=True)
+class MapDerivative:
+    """P_n(x) and dP_n/dx at x, and how they were obtained.
+
+    ``provider``: ``"finite_differences"``, ``"variational"`` or a caller's provider's name;
+    ``steps``: the central-difference step of each column (rad, rad/s; NaN for a derivative not
+    taken by differences); ``resolved``: False when the finite differences could not be resolved
+    and no fallback could (``jacobian`` is then a secant across the largest step that ran: a
+    direction for Newton's method, not for multipliers); ``note``: why, or which fallback was taken."""
+
+    value: np.ndarray
+    jacobian: np.ndarray
+    provider: str
+    steps: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
+    resolved: bool = True
+    note: str = ""
+
+
 class JacobianProvider(Protocol):
-    """The interface of a Jacobian provider: ``x -> (P(x), dP/dx at x)``, raising
-    :class:`MapFailure` where P cannot be evaluated (finite differences, or later the
-    variational equations with saltation matrices).
+    """What a provider is: ``derivative(x, base)`` gives the :class:`MapDerivative` at x; ``base``
+    is the map's value at x when the caller has run it (a provider may then skip that run).  A
+    plain callable ``x -> (P(x), dP/dx)`` is accepted too (:func:`derivative_at`)."""
 
-    A provider may also take the keyword ``P``: P(x) when the caller already has it (from a
-    run of the map at x it made anyway); the provider then returns that P and need not run the
-    map for it.  Callers pass it through :func:`jacobian_at`, which calls a provider that does
-    not take it with x alone: a provider written for ``x`` alone keeps working."""
-
-    def __call__(self, x: np.ndarray, P: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]: ...
+    def derivative(self, x: np.ndarray, base: MapValue | None = None) -> MapDerivative: ...
 
 
-def jacobian_at(provider, x, P=None) -> tuple[np.ndarray, np.ndarray]:
-    """``provider(x)``, told the map's value ``P`` at x when it is known and the provider takes
-    the keyword ``P`` (:class:`JacobianProvider`): :func:`finite_differences` then spares its
-    base run (4 runs instead of 5); the variational provider does not take it, as its one run
-    gives the switches it needs besides P."""
-    if P is not None and "P" in inspect.signature(provider).parameters:
-        return provider(x, P=P)
-    return provider(x)
-
-
-def finite_difference_steps(x, scale, rtol: float) -> np.ndarray:
-    """Central-difference steps ``h_j = rtol^(1/3) * max(|x_j|, scale_j)``.
-
-    The map's value carries an error of the order of the solver's tolerance, rtol times the
-    state's scale, that is not smooth in x (the accepted steps change with x); a central
-    difference with step h has truncation error O(h^2) and this noise divided by h, balanced
-    at h ~ rtol^(1/3) in units of the scale (Dennis & Schnabel 1983, Sec. 5.6; Press et al.,
-    Numerical Recipes, Sec. 5.7): a relative error of about rtol^(2/3) in the Jacobian.
-    """
-    x, scale = np.asarray(x, dtype=float), np.asarray(scale, dtype=float)
-    return float(rtol) ** (1.0 / 3.0) * np.maximum(np.abs(x), scale)
-
-
-def finite_differences(section_map: StroboscopicMap, scale, step_factor: float = 1.0) -> JacobianProvider:
-    """A Jacobian provider by central differences of ``section_map``.
-
-    ``scale`` (per state component: rad, rad/s) is the size of the motion, below which the
-    step does not shrink (see :func:`finite_difference_steps`); ``step_factor`` multiplies every
-    step (to check the Jacobian against a second step size).  Each call costs 2 n + 1 = 5 runs,
-    4 when told P(x) (the keyword ``P``, :func:`jacobian_at`): the columns are central
-    differences, which do not use the base run.
-    """
-    scale = np.asarray(scale, dtype=float)
-    if scale.shape != (2,) or not np.all(np.isfinite(scale)) or not np.all(scale > 0):
-        raise ParameterError("scale", scale, "two positive numbers (rad, rad/s)")
-    if not (isinstance(step_factor, (int, float)) and 0 < step_factor < 1e6):
-        raise ParameterError("step_factor", step_factor, "0 < step_factor < 1e6")
-
-    def provider(x, P=None):
-        x = np.asarray(x, dtype=float)
-        base = section_map(x) if P is None else np.array(P, dtype=float)
-        h = step_factor * finite_difference_steps(x, scale, section_map.options.rtol)
-        J = np.empty((2, 2))
-        for j in range(2):
-            J[:, j] = _column(section_map, x, j, h[j])
-        return base, J
-
-    return provider
-
-
-#: a step whose perturbed states leave the mode's domain is divided by DOMAIN_SHRINK, at most
-#: DOMAIN_TRIES times (a stiff contact: the deflection is far smaller than the motion)
-DOMAIN_SHRINK, DOMAIN_TRIES = 4.0, 6
-
-
-def _column(section_map: StroboscopicMap, x: np.ndarray, j: int, h: float) -> np.ndarray:
-    """(P(x + h e_j) - P(x - h e_j)) / 2h, the step shrunk while x +- h e_j is outside the mode."""
-    for _ in range(DOMAIN_TRIES):
-        e = np.zeros(2)
-        e[j] = h
-        try:
-            return (section_map(x + e) - section_map(x - e)) / (2.0 * h)
-        except MapFailure as failure:
-            if failure.outcome is not None:
-                raise
-            h /= DOMAIN_SHRINK
-    raise MapFailure(f"no finite-difference step in component {j} keeps the state in its mode "
-                     f"(down to {h * DOMAIN_SHRINK:.3g})")
+def derivative_at(provider, x, base: MapValue | None = None) -> MapDerivative:
+    """The derivative of ``provider`` at x.  A provider with a ``derivative`` method is asked for
+    it (told ``base``); a plain callable ``x -> (P, J)`` is called with x and its result taken as
+    given, its name as ``provider`` and a note that nothing checked it."""
+    x = np.asarray(x, dtype=float)
+    method = getattr(provider, "derivative", None)
+    if method is not None:
+        return method(x, base)
+    P, J = provider(x)
+    name = getattr(provider, "__name__", type(provider).__name__)
+    return MapDerivative(np.asarray(P, dtype=float), np.asarray(J, dtype=float), name,
+                         note="a provider of the caller's: its derivative is taken as given")

@@ -21,8 +21,9 @@ Limitation: damping C and E's impact laws, c proportional to abs(psi_i)^(1/4) (E
 have a Jacobian that grows without bound as psi_i -> 0 at first contact (an integrable
 singularity: Phi stays finite, but grows like (t - t_a)^(1/4)); the step-size control of an
 explicit method cannot pass it, and :func:`tangent` raises :class:`TangentFailure` there.  Use
-finite differences (:func:`camdyn.section_map.finite_differences`) for those scenes.  This is
-why the finite differences stay :func:`camdyn.periodic_orbit`'s default provider.
+finite differences (:func:`camdyn.derivatives.finite_differences`) for those scenes.  This is
+why the finite differences stay :func:`camdyn.periodic_orbit`'s default provider (which falls
+back to this one where its differences cannot be resolved: :mod:`camdyn.derivatives`).
 """
 from __future__ import annotations
 
@@ -44,9 +45,9 @@ from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_P
                                  integrate_segment)
 from .errors import CamdynError, ParameterError
 from .model import Model
-from .section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap
+from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue, StroboscopicMap
 
-__all__ = ["tangent", "variational", "TangentResult", "TangentSettings", "TangentFailure"]
+__all__ = ["tangent", "variational", "Variational", "TangentResult", "TangentSettings", "TangentFailure"]
 
 #: a segment whose integration fails on an unbounded Jacobian at its end (damping B's impact law,
 #: c = beta k_lambda abs(psi_i), as psi_i -> 0 at separation: the step size fell to 7e-15 s short
@@ -153,7 +154,7 @@ def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: Tange
     if not ok or not np.all(np.isfinite(y)):
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
                              f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
-                             "first contact: use camdyn.section_map.finite_differences)")
+                             "first contact: use camdyn.derivatives.finite_differences)")
     return y[[AUG_ALPHA, AUG_ALPHA_DOT]], y[AUG_PHI].reshape(2, 2), float(y[AUG_DIVERGENCE])
 
 
@@ -266,20 +267,36 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
                          flow_x, np.zeros(2) if growth is None else growth)
 
 
-def variational(section_map: StroboscopicMap, scale=None, settings: TangentSettings = TangentSettings()):
-    """A Jacobian provider x -> (P_n(x), dP_n/dx) by the tangent dynamics (one engine run and
-    one augmented integration per call, against 5 runs by finite differences).  ``scale`` is
-    accepted for the signature of :func:`camdyn.orbits.periodic_orbit`'s ``jacobian`` and not
-    used.  Raises :class:`~camdyn.section_map.MapFailure` where the map cannot be evaluated."""
+class Variational:
+    """The Jacobian provider by the tangent dynamics (:func:`tangent`): one engine run and one
+    augmented integration per call, against 4-5 runs by finite differences.  Raises
+    :class:`~camdyn.section_map.MapFailure` where the map cannot be evaluated or the tangent
+    dynamics cannot be integrated (damping C and E's impact laws, a grazing switch)."""
 
-    def provider(x):
-        x = np.asarray(x, dtype=float)
-        m = section_map.start_mode(x)
+    name = "variational"
+
+    def __init__(self, section_map: StroboscopicMap, settings: TangentSettings = TangentSettings()):
+        self.section_map, self.settings = section_map, settings
+
+    def __call__(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """(P_n(x), dP_n/dx), the plain protocol."""
+        d = self.derivative(x)
+        return d.value, d.jacobian
+
+    def derivative(self, x, base: MapValue | None = None) -> MapDerivative:
+        """The :class:`~camdyn.section_map.MapDerivative` at x (``base`` is not used: the one run
+        gives the switches the tangent dynamics need besides P_n(x))."""
+        sm, x = self.section_map, np.asarray(x, dtype=float)
         try:
-            r = tangent(section_map.model, section_map.t_span, x, mode=m, options=section_map.options,
-                        backend=section_map.backend, settings=settings)
+            r = tangent(sm.model, sm.t_span, x, mode=sm.start_mode(x), options=sm.options, backend=sm.backend,
+                        settings=self.settings)
         except TangentFailure as failure:
             raise MapFailure(str(failure), failure.outcome) from failure
-        return r.state, r.phi
+        return MapDerivative(r.state, r.phi, self.name)
 
-    return provider
+
+def variational(section_map: StroboscopicMap, scale=None, settings: TangentSettings = TangentSettings()) -> Variational:
+    """The variational Jacobian provider of ``section_map`` (:class:`Variational`).  ``scale`` is
+    accepted for the signature of a provider factory, ``jacobian(map, scale)`` (as
+    :func:`camdyn.periodic_orbit` takes it), and not used."""
+    return Variational(section_map, settings)

@@ -21,7 +21,8 @@ import camdyn
 from camdyn.errors import ParameterError
 from camdyn.model import Model
 from camdyn.orbits import OrbitOutcome, ShootingSettings, newton, periodic_orbit
-from camdyn.section_map import DEFAULT_OPTIONS, MapFailure, StroboscopicMap, finite_differences, jacobian_at
+from camdyn.derivatives import finite_differences
+from camdyn.section_map import DEFAULT_OPTIONS, MapFailure, MapValue, StroboscopicMap, derivative_at
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -233,6 +234,9 @@ class FakeMap:
     def __call__(self, x):
         return np.asarray(self.fn(np.asarray(x, dtype=float)), dtype=float)
 
+    def evaluate(self, x):
+        return MapValue(self(x), 0, 0, 0)
+
 
 A = np.array([[0.5, 0.3], [-0.2, 0.1]])
 X_STAR = np.array([0.2, -1.0])
@@ -250,21 +254,28 @@ def test_central_differences_are_exact_on_a_quadratic_map():
 
 
 def test_a_provider_told_p_spares_its_base_run_and_gives_the_same_jacobian():
-    """finite_differences' provider told P(x) (the keyword P, through jacobian_at) returns that P
-    and the same J to the bit (the columns are central differences, which never read the base
-    run) with 4 runs of the map instead of 5; a provider of x alone is called with x alone."""
+    """finite_differences' provider told the map's value at x (derivative_at's base) returns
+    that P and the same J to the bit (the columns are central differences, which never read the
+    base run's state) with 8 runs of the map instead of 9; a plain callable x -> (P, J) is called
+    with x alone and named as the provider."""
     calls = []
     P = FakeMap(lambda x: calls.append(1) or _quadratic(x))
     provider = finite_differences(P, np.ones(2))
     x = X_STAR + [0.1, -0.2]
     base, J = provider(x)
-    assert len(calls) == 5
-    known = np.array([7.0, 8.0])                       # not P(x): shows that the provider returns what it is told
-    told, J_told = jacobian_at(provider, x, known)
-    assert len(calls) == 5 + 4
-    assert np.array_equal(told, known) and np.array_equal(J_told, J)
+    assert len(calls) == 9                                # the base run, and 2 steps x 2 runs per column
+    known = MapValue(np.array([7.0, 8.0]), 0, 0, 0)      # not P(x): shows that the provider returns what it is told
+    told = derivative_at(provider, x, known)
+    assert len(calls) == 9 + 8
+    assert np.array_equal(told.value, known.state) and np.array_equal(told.jacobian, J)
+    assert told.provider == "finite_differences" and told.resolved and np.all(told.steps > 0)
     seen = []
-    assert jacobian_at(lambda x: seen.append(x) or (base, J), x, known)[0] is base and len(seen) == 1
+
+    def mine(x):
+        return seen.append(x) or (base, J)
+    plain = derivative_at(mine, x, known)
+    assert plain.value is not known.state and np.array_equal(plain.value, base) and len(seen) == 1
+    assert plain.provider == "mine" and "taken as given" in plain.note
 
 
 def test_newton_finds_a_known_fixed_point_and_its_multipliers():

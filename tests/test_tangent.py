@@ -17,7 +17,8 @@ from camdyn.engine.driver import integrate
 from camdyn.engine.saltation import saltation_matrix, switch_saltation
 from camdyn.model import Model
 from camdyn.orbits import periodic_orbit
-from camdyn.section_map import StroboscopicMap, finite_differences
+from camdyn.derivatives import finite_differences
+from camdyn.section_map import StroboscopicMap
 from camdyn.tangent import TangentSettings, tangent, variational
 
 RIG = camdyn.example_rig()

@@ -67,7 +67,7 @@ def branch(leg: BranchLeg, rig=None) -> dict:
         rp.append(float(np.ptp(r.alpha_r)) if r.ok else None)
     outcomes = ds.attrs["outcomes"].split()
     return {"name": leg.name, "lambda": ds["lambda"].values.tolist(), "stable": ds["stable"].values.tolist(),
-            "alpha_rp": rp, "max_gap": ds["max_gap"].values.tolist(), "branch": ds["branch"].values.tolist(),
+            "alpha_rp": rp, "max_gap": ds["max_gap"].values.tolist(), "branch": ds["point_branch"].values.tolist(),
             "periods": ds["periods"].values.tolist(),
             "events": [{"kind": k, "speed_rpm": lam, "branch": b} for k, lam, b, _ in events_table(ds)],
             "end": outcomes[int(ds["branch_outcome"].values[0])]}

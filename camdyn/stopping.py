@@ -4,9 +4,11 @@ A run with ``stop=StopWhenPeriodic(...)`` (:func:`camdyn.simulate`, :func:`camdy
 on by default in :func:`camdyn.sweep.bifurcation`) is integrated in pieces of
 ``check_every`` revolutions (:func:`camdyn.pieces.integrate_in_pieces`); after each piece the
 once-per-revolution section (the samples at t = t_start + j T) is checked, and the run stops
-when its last ``revolutions`` section values repeat with a period p <= ``max_period``
-revolutions: ``abs(alpha_j - alpha_{j-p}) <= tol (rtol max abs(alpha) + atol)``, rtol and atol the run's
-own, and the same mode, for each of them.
+when its last ``revolutions`` section values form a cycle of period p <= ``max_period``
+revolutions: the values of each phase (mod p) lie within ``tol (rtol max abs(alpha) + atol)`` of
+each other (rtol and atol the run's own) in one mode, and no shorter cycle is still settling into
+it (:meth:`StopWhenPeriodic.period_of`): p is the minimal period of the converged cycle within
+that threshold.
 The Result is then completed to the requested length by repeating its last p revolutions
 (samples, outputs, regimes and switches shifted by whole multiples of p T; the cam angle and the
 energy ledger's works grow by their increment over the cycle), so that every measure sees a
@@ -80,24 +82,76 @@ class StopWhenPeriodic:
         return self.tol * (rtol * float(np.max(np.abs(section))) + atol)
 
     def period_of(self, section: np.ndarray, modes: np.ndarray, rtol: float, atol: float) -> int:
-        """The smallest p <= max_period with which the last ``revolutions`` section values repeat
-        (alpha to :meth:`threshold`, the mode exactly); 0 when none does."""
+        """The period the run has converged to: the smallest p <= max_period such that
+
+        * the last ``revolutions`` section values form a cycle of period p: every value is within
+          :meth:`threshold` of every other value of its phase (mod p), with the same mode; and
+        * no shorter cycle is still settling into it (:func:`settling`): near a period doubling
+          the section alternates about a period-q orbit with an amplitude that shrinks (below
+          the doubling) or grows (above it) by a multiplier near -1; over a window that
+          alternation can be within the threshold of a 2q-cycle before the motion has
+          converged to either.
+
+        0 when there is none (the run has not converged)."""
         k = self.revolutions
-        if section.size < k + 1:
+        if section.size < k:
             return 0
-        # largest[j]: max |alpha| over the last j + 1 values, so that the threshold of the last k + p
-        # values is read, not recomputed, for each p; the last pair rules most p out before the arrays
-        largest = np.maximum.accumulate(np.abs(section[-(k + self.max_period):])[::-1])
+        tail, tail_modes = section[-k:], modes[-k:]
+        limit = self.threshold(tail, rtol, atol)
         for p in range(1, self.max_period + 1):
-            if section.size < k + p:
-                return 0
-            limit = self.tol * (rtol * float(largest[k + p - 1]) + atol)
-            if modes[-1] != modes[-1 - p] or abs(section[-1] - section[-1 - p]) > limit:
-                continue
-            a, m = section[-k - p:], modes[-k - p:]
-            if np.all(np.abs(a[p:] - a[:-p]) <= limit) and np.all(m[p:] == m[:-p]):
+            if _cycle(tail, tail_modes, p, limit) and not settling(section, p, limit, max(SETTLE_BLOCKS, -(-k // p))):
                 return p
         return 0
+
+
+#: a cycle of period p counts only when, over at least SETTLE_BLOCKS blocks of p values (and the
+#: whole window), the amplitude of every shorter cycle q = p / r within it (r a prime factor of p)
+#: is stationary: it changes by no more than the threshold and is not strictly monotone.  A
+#: stationary cycle's amplitudes scatter, so a strictly monotone run of them is a transient (by
+#: chance from scatter alone with probability 2 / SETTLE_BLOCKS! = 0.3 %: the stop is then put
+#: off by a check)
+SETTLE_BLOCKS = 6
+
+
+def _cycle(a: np.ndarray, modes: np.ndarray, p: int, limit: float) -> bool:
+    """Whether ``a`` (with ``modes``) is p-periodic to ``limit``: each phase class, counted from the
+    end, spans at most ``limit`` and keeps one mode."""
+    if abs(a[-1] - a[-1 - p]) > limit or modes[-1] != modes[-1 - p]:      # the last pair rules most p out
+        return False
+    for c in range(p):
+        values, kinds = a[-1 - c::-p], modes[-1 - c::-p]
+        if values.max() - values.min() > limit or np.any(kinds != kinds[0]):
+            return False
+    return True
+
+
+def _prime_factors(p: int) -> list[int]:
+    factors, r = [], 2
+    while r * r <= p:
+        while p % r == 0:
+            factors.append(r)
+            p //= r
+        r += 1
+    return sorted(set(factors + ([p] if p > 1 else [])))
+
+
+def settling(section: np.ndarray, p: int, limit: float, blocks: int = SETTLE_BLOCKS) -> bool:
+    """Whether a shorter cycle within a period-p cycle is still settling: for a prime factor r of
+    p and q = p / r, the largest |alpha_j - alpha_(j-q)| in each of the last ``blocks`` blocks of
+    p values changes by more than ``limit`` over them, or strictly decreases or increases (see
+    :data:`SETTLE_BLOCKS`).  True also while the run is too short to tell (fewer than
+    ``blocks`` p + q values)."""
+    for r in _prime_factors(p):
+        q = p // r
+        need = blocks * p + q
+        if section.size < need:
+            return True
+        a = section[-need:]
+        amplitude = np.abs(a[q:] - a[:-q]).reshape(blocks, p).max(axis=1)
+        change = np.diff(amplitude)
+        if amplitude.max() - amplitude.min() > limit or np.all(change < 0) or np.all(change > 0):
+            return True
+    return False
 
 
 class Watch:
@@ -158,4 +212,4 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
                                switches=continued[continued.t <= t_end])
 
 
-__all__ = ["StopWhenPeriodic", "Watch", "per_revolution", "extend"]
+__all__ = ["StopWhenPeriodic", "Watch", "per_revolution", "extend", "settling", "SETTLE_BLOCKS"]

@@ -235,9 +235,10 @@ def variable_attributes(spec: SweepSpec) -> dict[str, dict]:
     out.update({p.name: {"units": _unit(p.unit), "long_name": p.description} for p in PARAMETERS})
     out["revolutions_run"] = {"units": "1", "long_name": "cam revolutions integrated (fewer than requested where "
                                                          "the run stopped once periodic: see stop_period)"}
-    out["stop_period"] = {"units": "1", "long_name": "period (revolutions) of the cycle the run converged to and "
-                                                     "stopped on, repeated to the requested length; 0: not converged, "
-                                                     "run to its end"}
+    out["stop_period"] = {"units": "1", "long_name": "minimal period (revolutions) of the cycle the run converged to "
+                                                     "within the stop threshold, with no shorter cycle still settling "
+                                                     "(camdyn.StopWhenPeriodic.period_of), repeated to the requested "
+                                                     "length; 0: not converged, run to its end"}
     for name, (long_name, units) in getattr(spec.measure, "variables", {}).items():
         out[name] = {"units": units, "long_name": long_name}
     return out

@@ -62,6 +62,39 @@ def test_period_of_finds_the_smallest_period_and_not_a_transient():
     assert stop.period_of(np.ones(40), np.arange(40) % 2, *tols) == 2  # the mode must repeat too
 
 
+def test_a_settling_alternation_is_not_a_doubled_cycle():
+    """Near a period doubling the section alternates about a period-1 orbit with an amplitude that
+    a multiplier near -1 shrinks (below it) or grows toward a 2-cycle (above it).  Over a window
+    such an alternation can be 2-periodic within the threshold while it is not 1-periodic: it is
+    no cycle of period 2 until it has settled (issue 25: stop_period 2 where the orbit is P1)."""
+    stop = camdyn.StopWhenPeriodic(max_period=4, tol=10, revolutions=16)
+    tols = (1e-8, 1e-12)                              # threshold 10 (1e-8 * 1 + 1e-12) ~ 1e-7
+    j = np.arange(60)
+    modes = np.zeros(60, dtype=int)
+    shrinking = 1.0 + 3e-7 * (-0.97) ** j              # lag-2 changes 6 % of 3e-7: within it; lag-1 not
+    assert all(stop.period_of(shrinking[:n], modes[:n], *tols) != 2 for n in range(16, 61))
+    assert stop.period_of(1.0 + 1e-9 * (-0.97) ** j, modes, *tols) == 1     # settled within the threshold
+    growing = 1.0 + 1e-3 * (-1.0) ** j * (1.0 - 0.9 ** j)                  # toward a 2-cycle of amplitude 1e-3
+    assert stop.period_of(growing[:40], modes[:40], *tols) == 0
+    assert stop.period_of(np.concatenate([growing, 1.0 + 1e-3 * (-1.0) ** np.arange(100)]), np.zeros(160, int),
+                          *tols) == 2
+
+
+def test_stop_period_is_the_minimal_period_on_both_sides_of_each_period_doubling():
+    """The example rig's period-1 branch doubles at 1710.2 rev/min and its period-2 branch at
+    1798.8 (tests/test_continuation.py, by continuation): the stopped diagram says period 1 at 1690
+    and 1700, period 2 at 1730 and 1790, where it said 2 and 4 before (issue 25), and its
+    sections are the brute-force run's to the stop threshold over the cycle's remaining transient."""
+    speeds = [1690.0, 1700.0, 1730.0, 1790.0]
+    stopped = S.bifurcation(RIG, SCENE, speeds, revolutions=300, transient_revolutions=200, progress=False)
+    assert stopped["stop_period"].values.tolist() == [1, 1, 2, 2]
+    full = S.bifurcation(RIG, SCENE, speeds, revolutions=300, transient_revolutions=200, progress=False, stop=None)
+    # the threshold is 10 (rtol |alpha| + atol) = 1.4e-9 rad here (rtol 1e-8 and atol 1e-12, simulate's
+    # defaults); the transient left at the stop, threshold / (1 - |mu|), is below 1e-7 at these speeds
+    # (|mu| <= 0.98 by continuation), and the brute force still carries its own scatter
+    np.testing.assert_allclose(stopped["alpha_section"].values, full["alpha_section"].values, rtol=0, atol=1e-7)
+
+
 def test_bad_stop_options_are_refused():
     with pytest.raises(ParameterError, match="revolutions"):
         camdyn.StopWhenPeriodic(max_period=8, revolutions=10)

@@ -104,6 +104,20 @@ class UserMotion:
 CamMotion = ConstantSpeed | Oscillating | UserMotion
 
 
+def periodic_cam(cam, speed_rpm: float | None) -> CamMotion:
+    """:func:`cam_motion` for an analysis that needs a cam period (a periodic orbit, its map, the
+    Lyapunov exponents per revolution): a constant speed must be nonzero, a user's motion must
+    give ``period``."""
+    motion = cam_motion(cam, speed_rpm)
+    if not math.isfinite(motion.period):
+        if isinstance(motion, ConstantSpeed):
+            raise ParameterError("speed_rpm", motion.speed_rpm, "nonzero (rev/min): this analysis works per cam "
+                                 "revolution, and a cam at rest has none", problem="is zero")
+        raise ParameterError("cam", None, "a cam motion with a period (UserMotion(..., period=T))",
+                             problem=f"{motion!r} has no period")
+    return motion
+
+
 def cam_motion(cam, speed_rpm: float | None):
     """The cam motion of a call that takes ``cam`` or ``speed_rpm`` (a constant speed, rev/min):
     exactly one of them, else :class:`~camdyn.errors.ParameterError`."""

@@ -36,11 +36,17 @@ def _series(phi) -> np.ndarray:
     try:
         x = np.asarray(phi, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError("series", type(phi).__name__, "a 1-D sequence of real numbers") from None
+        raise ParameterError("series", None, "a 1-D sequence of real numbers",
+                             problem=f"is a {type(phi).__name__} that is not a sequence of numbers") from None
     if x.ndim != 1 or x.size < MIN_LENGTH:
-        raise ParameterError("series", f"shape {x.shape}", f"a 1-D series of at least {MIN_LENGTH} values")
-    if not np.all(np.isfinite(x)):
-        raise ParameterError("series", "non-finite values", "finite values only (no NaN, no inf)")
+        raise ParameterError("series", None, f"a 1-D series of at least {MIN_LENGTH} values",
+                             problem=f"has shape {x.shape}")
+    bad = np.flatnonzero(~np.isfinite(x))
+    if bad.size:
+        what = "NaN" if np.isnan(x[bad[0]]) else "an infinite value"
+        more = f" (and {bad.size - 1} more non-finite values)" if bad.size > 1 else ""
+        raise ParameterError("series", None, "finite values only (no NaN, no inf)",
+                             problem=f"has {what} at index {bad[0]}{more}")
     return x
 
 

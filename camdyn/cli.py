@@ -56,6 +56,71 @@ class MissingPart(CamdynError):
     """An optional dependency or module is not available (exit code 4)."""
 
 
+# --------------------------------------------------------------------------- API names and flags
+#: names the library's messages use, and the option of a command that sets the same thing (its
+#: dest); a name that is a command's dest itself needs no entry
+API_TO_DEST = {"transient": "transient_revolutions", "warmup_revolutions": "warmup", "frequency_rpm": "oscillating_rpm",
+               "max_corrector": "max_iterations"}
+#: the library's option names without an underscore (other words of a message are left as they are)
+API_WORDS = ("rtol", "atol", "tol")
+#: phrases of the library's advice that name a value, and the option that sets it ({flag}: its flag)
+API_PHRASES = {"jacobian=camdyn.tangent.variational": ("jacobian", "{flag} variational"),
+               "ContinuationSettings.min_step": ("min_arclength_step", "{flag}"),
+               "ContinuationSettings.max_step": ("max_arclength_step", "{flag}"),
+               "ContinuationSettings.max_points": ("max_points", "{flag}"),
+               "friction='tanh'": ("friction", "{flag} tanh"), "follower='dynamic'": ("follower", "{flag} dynamic"), "another start value": ("start", "another {flag}")}
+
+
+def _flags(parser) -> dict[str, str]:
+    """dest -> flag (its longest option string) of a (sub)parser's options."""
+    return {a.dest: max(a.option_strings, key=len) for a in parser._actions if a.option_strings}
+
+
+def _in_flags(text: str, args) -> str:
+    """``text`` (a message of the library) with the names it gives advice about replaced by the
+    command's options that set them (``min_step`` -> ``--min-step``), where it has them."""
+    flags = getattr(args, "flags", {})
+    for phrase, (dest, form) in API_PHRASES.items():
+        if dest in flags:
+            text = text.replace(phrase, form.format(flag=flags[dest]))
+
+    def flag(match):
+        word = match.group(0)
+        if "_" not in word and word not in API_WORDS:
+            return word
+        return flags.get(API_TO_DEST.get(word, word), word)
+    return re.sub(r"(?<![-\w.=])[a-z][a-z0-9]*(?:_[a-zA-Z0-9]+)*(?![\w(=])", flag, text)
+
+
+def _parameter_line(exc, args, dests: dict[str, str] | None = None) -> str | None:
+    """A ParameterError's message with its name as the command's flag (``--transient-revolutions 0
+    is out of range ...``, not ``transient = 0 ...``), or None when the command has no such flag;
+    ``dests``: the option of each name, where it is not its dest (nor in API_TO_DEST)."""
+    flags, dests = getattr(args, "flags", {}), dests or {}
+    flag = flags.get(dests.get(exc.name) or API_TO_DEST.get(exc.name, exc.name))
+    text = " ".join(str(exc).split())
+    if flag is None:
+        return None
+    for prefix in (f"{exc.name} = ", f"{exc.name} "):
+        if text.startswith(prefix):
+            return f"{flag} {text[len(prefix):]}"
+    return None
+
+
+def _built(factory, dests: dict[str, str], args, **kwargs):
+    """``factory(**kwargs)`` (a settings object), its ParameterError told by the command's flag:
+    ``dests`` maps the factory's field names to the options that set them."""
+    from .errors import ParameterError
+
+    try:
+        return factory(**kwargs)
+    except ParameterError as exc:
+        line = _parameter_line(exc, args, dests)
+        if line is None:
+            raise
+        raise UsageError(line) from None
+
+
 # --------------------------------------------------------------------------- helpers
 def _progress_enabled(args) -> bool | None:
     """tqdm's ``disable``: None shows bars only on a terminal; --no-progress hides them."""
@@ -115,7 +180,7 @@ def _parse_values(text: str, name: str) -> list[float]:
                 raise ValueError
             a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
             if n < 1:
-                raise ValueError
+                raise UsageError(f"{name} {text}: the count (the third field) must be at least 1, got {n}")
             if len(parts) == 4:
                 if a <= 0 or b <= 0:
                     raise UsageError(f"{name}: a log range needs positive ends, got {text!r}")
@@ -231,8 +296,10 @@ def _simulate(args) -> _Run:
 
     cam = _cam(args)
     scene = _scene(args, cam.kind)
-    kwargs = dict(sample_rate_Hz=args.sample_rate_Hz, method=args.method, rtol=args.rtol, atol=args.atol,
-                  **_backend_kwargs(args))
+    options = _solver_options(args)
+    kwargs = dict(sample_rate_Hz=args.sample_rate_Hz, method=options.method, rtol=options.rtol, atol=options.atol,
+                  **({"max_step": options.max_step} if math.isfinite(options.max_step) else {}),
+                  **({"events": options.events} if args.max_events != 1_000_000 else {}), **_backend_kwargs(args))
     if args.t_end is not None:
         kwargs["t_end"] = args.t_end
     elif not math.isfinite(cam.period):
@@ -370,7 +437,7 @@ def cmd_simulate(args) -> int:
         plots = _plot_modules()
         _save_figure(plots.overview(result), args.plot)
     if not result.ok:
-        print(f"camdyn: the run stopped early: {result.outcome.message}", file=sys.stderr)
+        print(f"camdyn: the run stopped early: {_in_flags(result.outcome.message, args)}", file=sys.stderr)
         return EXIT_INCOMPLETE
     return EXIT_OK
 
@@ -505,7 +572,7 @@ def cmd_lyapunov(args) -> int:
     cam = _cam(args)
     scene = _scene(args, cam.kind)
     settings = LyapunovSettings(args.revolutions, args.transient_revolutions, args.batches)
-    options = SolverOptions(method=args.method, rtol=args.rtol, atol=args.atol)
+    options = _solver_options(args)
     rig = _rig(args)
     with _busy(f"Lyapunov exponents of {describe_scene(scene)}, {describe_cam(cam)}", args):
         L = lyapunov_exponents(rig, scene, cam, settings=settings, options=options, **_backend_kwargs(args))
@@ -526,7 +593,6 @@ def cmd_lyapunov(args) -> int:
 # --- continue --------------------------------------------------------------------------
 def cmd_continue(args) -> int:
     from .continuation import SPEED, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
-    from .engine.config import SolverOptions
 
     rig, scene = _rig(args), _scene(args)
     if args.param != SPEED and args.speed_rpm is None:
@@ -535,18 +601,25 @@ def cmd_continue(args) -> int:
         raise UsageError("--speed-rpm is for a rig parameter's continuation; the speed itself runs from --start "
                          "to --end")
     _check_outputs(args, "netcdf", "plot")
+    settings = _built(ContinuationSettings, {"step": "arclength_step", "min_step": "min_arclength_step",
+                                             "max_step": "max_arclength_step", "max_corrector": "max_iterations"},
+                      args, step=args.arclength_step, min_step=args.min_arclength_step,
+                      max_step=args.max_arclength_step, max_points=args.max_points, tol=args.tol,
+                      max_corrector=args.max_iterations, switch_depth=args.switch_depth)
     kwargs = dict(speed_rpm=args.speed_rpm, periods=args.periods, phase_fraction=args.phase_fraction,
-                  warmup_revolutions=args.warmup, settings=ContinuationSettings(max_points=args.max_points),
-                  options=SolverOptions(rtol=args.rtol, atol=args.atol))
-    if args.backend:
-        kwargs["backend"] = args.backend
+                  warmup_revolutions=args.warmup, settings=settings, options=_solver_options(args),
+                  **_backend_kwargs(args))
+    if args.jacobian == "variational":
+        from .tangent import variational
+        kwargs["jacobian"] = variational
     with _busy("continuing the branch", args):
         ds = continue_orbit(rig, scene, args.param, args.start, args.end, **kwargs)
     unit = ds.attrs["parameter_units"]
     print(f"continuation of {scene.slug} on rig {rig.name!r} in {args.param} ({unit}): {ds.sizes['point']} orbits "
           f"on {ds.sizes['branch']} branch(es)")
     for i in range(ds.sizes["branch"]):
-        print(f"  branch {i} (period {int(ds['branch_periods'][i])} T): {ds.attrs[f'branch_{i}_message']}")
+        print(f"  branch {i} (period {int(ds['branch_periods'][i])} T): "
+              f"{_in_flags(ds.attrs[f'branch_{i}_message'], args)}")
     print("event,parameter,branch,point" if ds.sizes["event"] else "no events")
     for kind, lam, branch, point in events_table(ds):
         print(f"{kind},{lam:.8g},{branch},{point}")
@@ -1042,6 +1115,19 @@ def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s 
     g.add_argument("--atol", type=float, default=atol, help=f"absolute tolerance (default: {atol:g})")
     g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
                    help=backend_help)
+    g.add_argument("--max-step", type=float, default=math.inf, dest="max_step", metavar="SECONDS",
+                   help="largest step the integrator may take (default: no limit)")
+    g.add_argument("--max-events", type=int, default=1_000_000, dest="max_events", metavar="N",
+                   help="most regime switches one run may have before it stops as MAX_EVENTS (default: 1000000)")
+
+
+def _solver_options(args):
+    """The engine's SolverOptions from the solver options of ``_add_solver``: built here, for
+    every command that takes them."""
+    from .engine.config import EventSettings, SolverOptions
+
+    return SolverOptions(method=args.method, rtol=args.rtol, atol=args.atol, max_step=args.max_step,
+                         events=EventSettings(max_events=args.max_events))
 
 
 def _add_file(g, flag: str, kind: str, help_: str, *aliases: str, dest: str | None = None, **kw):
@@ -1212,10 +1298,23 @@ def _parser() -> argparse.ArgumentParser:
                    help="revolutions from the static equilibrium before the first orbit's search (default: 20)")
     g.add_argument("--max-points", type=int, default=400, dest="max_points", metavar="N",
                    help="at most this many orbits per branch (default: 400)")
-    g.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default: 1e-10)")
-    g.add_argument("--atol", type=float, default=1e-13, help="absolute tolerance (default: 1e-13)")
-    g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
-                   help="who runs the engine's loop: %(choices)s")
+    g.add_argument("--arclength-step", type=float, default=0.01, dest="arclength_step", metavar="DS",
+                   help="first step in scaled arclength (the parameter range is 1) (default: 0.01)")
+    g.add_argument("--min-arclength-step", type=float, default=1e-5, dest="min_arclength_step", metavar="DS",
+                   help="the branch ends where the corrector fails at this arclength step (default: 1e-5)")
+    g.add_argument("--max-arclength-step", type=float, default=0.05, dest="max_arclength_step", metavar="DS",
+                   help="largest step in scaled arclength (default: 0.05)")
+    g.add_argument("--tol", type=float, default=1e-8,
+                   help="scaled residual the corrector and the first orbit's Newton stop at (default: 1e-8)")
+    g.add_argument("--max-iterations", type=int, default=8, dest="max_iterations", metavar="N",
+                   help="corrector iterations per step (default: 8; the first orbit's Newton takes 20)")
+    g.add_argument("--switch-depth", type=int, default=1, dest="switch_depth", metavar="N",
+                   help="how many period doublings deep to switch branches: 1 follows period 2 from a "
+                        "period-1 branch, 2 also period 4 (default: 1)")
+    g.add_argument("--jacobian", default="finite_differences", choices=("finite_differences", "variational"),
+                   help="dP/dx by finite differences (checked, falling back to the tangent dynamics) or by the "
+                        "tangent dynamics (default: finite_differences)")
+    _add_solver(g, rtol=1e-10, atol=1e-13)
     _add_file(g, "--netcdf", "netcdf", "save the branches and events as NetCDF (.nc)")
     _add_file(g, "--plot", "plot", "save the branches with their events (.png, .pdf, .svg...)")
 
@@ -1266,12 +1365,15 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--clear", action="store_true", help="delete every cache folder (the next run compiles, and derives, again)")
     g.add_argument("--clear-stale", action="store_true", dest="clear_stale",
                    help="delete the folders of other camdyn versions, engines or derivations only")
+    for p in sub.choices.values():
+        p.set_defaults(flags=_flags(p))
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     show_traceback = "--traceback" in argv
+    args = None
     try:
         args = _parser().parse_args(argv)
         args.argv = argv
@@ -1292,7 +1394,7 @@ def main(argv: list[str] | None = None) -> int:
             import traceback
 
             traceback.print_exc()
-        code, line = _classify(exc)
+        code, line = _classify(exc, args)
         print(f"camdyn: {line}", file=sys.stderr)
         return code
 
@@ -1303,9 +1405,14 @@ def _show_notice(message, category, filename, lineno, file=None, line=None):
     print(f"camdyn: note: {message}", file=file or sys.stderr)
 
 
-def _classify(exc: BaseException) -> tuple[int, str]:
-    """Exit code and the one-line message of an exception."""
+def _classify(exc: BaseException, args=None) -> tuple[int, str]:
+    """Exit code and the one-line message of an exception (a parameter's name as the command's
+    flag when it has one)."""
+    from .errors import ParameterError
+
     text = " ".join(str(exc).split()) or type(exc).__name__
+    if isinstance(exc, ParameterError):
+        text = _parameter_line(exc, args) or _in_flags(text, args)
     if isinstance(exc, MissingPart):
         return EXIT_MISSING, f"error: {text}"
     if isinstance(exc, ImportError):

@@ -127,10 +127,12 @@ class ContinuationOutcome(ActionableOutcome):
     END_REACHED = "the branch reached the end value of the parameter"
     LEFT_RANGE = ("the branch left the range at the start value (it turned back at a fold, or a switched "
                   "branch ran toward the start); continue from another start value to follow it further")
-    MAX_POINTS = "max_points orbits were computed before the end value: raise max_points or max_step"
+    MAX_POINTS = ("ContinuationSettings.max_points orbits were computed before the end value: raise "
+                  "ContinuationSettings.max_points or ContinuationSettings.max_step")
     STEP_TOO_SMALL = ("the corrector failed at the minimum step (a non-smooth point such as grazing or a "
                       "sliding bifurcation, or a failed run, see the message): the branch ends here; "
-                      "try another phase_fraction, a smaller min_step, or continue from beyond it")
+                      "try another phase_fraction, a smaller ContinuationSettings.min_step, or continue from "
+                      "beyond it")
     START_FAILED = ("no periodic orbit at the start value (see the message): try another start value, "
                     "phase_fraction or warmup_revolutions")
 
@@ -693,7 +695,7 @@ def _start(problem: Problem, warmup_revolutions: int, settings):
     rig = model.rig
     orbit = periodic_orbit(rig, problem.scene, model.cam, periods=problem.periods,
                            phase=problem.phase_fraction * model.period, warmup_revolutions=warmup_revolutions,
-                           settings=ShootingSettings(settings.tol, 20), options=problem.options,
+                           settings=ShootingSettings(settings.tol, max(20, settings.max_corrector)), options=problem.options,
                            jacobian=problem.jacobian, backend=problem.backend)
     if not (orbit.ok or orbit.outcome is OrbitOutcome.MULTIPLIERS_UNRESOLVED):   # the orbit, not its multipliers
         return None, orbit.message

@@ -41,6 +41,9 @@ class ParameterError(CamdynError, ValueError):
         ``"required by damping model D"`` when ``value`` is ``None``.
     reason : str, optional
         Appended in parentheses: the parameter's meaning and unit, and the likely mistake.
+    problem : str, optional
+        What is wrong with the value, in words, when that says more than the value itself
+        (a series: ``"has NaN at index 0"``): the message is ``"<name> <problem>: must be <valid>"``.
 
     Example messages:
 
@@ -52,24 +55,28 @@ class ParameterError(CamdynError, ValueError):
       ``method = 'RK54' is not valid (did you mean 'RK45'?): must be one of ('RK45', 'DOP853')``.
     """
 
-    def __init__(self, name: str, value: Any, valid: str, *, reason: str | None = None):
-        self.name, self.value, self.valid, self.reason = name, value, valid, reason
-        if value is None:
+    def __init__(self, name: str, value: Any, valid: str, *, reason: str | None = None, problem: str | None = None):
+        self.name, self.value, self.valid, self.reason, self.problem = name, value, valid, reason, problem
+        if problem:
+            message = f"{name} {problem}: must be {valid}"
+        elif value is None:
             message = f"{name} is not given: {valid}"
         elif isinstance(value, Real) and not isinstance(value, bool):
             message = f"{name} = {value} is out of range: must be {valid}"
         elif isinstance(value, str) and not _NUMERIC.search(valid):
             # a name chosen from a list (a method, a backend, a preset): not a number problem
             message = f"{name} = {value!r} is not valid{_did_you_mean(value, valid)}: must be {valid}"
-        else:
+        elif isinstance(value, (str, bool)) or _NUMERIC.search(valid):
             kind = type(value).__name__
             message = f"{name} = {value!r} is not a real number ({kind}): must be {valid}"
+        else:
+            message = f"{name} = {value!r} is not valid: must be {valid}"
         if reason:
             message += f" ({reason})"
         super().__init__(message)
 
     def __reduce__(self):
-        rebuild = functools.partial(type(self), reason=self.reason)
+        rebuild = functools.partial(type(self), reason=self.reason, problem=self.problem)
         return rebuild, (self.name, self.value, self.valid)
 
 

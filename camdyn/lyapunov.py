@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cam import CamMotion, cam_motion
+from .cam import CamMotion, periodic_cam
 from .engine.config import SolverOptions
 from .engine.driver import integrate
 from .errors import ParameterError
@@ -113,7 +113,8 @@ def spectrum(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=N
     """The Lyapunov spectrum of ``model``'s run (see the module docstring)."""
     T = model.period
     if not (math.isfinite(T) and T > 0):
-        raise ParameterError("cam", model.cam, "a periodic cam motion (a nonzero speed)")
+        raise ParameterError("cam", None, "a periodic cam motion (a nonzero speed, or a period)",
+                             problem=f"{model.cam!r} has no period")
     x, mode = _start(model, settings.transient, y0, options, backend)
     Q = np.eye(2)
     logs = np.empty((settings.revolutions, 2))
@@ -141,4 +142,4 @@ def lyapunov_exponents(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, 
     equilibrium), over ``settings.revolutions`` (see the module docstring)."""
     if not isinstance(settings, LyapunovSettings):
         raise ParameterError("settings", settings, "a camdyn.lyapunov.LyapunovSettings")
-    return spectrum(Model(rig, scene, cam_motion(cam, speed_rpm)), settings, y0, options, backend)
+    return spectrum(Model(rig, scene, periodic_cam(cam, speed_rpm)), settings, y0, options, backend)

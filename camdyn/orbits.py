@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import quasistatic
-from .cam import CamMotion, cam_motion
+from .cam import CamMotion, periodic_cam
 from .engine.config import SolverOptions
 from .engine.driver import integrate
 from .errors import ParameterError
@@ -254,7 +254,7 @@ def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, spee
     orbit's state at the section (:mod:`camdyn.quasistatic`), for an orbit in permanent contact
     (RUN_FAILED, saying where, when the contact force would turn tensile).
     """
-    cam = cam_motion(cam, speed_rpm)
+    cam = periodic_cam(cam, speed_rpm)
     if not isinstance(settings, ShootingSettings):
         raise ParameterError("settings", settings, "a camdyn.orbits.ShootingSettings")
     model = Model(rig, scene, cam)

@@ -91,7 +91,8 @@ class StroboscopicMap:
                  options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
         T = model.period
         if not (math.isfinite(T) and T > 0):
-            raise ParameterError("model", model.cam, "a periodic cam motion (a nonzero speed)")
+            raise ParameterError("model", None, "a periodic cam motion (a nonzero speed, or a period)",
+                                 problem=f"{model.cam!r} has no period")
         if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or not 1 <= periods <= MAX_PERIODS:
             raise ParameterError("periods", periods, f"an integer, 1 <= periods <= {MAX_PERIODS}")
         if isinstance(phase, bool) or not isinstance(phase, (int, float)) or not 0.0 <= phase < T:

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 import camdyn
 from camdyn.cli import main as cli_main
-from camdyn.errors import CamdynError
+from camdyn.errors import CamdynError, ParameterError
 from camdyn.rig import PARAMETERS
 from registry import BACKENDS, RIG
 
@@ -129,3 +129,29 @@ def test_a_name_that_is_not_one_of_the_choices_is_not_called_a_number():
     with pytest.raises(ParameterError) as info:
         camdyn.load_rig("exmaple")
     assert "did you mean 'example'" in str(info.value) and "real number" not in str(info.value)
+
+
+def test_a_cam_at_rest_is_refused_by_the_periodic_analyses_saying_why():
+    """issue 25: 'model = ConstantSpeed(speed_rpm=0.0) is not a real number (ConstantSpeed)'."""
+    rig, scene = camdyn.example_rig(), camdyn.Scene()
+    for call in (lambda: camdyn.periodic_orbit(rig, scene, speed_rpm=0.0),
+                 lambda: camdyn.lyapunov_exponents(rig, scene, speed_rpm=0)):
+        with pytest.raises(ParameterError, match=r"^speed_rpm is zero: must be nonzero \(rev/min\)"):
+            call()
+
+
+@pytest.mark.parametrize("series, says", [
+    ([float("nan")] * 200, "series has NaN at index 0 (and 199 more non-finite values)"),
+    ([0.0] * 150 + [float("inf")] + [0.0] * 49, "series has an infinite value at index 150:"),
+    ([0.0] * 20, "series has shape (20,): must be a 1-D series of at least 100 values"),
+])
+def test_the_zero_one_test_says_what_is_wrong_with_a_series(series, says):
+    from camdyn.chaos01 import zero_one_test
+    with pytest.raises(ParameterError) as info:
+        zero_one_test(series)
+    assert says in str(info.value) and "not a real number" not in str(info.value)
+
+
+def test_an_object_that_is_not_a_number_is_not_called_one():
+    message = str(ParameterError("model", camdyn.ConstantSpeed(100.0), "a periodic cam motion"))
+    assert "is not valid: must be a periodic cam motion" in message and "real number" not in message

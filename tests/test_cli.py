@@ -419,7 +419,7 @@ def test_ranges_may_start_with_a_minus_sign(capsys):
     assert main(["contact-loss", "--k-s", "-500:8000:5:log"]) == 2
     assert "a log range needs positive ends" in one_error_line(capsys)  # read, then refused with the reason
     assert main(["contact-loss", "--k-s", "-500,8000"]) == 2
-    assert "k_s = -500.0 is out of range" in one_error_line(capsys)
+    assert "--k-s -500.0 is out of range" in one_error_line(capsys)   # told by the flag the user typed
 
 
 # ------------------------------------------------------------------ whole periods after the transient (G)
@@ -497,3 +497,59 @@ def test_warnings_print_as_one_note_line_not_python_source(capsys, monkeypatch):
     assert main(["scenes"]) == 0
     err = capsys.readouterr().err
     assert "camdyn: note: compiling, once" in err and ".py:" not in err
+
+
+# ------------------------------------------------------------------ messages in the command's own terms (issue 25)
+@pytest.mark.parametrize("argv, starts", [
+    (["lyapunov", "--speed-rpm", "0"], "camdyn: error: --speed-rpm is zero: must be nonzero"),
+    (["lyapunov", "--speed-rpm", "300", "--transient-revolutions", "-1"], "camdyn: error: --transient-revolutions -1"),
+    (["lyapunov", "--speed-rpm", "300", "--revolutions", "10", "--batches", "3"], "camdyn: error: --revolutions 10"),
+    (["continue", "--start", "0", "--end", "100"], "camdyn: error: --end 100"),
+    (["continue", "--start", "1600", "--end", "1700", "--min-arclength-step", "0"],
+     "camdyn: error: --min-arclength-step 0"),
+    (["sweep", "--speeds", "600:1500:0"], "camdyn: error: --speeds 600:1500:0: the count (the third field) must be "
+                                          "at least 1, got 0"),
+])
+def test_an_error_names_the_option_the_user_typed(argv, starts, capsys):
+    """A library parameter's error is told by the command's flag (--transient-revolutions, not the
+    library's 'transient'), with what is wrong."""
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(starts), line
+
+
+def _words_left(text: str) -> list[str]:
+    """The library's option names (snake_case words) left in a message after _in_flags."""
+    import re
+    return re.findall(r"(?<![-\w.=])[a-z][a-z0-9]*(?:_[a-zA-Z0-9]+)+(?![\w(])", text)
+
+
+@pytest.mark.parametrize("command, extra", [("continue", ["--start", "1", "--end", "2"]),
+                                            ("simulate", ["--speed-rpm", "100"]),
+                                            ("lyapunov", ["--speed-rpm", "100"])])
+def test_every_piece_of_advice_a_command_prints_is_one_of_its_options(command, extra):
+    """The outcomes a command can print (a branch's, its first orbit's, a run's) advise changing
+    settings by the library's names; printed by the command they name its flags, which it has."""
+    from camdyn.continuation import ContinuationOutcome
+    from camdyn.orbits import OrbitOutcome
+    from camdyn.outcome import Outcome
+    args = cli._parser().parse_args([command, *extra])
+    enums = (ContinuationOutcome, OrbitOutcome, Outcome) if command == "continue" else (Outcome,)
+    for enum in enums:
+        for outcome in enum:
+            text = cli._in_flags(outcome.message, args)
+            left = [w for w in _words_left(text) if w not in ("t_end", "n T")]
+            assert not left, (command, outcome.name, left, text)
+            assert "=camdyn" not in text and "='" not in text, (command, outcome.name, text)
+    flags = args.flags
+    for needed in ("min_arclength_step", "max_arclength_step", "switch_depth", "jacobian", "max_step", "max_events") \
+            if command == "continue" else ("max_step", "max_events", "rtol", "atol", "friction"):
+        assert needed in flags, (command, needed)
+
+
+def test_continue_follows_period_two_to_four_with_switch_depth(capsys):
+    """--switch-depth 2 switches at the period-2 branch's doubling too (the example rig: period 1 ->
+    2 at 1710.2 rev/min, 2 -> 4 at 1798.8)."""
+    assert main(["continue", "--start", "1700", "--end", "1810", "--switch-depth", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "(period 2 T)" in out and "(period 4 T)" in out

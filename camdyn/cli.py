@@ -565,7 +565,6 @@ def cmd_contact_loss(args) -> int:
 
 
 def cmd_lyapunov(args) -> int:
-    from .engine.config import SolverOptions
     from .lyapunov import LyapunovSettings, lyapunov_exponents
     from .metadata import describe_cam, describe_scene
 

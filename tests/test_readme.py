@@ -13,6 +13,31 @@ BLOCKS = re.findall(r"```python\n(.*?)```", README, flags=re.S)
 @pytest.mark.parametrize("index", range(len(BLOCKS)))
 def test_readme_python_block_runs(index, capsys):
     exec(compile(BLOCKS[index], f"README block {index}", "exec"), {})
+    printed = capsys.readouterr().out
+    for comment in _printed_comments(BLOCKS[index]):
+        for shown, cut in re.findall(f"({NUMBER})(\\.\\.\\.)?", comment):
+            assert _shown_in(shown, printed, bool(cut)), \
+                f"README block {index}: {comment!r} shows {shown}; it printed {printed!r}"
+
+
+#: a number as the README shows it (its decimals say to what it is rounded)
+NUMBER = r"-?\d+(?:\.\d+)?(?:e-?\d+)?"
+
+
+def _printed_comments(block: str) -> list[str]:
+    """The comments that show what the line before printed (a '# ...' line right under a print)."""
+    lines = block.splitlines()
+    return [b.strip()[2:] for a, b in zip(lines, lines[1:]) if "print(" in a and b.strip().startswith("# ")]
+
+
+def _shown_in(shown: str, printed: str, cut: bool) -> bool:
+    """Whether a number the README shows is one the block printed, to the digits shown: rounded,
+    or cut short where it is followed by '...'."""
+    decimals = len(shown.split(".")[1]) if "." in shown and "e" not in shown else 0
+    value, unit = float(shown), 10.0 ** -decimals
+    if cut:
+        return any(0 <= abs(float(p)) - abs(value) < unit and float(p) * value >= 0 for p in re.findall(NUMBER, printed))
+    return any(abs(float(p) - value) <= 0.5 * unit * (1 + 1e-9) for p in re.findall(NUMBER, printed))
 
 
 def test_readme_has_the_two_fresh_machine_commands():

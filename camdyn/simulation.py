@@ -49,7 +49,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
              atol: float = 1e-12, max_step: float = math.inf,
              events: EventSettings | None = None, energy_ledger: bool = False,
              backend: str = "compiled", progress: Callable[[float], None] | None = None,
-             stop=None, step_control: str = STEP_CONTROL) -> Result:
+             stop=None, step_control=STEP_CONTROL) -> Result:
     """Simulate the cam-follower of ``rig`` with the physics of ``scene``.
 
     The cam motion is ``cam`` (a ConstantSpeed, Oscillating or UserMotion), or
@@ -58,9 +58,11 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     rad/s), by default the static equilibrium (alpha*, 0) as in Section 4.
     The outputs are sampled at ``sample_rate_Hz``.  ``method`` (``"DOP853"`` or
     ``"RK45"``) integrates each mode of the scene's hybrid automaton; every switch is
-    located on the dense output.  ``step_control``: the step-size controller, ``"pi"`` (default:
+    located on the dense output.  ``step_control``: the step-size controller, a
+    :class:`camdyn.engine.StepControl` or its name: ``PI_CONTROL`` / ``"pi"`` (default:
     proportional-integral, fewer rejected steps where the error estimate jumps, as in a contact
-    mode's ring-down) or ``"scipy"`` (SciPy's: the steps are ``solve_ivp``'s on a smooth stretch);
+    mode's ring-down) or ``SCIPY_CONTROL`` / ``"scipy"`` (SciPy's: the steps are ``solve_ivp``'s
+    on a smooth stretch);
     docs/performance.md measures both.  Check ``result.ok``: a run that could not finish says why.
     ``energy_ledger=True`` also integrates the work of the cam drive and the energy
     dissipated by contact damping and by friction (``result.work_in``,

@@ -34,11 +34,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE_ALPHA, STATE_ALPHA_DOT
-from .engine.config import LOOK_AHEAD, SolverOptions
+from .engine.config import LOOK_AHEAD, SolverOptions, step_control
 from .engine.driver import integrate
 from .engine.kernels import compiled_jacobian, compiled_kernels
 from .engine.loop import ALPHA, ALPHA_DOT
 from .engine.saltation import switch_saltation
+from .engine.stepper import SCIPY_CONTROL, StepControl
 from .engine.tableau import method_of
 from .engine.tables import transition_rows
 from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,
@@ -80,12 +81,14 @@ class TangentSettings:
 
     rtol: float = 1e-10
     atol: float = 1e-12
+    step_control: StepControl = SCIPY_CONTROL      # or its name; SciPy's: the steps of solve_ivp's DOP853
 
     def __post_init__(self):
         for name in ("rtol", "atol"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
                 raise ParameterError(name, value, "0 < value < 1")
+        object.__setattr__(self, "step_control", step_control(self.step_control))
 
 
 @dataclass(frozen=True)
@@ -179,7 +182,7 @@ def _integrate(model: Model, m: int, t0: float, t1: float, y0, settings: Tangent
     if compiled:
         K = model.kernels
         y, ok = integrate_segment(compiled_kernels(K, outputs=False).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
-                                  settings.rtol, atol, method_of("DOP853"), LOOK_AHEAD)
+                                  settings.rtol, atol, method_of("DOP853"), LOOK_AHEAD, settings.step_control)
         return y, ok, "the step size fell below the spacing of t"
     sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
     return sol.y[:, -1], sol.success, sol.message

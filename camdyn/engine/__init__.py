@@ -15,11 +15,13 @@ from __future__ import annotations
 import importlib
 
 from .config import BACKENDS, METHODS, EventSettings, SolverOptions
+from .stepper import PI_CONTROL, SCIPY_CONTROL, StepControl
 
 #: names loaded on first use (PEP 562): the driver imports numba, the settings do not
 _LAZY = {"integrate": ".driver", "Switch": ".switches", "Switches": ".switches", "Trajectory": ".driver"}
 
-__all__ = ["integrate", "SolverOptions", "EventSettings", "Switch", "Switches", "Trajectory", "BACKENDS", "METHODS"]
+__all__ = ["integrate", "SolverOptions", "EventSettings", "StepControl", "PI_CONTROL", "SCIPY_CONTROL", "Switch", "Switches",
+           "Trajectory", "BACKENDS", "METHODS"]
 
 
 def __getattr__(name: str):

@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
-from .stepper import CONTROLS
+from .stepper import CONTROLS, PI_CONTROL, StepControl
 from .tableau import TABLEAUS
 
 _EPS = float(np.finfo(float).eps)
@@ -39,12 +39,23 @@ REACH_FACTOR = 2.0
 #: |alpha| beyond this is the singular 90 degrees of Eq. 11 (tan, sec)
 ANGLE_LIMIT = math.pi / 2 - 0.02
 METHODS = tuple(TABLEAUS)
-#: the step-size controller by default (stepper.CONTROLS): the PI controller, which at equal error
-#: takes less time than SciPy's on the contact ring-downs of docs/performance.md (fewer rejected
-#: attempts where DOP853's error estimate jumps with the vibration's phase)
-STEP_CONTROL = "pi"
+#: the step-size controller by default (a stepper.StepControl): the PI controller, which at equal
+#: error takes less time than SciPy's on the contact ring-downs of docs/performance.md (fewer
+#: rejected attempts where DOP853's error estimate jumps with the vibration's phase)
+STEP_CONTROL = PI_CONTROL
 #: who runs the loop: numba-compiled (cfunc kernels, cached on disk) or the same code in Python
 BACKENDS = ("compiled", "python")
+
+
+def step_control(value) -> StepControl:
+    """A step-size controller: a :class:`~camdyn.engine.stepper.StepControl` as it is, or one by
+    its name (``"pi"``, ``"scipy"``)."""
+    if isinstance(value, StepControl):
+        return value
+    if isinstance(value, str) and value in CONTROLS:
+        return CONTROLS[value]
+    raise ParameterError("step_control", value, f"a camdyn.engine.StepControl or one of {tuple(CONTROLS)} "
+                         "(SciPy's integral controller, or the proportional-integral one)")
 
 
 @dataclass(frozen=True)
@@ -92,7 +103,7 @@ class SolverOptions:
     max_step: float = math.inf
     events: EventSettings = field(default_factory=EventSettings)
     ledger: bool = False   # integrate the work of the drive, contact damping and friction
-    step_control: str = STEP_CONTROL   # the step-size controller: a key of camdyn.engine.stepper.CONTROLS
+    step_control: StepControl = STEP_CONTROL   # a stepper.StepControl, or its name ("pi", "scipy")
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -106,9 +117,7 @@ class SolverOptions:
             raise ParameterError("max_step", self.max_step, "max_step > 0 (s)")
         if not isinstance(self.events, EventSettings):
             raise ParameterError("events", self.events, "an EventSettings")
-        if self.step_control not in CONTROLS:
-            raise ParameterError("step_control", self.step_control, f"one of {tuple(CONTROLS)} (SciPy's integral "
-                                 "controller, or the proportional-integral one)")
+        object.__setattr__(self, "step_control", step_control(self.step_control))
 
 
 class Settings(NamedTuple):
@@ -137,7 +146,7 @@ def settings(options: SolverOptions, contact_frequency: float) -> Settings:
     (rad/s: the undamped linearized frequency vartheta, Eq. 23)."""
     ev = options.events
     step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
-    a, b = CONTROLS[options.step_control]
+    a, b = options.step_control.a, options.step_control.b
     return Settings(float(options.rtol), float(options.atol), float(options.max_step), a, b, float(ev.xtol),
                     int(ev.interior_points), float(ev.reach_factor), int(ev.max_events), ANGLE_LIMIT,
                     CHATTER_SWITCHES, CHATTER_WINDOW, step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))

@@ -31,7 +31,7 @@ from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
 from .rules import (NONFINITE, across, chattering, clear_of_surfaces, first_crossing, initial_mode, left_at_start,
                     scratch, switch, zero_at_start)
-from .stepper import ACCEPTED, ERR_FLOOR, dense_coefficients, dense_eval, initial_step, step, step_impl
+from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coefficients, dense_eval, initial_step
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
 
@@ -151,7 +151,7 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
     ``may_retry``; K[n] then holds f there, the next step's first stage).  A state that is not
     across (no retry left) or not finite is replaced by the interpolant's, across by
     construction (verdict UNUSABLE).  K[0] must hold f(t, y)."""
-    c0, c1 = step_impl(prob.kernels.rhs, prob.p, m, t, y0, y1, t_cross - t, method, K)
+    c0, c1 = attempt(prob.kernels.rhs, prob.p, m, t, y0, y1, t_cross - t, method, K)
     if math.isfinite(c0) and math.isfinite(c1):
         if across(prob, m, w, t_cross, c0, c1):
             return c0, c1, ACROSS
@@ -203,8 +203,8 @@ def run(prob, method, cfg, start, samples):
         watched = n_watched > 0
         have_start = False
         while t < t_end:
-            status, t_new, n0, n1, h_next, f, rej, err_prev = step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg,
-                                                                   err_prev)
+            status, t_new, n0, n1, h_next, f, rej, err_prev = accepted_step(rhs, p, m, t, y0, y1, h_abs, t_end, method,
+                                                                            K, cfg, err_prev)
             nfev += f
             rejected += rej
             if status != ACCEPTED:

@@ -1,15 +1,26 @@
 """The explicit Runge-Kutta step with dense output: SciPy's algorithm, one source for the
 compiled and the interpreted loop (:mod:`camdyn.engine.jit`).
 
-The state is ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot, rhs(m, t, alpha,
-alpha_dot, p))`` in mode m (the generated kernel, a numba ``cfunc`` when compiled).  The split
-is SciPy's ``RungeKutta``: :func:`step_impl` computes one attempt (stages and solution),
-:func:`error_norm` its error, and :func:`step` does the bookkeeping (accept or reject, the next
-step size) as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are SciPy's; or,
-with the PI controller (:data:`CONTROLS`), the next step size also reads the previous accepted
-step's error.
-:func:`dense_coefficients` and :func:`dense_eval` are the interpolant (``RkDenseOutput`` /
-``Dop853DenseOutput`` in power form).  The method is a :class:`~camdyn.engine.tableau.Method`;
+**The rules of a step, written once** for every state size: the error estimate's norm
+(:func:`rms`, and DOP853's blend of its 5th- and 3rd-order estimates, :func:`blended`), the
+first step's two guesses (:func:`first_guess`, :func:`second_guess`: SciPy's
+``select_initial_step``), the step-size controller as data (:class:`StepControl`: SciPy's
+integral controller and the PI controller) with the factors after an accepted and a rejected
+attempt (:func:`accepted_factor`, :func:`rejected_factor`), and the smallest step
+(:func:`min_step`).  The loop's 2-component state (below) and the tangent dynamics' augmented
+state (:mod:`.variational`) each sum their stages in their own arithmetic and call these.  (A
+stepper over state arrays of any size, one function for both, gives the loop's runs the same
+bits but takes 1.6-1.7 times as long per step on its 2-component state: python
+benchmarks/generic_stepper.py.)
+
+The loop's state is ``y = (alpha, alpha_dot)`` and the ODE ``y' = (alpha_dot, rhs(m, t,
+alpha, alpha_dot, p))`` in mode m (the generated kernel, a numba ``cfunc`` when compiled).  The
+split is SciPy's ``RungeKutta``: :func:`attempt` computes one attempt (stages and solution),
+:func:`error_norm` its error, and :func:`accepted_step` does the bookkeeping (accept or reject,
+the next step size) as ``RungeKutta._step_impl`` does, so on a smooth problem the steps are
+SciPy's; or, with the PI controller, the next step size also reads the previous accepted step's
+error.  :func:`dense_coefficients` and :func:`dense_eval` are the interpolant (``RkDenseOutput``
+/ ``Dop853DenseOutput`` in power form).  The method is a :class:`~camdyn.engine.tableau.Method`;
 the stage buffer ``K`` has one row per stage, the FSAL stage and the interpolant's extra stages.
 
 One deliberate difference from SciPy: an attempt whose error is not finite (a stage that
@@ -19,31 +30,83 @@ times smaller, instead of poisoning the step size with NaN.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from .jit import jitable
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
-#: the step-size controllers (SolverOptions.step_control), as the coefficients (a, b) of the next
-#: step's factor SAFETY err^(-a/k) err_prev^(b/k), k the error estimate's order + 1 (the
-#: method's exponent is -1/k): "scipy", SciPy's integral controller (the accepted step's error
-#: alone: the steps are SciPy's); "pi", the proportional-integral controller (a = 0.7, b = 0.4:
-#: Gustafsson, ACM TOMS 17, 1991; Hairer & Wanner, Solving ODEs II, Sec. IV.2), which also reads
-#: the previous accepted step's error and so damps the growth after a step whose estimate dipped
-CONTROLS = {"scipy": (1.0, 0.0), "pi": (0.7, 0.4)}
+
+
+class StepControl(NamedTuple):
+    """A step-size controller as data: after an accepted attempt the next step is the accepted
+    one times SAFETY err^(-a/k) err_prev^(b/k), k the error estimate's order + 1 (the method's
+    exponent is -1/k) and err_prev the previous accepted attempt's error (:func:`accepted_factor`)."""
+
+    name: str
+    a: float
+    b: float
+
+
+#: SciPy's integral controller (the accepted step's error alone: the steps are ``solve_ivp``'s)
+SCIPY_CONTROL = StepControl("scipy", 1.0, 0.0)
+#: the proportional-integral controller (Gustafsson, ACM TOMS 17, 1991; Hairer & Wanner, Solving
+#: ODEs II, Sec. IV.2), which also reads the previous accepted step's error and so damps the growth
+#: after a step whose estimate dipped
+PI_CONTROL = StepControl("pi", 0.7, 0.4)
+#: the controllers by name (the names SolverOptions accepts besides the objects)
+CONTROLS = {c.name: c for c in (SCIPY_CONTROL, PI_CONTROL)}
 #: the previous error a run's first step reads, and the least one any step passes on (Hairer's
 #: DOPRI codes' FACOLD): a tiny estimate does not unleash the next step's growth
 ERR_FLOOR = 1e-4
 
-#: step() status codes
+#: accepted_step() status codes
 ACCEPTED, TOO_SMALL = 0, 1
 
 
 @jitable
+def rms(sum_of_squares, n):
+    """SciPy's RMS norm of an n-vector from the sum of its squares."""
+    return math.sqrt(sum_of_squares / n)
+
+
+@jitable
+def blended(e5, e3, h, n):
+    """DOP853's error norm (SciPy's ``_estimate_error_norm``) from the sums of the squared,
+    scaled 5th- and 3rd-order estimates over n components."""
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+
+
+@jitable
+def first_guess(d0, d1):
+    """The first trial step of SciPy's ``select_initial_step`` (Hairer, Norsett & Wanner II.4)
+    from the scaled norms of the state (d0) and of its rate (d1); 0 where the rate overflows."""
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    return h0 if h0 > 0.0 else 0.0
+
+
+@jitable
+def second_guess(h0, d1, d2, exponent):
+    """The step from the rate's change over the first trial step (d2, scaled, per second), as
+    ``select_initial_step`` takes it; the caller bounds it by 100 h0 and the span."""
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        return max(1e-6, h0 * 1e-3)
+    return (0.01 / max(d1, d2)) ** (-exponent)
+
+
+@jitable
+def min_step(t):
+    """The smallest step at time t, SciPy's: 10 times the spacing of the floats there."""
+    return 10.0 * spacing(t)
+
+
+@jitable
 def _norm(x0, x1):
-    """SciPy's RMS norm of a 2-vector."""
-    return math.sqrt(0.5 * (x0 * x0 + x1 * x1))
+    """The RMS norm of a 2-vector."""
+    return rms(x0 * x0 + x1 * x1, 2.0)
 
 
 @jitable
@@ -75,7 +138,7 @@ def stages(rhs, p, m, t, y0, y1, h, coef, c_row, K, first, last):
 
 
 @jitable
-def step_impl(rhs, p, m, t, y0, y1, h, method, K):
+def attempt(rhs, p, m, t, y0, y1, h, method, K):
     """One attempt of size h: stages, y_new and the FSAL stage f(t + h, y_new) in K[n_stages]."""
     coef, b, n = method.coef, method.b_row, method.n_stages
     stages(rhs, p, m, t, y0, y1, h, coef, method.c_row, K, 1, n)
@@ -103,17 +166,14 @@ def error_norm(K, h, y0, y1, n0, n1, rtol, atol, method):
         e0 += K[j, 0] * coef[e, j]
         e1 += K[j, 1] * coef[e, j]
     if method.error_kind == 0:
-        return _norm(e0 * h / s0, e1 * h / s1)
+        x0, x1 = e0 * h / s0, e1 * h / s1
+        return rms(x0 * x0 + x1 * x1, 2.0)
     f0 = 0.0
     f1 = 0.0
     for j in range(n + 1):
         f0 += K[j, 0] * coef[e3, j]
         f1 += K[j, 1] * coef[e3, j]
-    e5 = (e0 / s0) ** 2 + (e1 / s1) ** 2
-    e3 = (f0 / s0) ** 2 + (f1 / s1) ** 2
-    if e5 == 0.0 and e3 == 0.0:
-        return 0.0
-    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 2.0)
+    return blended((e0 / s0) ** 2 + (e1 / s1) ** 2, (f0 / s0) ** 2 + (f1 / s1) ** 2, h, 2.0)
 
 
 @jitable
@@ -140,7 +200,7 @@ def rejected_factor(err, exponent):
 
 
 @jitable
-def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev):
+def accepted_step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev):
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry; ``err_prev``: the
     previous accepted step's error (ERR_FLOOR at a run's start), read by the PI controller.
 
@@ -149,22 +209,22 @@ def step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev):
     attempt's stages with f(t_new, y_new) in row n_stages.
     """
     exponent = method.exponent
-    min_step = 10.0 * spacing(t)
+    smallest = min_step(t)
     if h_abs > cfg.max_step:
         h_abs = cfg.max_step
-    elif h_abs < min_step:
-        h_abs = min_step
+    elif h_abs < smallest:
+        h_abs = smallest
     nfev = 0
     rejected = 0
     while True:
-        if h_abs < min_step:
+        if h_abs < smallest:
             return TOO_SMALL, t, y0, y1, h_abs, nfev, rejected, err_prev
         t_new = t + h_abs
         if t_new - t_bound > 0:
             t_new = t_bound
         h = t_new - t
         h_abs = abs(h)
-        n0, n1 = step_impl(rhs, p, m, t, y0, y1, h, method, K)
+        n0, n1 = attempt(rhs, p, m, t, y0, y1, h, method, K)
         nfev += method.n_stages
         err = error_norm(K, h, y0, y1, n0, n1, cfg.rtol, cfg.atol, method)
         if err < 1.0:
@@ -183,23 +243,16 @@ def initial_step(rhs, p, m, t, y0, y1, f1, t_bound, method, cfg):
     rtol, atol = cfg.rtol, cfg.atol
     s0 = atol + abs(y0) * rtol
     s1 = atol + abs(y1) * rtol
-    d0 = _norm(y0 / s0, y1 / s1)
     d1 = _norm(y1 / s0, f1 / s1)
-    if d0 < 1e-5 or d1 < 1e-5:
-        h0 = 1e-6
-    else:
-        h0 = 0.01 * d0 / d1
-    if not h0 > 0.0:  # an overflowing field (d1 = inf or NaN): SciPy's estimate is 0 too
+    h0 = first_guess(_norm(y0 / s0, y1 / s1), d1)
+    if h0 == 0.0:  # an overflowing field (d1 = inf or NaN): SciPy's estimate is 0 too
         return 0.0
     h0 = min(h0, length)
     z0 = y0 + h0 * y1
     z1 = y1 + h0 * f1
     g1 = rhs(m, t + h0, z0, z1, p)
     d2 = _norm((z1 - y1) / s0, (g1 - f1) / s1) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (-method.exponent)
+    h1 = second_guess(h0, d1, d2, method.exponent)
     return min(100.0 * h0, h1, length, cfg.max_step)
 
 

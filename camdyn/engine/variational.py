@@ -3,11 +3,11 @@ switches, integrated by the engine's Runge-Kutta pair, compiled (numba).
 
 The system: x' = (alpha_dot, alpha_ddot), Phi' = J Phi with J = [[0, 1], [a_alpha,
 a_alpha_dot]] from the generated ``jacobian``, and the divergence a_alpha_dot integrated
-(:mod:`camdyn.tangent` explains its use).  The step is SciPy's algorithm for n components (the
-RMS error norm, DOP853's blended estimate, the same step-size control and initial step as
-:mod:`.stepper`, which is specialised to the 2-component state of the loop).  At the segment's
-start the Jacobian is taken LOOK_AHEAD along the motion (the limit from inside the segment: a
-segment starting on a surface may start on a kink of the law).
+(:mod:`camdyn.tangent` explains its use).  The step is the loop's (:mod:`.stepper`: its error
+norms, first-step guesses, controller and smallest step, called here), with the stages summed
+over the augmented state's N_AUGMENTED components.  At the segment's start the Jacobian is taken
+LOOK_AHEAD along the motion (the limit from inside the segment: a segment starting on a surface
+may start on a kink of the law).
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from numba import njit
 from ..derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import jitable
-from .stepper import accepted_factor, rejected_factor, spacing
+from .stepper import ERR_FLOOR, accepted_factor, blended, first_guess, min_step, rejected_factor, rms, second_guess
 
 cache.install()
 
@@ -60,25 +60,39 @@ def augmented_field(rhs, jacobian, p, m, t, y, t_start, look_ahead, jac, out):
 
 @njit(cache=True, error_model="numpy")
 def _norm(v):
-    return math.sqrt(np.sum(v * v) / v.shape[0])
+    return rms(np.sum(v * v), v.shape[0])
 
 
 @njit(cache=True, error_model="numpy")
 def _initial_step(rhs, jacobian, p, m, t, y, f0, t_end, rtol, atol, exponent, look_ahead, jac, work):
-    """SciPy's select_initial_step (Hairer, Norsett & Wanner II.4)."""
+    """The first step (:func:`~camdyn.engine.stepper.first_guess`, :func:`~camdyn.engine.stepper.second_guess`)."""
     scale = atol + np.abs(y) * rtol
-    d0, d1 = _norm(y / scale), _norm(f0 / scale)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, t_end - t)
+    d1 = _norm(f0 / scale)
+    h0 = min(first_guess(_norm(y / scale), d1), t_end - t)
+    if h0 == 0.0:
+        return 0.0
     augmented_field(rhs, jacobian, p, m, t + h0, y + h0 * f0, t, look_ahead, jac, work)
-    d2 = _norm((work - f0) / scale) / h0
-    h1 = max(1e-6, h0 * 1e-3) if (d1 <= 1e-15 and d2 <= 1e-15) else (0.01 / max(d1, d2)) ** (-exponent)
+    h1 = second_guess(h0, d1, _norm((work - f0) / scale) / h0, exponent)
     return min(100.0 * h0, h1, t_end - t)
 
 
 @njit(cache=True, error_model="numpy")
-def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, look_ahead):
-    """y (N_AUGMENTED) at t_end from y at t0 in mode m; returns (y, ok)."""
+def _error(K, h, y, y_new, rtol, atol, method):
+    """The attempt's error norm (:func:`~camdyn.engine.stepper.error_norm` over N_AUGMENTED components)."""
+    scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
+    e5, e3 = np.zeros(N_AUGMENTED), np.zeros(N_AUGMENTED)
+    for j in range(method.n_stages + 1):
+        e5 += method.coef[method.e_row, j] * K[j]
+        e3 += method.coef[method.e3_row, j] * K[j]
+    if method.error_kind == 0:
+        return _norm(e5 * h / scale)
+    return blended(np.sum((e5 / scale) ** 2), np.sum((e3 / scale) ** 2), h, N_AUGMENTED)
+
+
+@njit(cache=True, error_model="numpy")
+def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, look_ahead, control):
+    """y (N_AUGMENTED) at t_end from y at t0 in mode m, the step size set by ``control`` (a
+    :class:`~camdyn.engine.stepper.StepControl`); returns (y, ok)."""
     coef, n = method.coef, method.n_stages
     K = np.empty((n + 1, N_AUGMENTED))
     jac, z = np.empty(2), np.empty(N_AUGMENTED)
@@ -87,10 +101,11 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
     augmented_field(rhs, jacobian, p, m, t, y, t0, look_ahead, jac, K[0])
     h_abs = _initial_step(rhs, jacobian, p, m, t, y, K[0].copy(), t_end, rtol, atol, method.exponent,
                           look_ahead, jac, z)
+    err_prev = ERR_FLOOR
     while t < t_end:
         rejected = False
         while True:
-            if h_abs < 10.0 * spacing(t):
+            if h_abs < min_step(t):
                 return y, False
             t_new = min(t + h_abs, t_end)
             h = t_new - t
@@ -101,18 +116,10 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
                 augmented_field(rhs, jacobian, p, m, t + coef[method.c_row, s] * h, z, t0, look_ahead, jac, K[s])
                 if s == n:
                     y_new = z.copy()
-            scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
-            e5, e3 = np.zeros(N_AUGMENTED), np.zeros(N_AUGMENTED)
-            for j in range(n + 1):
-                e5 += coef[method.e_row, j] * K[j]
-                e3 += coef[method.e3_row, j] * K[j]
-            if method.error_kind == 0:
-                err = _norm(e5 * h / scale)
-            else:
-                s5, s3 = np.sum((e5 / scale) ** 2), np.sum((e3 / scale) ** 2)
-                err = 0.0 if s5 == 0.0 and s3 == 0.0 else h * s5 / math.sqrt((s5 + 0.01 * s3) * N_AUGMENTED)
-            if err < 1.0:  # SciPy's controller (stepper.CONTROLS["scipy"])
-                h_abs = h * accepted_factor(err, 1.0, rejected, method.exponent, 1.0, 0.0)
+            err = _error(K, h, y, y_new, rtol, atol, method)
+            if err < 1.0:
+                h_abs = h * accepted_factor(err, err_prev, rejected, method.exponent, control.a, control.b)
+                err_prev = max(err, ERR_FLOOR)
                 break
             h_abs = h * rejected_factor(err, method.exponent)
             rejected = True

@@ -13,7 +13,6 @@ and prints the time of each, the minimum of interleaved rounds, and their ratio.
 from __future__ import annotations
 
 import argparse
-import math
 import time
 import warnings
 

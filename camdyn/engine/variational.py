@@ -11,7 +11,6 @@ may start on a kink of the law).
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 from numba import njit

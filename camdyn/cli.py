@@ -1120,6 +1120,14 @@ def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s 
                    help="most regime switches one run may have before it stops as MAX_EVENTS (default: 1000000)")
 
 
+def _MAP_OPTIONS():
+    """The tolerances of the periodic analyses (camdyn.engine.config.MAP_OPTIONS), their default on
+    the command line too (numba-free: the parser is built without it)."""
+    from .engine.config import MAP_OPTIONS
+
+    return MAP_OPTIONS
+
+
 def _solver_options(args):
     """The engine's SolverOptions from the solver options of ``_add_solver``: built here, for
     every command that takes them."""
@@ -1227,7 +1235,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="revolutions discarded first (default: 50)")
     g.add_argument("--batches", type=int, default=10,
                    help="batches for the standard error; divides --revolutions (default: 10)")
-    _add_solver(g, rtol=1e-10, atol=1e-13)
+    _add_solver(g, rtol=_MAP_OPTIONS().rtol, atol=_MAP_OPTIONS().atol)
     p.add_argument("--json", action="store_true", help="print the exponents and their estimate as JSON")
 
     p = command("sweep", "sweep the cam speed (and one rig parameter): bifurcation diagram or contact map",
@@ -1313,7 +1321,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--jacobian", default="finite_differences", choices=("finite_differences", "variational"),
                    help="dP/dx by finite differences (checked, falling back to the tangent dynamics) or by the "
                         "tangent dynamics (default: finite_differences)")
-    _add_solver(g, rtol=1e-10, atol=1e-13)
+    _add_solver(g, rtol=_MAP_OPTIONS().rtol, atol=_MAP_OPTIONS().atol)
     _add_file(g, "--netcdf", "netcdf", "save the branches and events as NetCDF (.nc)")
     _add_file(g, "--plot", "plot", "save the branches with their events (.png, .pdf, .svg...)")
 

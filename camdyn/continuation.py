@@ -80,7 +80,7 @@ from .engine.driver import Trajectory
 from .engine.loop import ALPHA, ALPHA_DOT
 from .errors import CamdynError, ParameterError
 from .model import Model
-from .orbits import OrbitOutcome, ShootingSettings, newton, periodic_orbit, sorted_multipliers
+from .orbits import OrbitOutcome, ShootingSettings, newton, newton_matrix, periodic_orbit, sorted_multipliers
 from .outcome import ActionableOutcome
 from .rig import PARAMETERS, Rig
 from .scene import Scene
@@ -309,7 +309,7 @@ def _evaluate(problem: Problem, lam: float, x, mode, periods: int, scale, base: 
     d = derivative_at(problem.jacobian(section_map, scale), x, base)
     dP_dlam, h, note = _d_lambda(problem, lam, x, mode, periods, scale, base)
     A = np.empty((2, 3))
-    A[:, :2] = (d.jacobian - np.eye(2)) * scale[None, :] / scale[:, None]
+    A[:, :2] = newton_matrix(d.jacobian, scale)
     A[:, 2] = dP_dlam * problem.span / scale
     if not np.all(np.isfinite(A)):
         raise MapFailure(f"no derivatives at {problem.parameter} = {lam:.8g}: {d.note or note}")

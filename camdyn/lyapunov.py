@@ -26,7 +26,6 @@ batch means (:attr:`LyapunovExponents.standard_error`) assumes the batches are i
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -34,13 +33,11 @@ import numpy as np
 
 from .cam import CamMotion, periodic_cam
 from .engine.config import SolverOptions
-from .engine.driver import integrate
 from .errors import ParameterError
 from .model import Model
-from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
-from .section_map import DEFAULT_OPTIONS
+from .section_map import DEFAULT_OPTIONS, MapFailure, warm_up
 from .tangent import TangentSettings, tangent
 
 __all__ = ["lyapunov_exponents", "spectrum", "LyapunovExponents", "LyapunovSettings"]
@@ -96,14 +93,13 @@ class LyapunovExponents:
 
 def _start(model: Model, transient: int, y0, options, backend):
     """The state and mode after ``transient`` revolutions from y0 (None: the equilibrium)."""
-    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
     if transient == 0:
-        return y0, None
+        return (model.static_state() if y0 is None else np.asarray(y0, dtype=float)), None
     t_end = transient * model.period
-    run = functools.partial(integrate, backend=backend)
-    tr = integrate_in_pieces(run, model, (0.0, t_end), y0, np.array([t_end]), options)
-    if not tr.outcome.ok:
-        raise ParameterError("transient", transient, f"a run that succeeds ({tr.outcome.message})")
+    try:
+        tr = warm_up(model, t_end, y0, np.array([t_end]), options, backend)
+    except MapFailure as failure:
+        raise ParameterError("transient", transient, f"a run that succeeds ({failure})") from None
     return tr.y[:2, -1].copy(), int(tr.end_mode)
 
 

@@ -19,7 +19,6 @@ integration error, below which a residual is noise).
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -29,15 +28,13 @@ import numpy as np
 from . import quasistatic
 from .cam import CamMotion, periodic_cam
 from .engine.config import SolverOptions
-from .engine.driver import integrate
 from .errors import ParameterError
 from .model import Model
 from .outcome import ActionableOutcome
-from .pieces import integrate_in_pieces
 from .rig import Rig
 from .scene import Scene
 from .derivatives import finite_differences
-from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, StroboscopicMap, derivative_at
+from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, StroboscopicMap, derivative_at, warm_up
 
 #: samples of the warm-up's last revolution, for the size of the motion (the residual's scale)
 SCALE_SAMPLES = 64
@@ -132,19 +129,16 @@ class ShootingSettings:
 def warm_start(model: Model, revolutions: float, phase: float, y0=None,
                options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
     """The state and mode at the section time ``phase + revolutions T`` after a run from ``y0``
-    (default the static equilibrium) at t = 0, and the size of the motion over its last
-    revolution (``max |alpha - alpha*|`` and ``max |alpha_dot|``: the residual's scale)."""
+    (default the static equilibrium) at t = 0 (:func:`~camdyn.section_map.warm_up`), and the
+    size of the motion over its last revolution (``max |alpha - alpha*|`` and ``max |alpha_dot|``:
+    the residual's scale)."""
     T = model.period
     if isinstance(revolutions, bool) or not isinstance(revolutions, (int, np.integer)) or revolutions < 1:
         raise ParameterError("warmup_revolutions", revolutions, "an integer >= 1")
     t_end = phase + revolutions * T
     t_eval = t_end - T + T * np.arange(SCALE_SAMPLES + 1) / SCALE_SAMPLES
     t_eval[-1] = t_end                       # the section itself, not t_end - T + T rounded
-    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
-    run = functools.partial(integrate, backend=backend)
-    tr = integrate_in_pieces(run, model, (0.0, t_end), y0, t_eval, options)
-    if not tr.outcome.ok or tr.t.size != t_eval.size:
-        raise MapFailure(f"the warm-up run failed: {tr.outcome.message}", tr.outcome)
+    tr = warm_up(model, t_end, y0, t_eval, options, backend)
     a, ad = tr.y[0], tr.y[1]
     scale = np.array([np.max(np.abs(a - model.equilibrium.alpha)), np.max(np.abs(ad))])
     tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])   # a motion at rest: rad, rad/s
@@ -155,9 +149,15 @@ def _residual(F: np.ndarray, scale: np.ndarray) -> float:
     return float(np.max(np.abs(F) / scale))
 
 
+def newton_matrix(J: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """dP/dx - I in the variables scaled by the motion's size (x_j / scale_j): the Jacobian of
+    the scaled residual (P(x) - x) / scale, which shooting and the continuation's corrector solve."""
+    return (J - np.eye(2)) * scale[None, :] / scale[:, None]
+
+
 def _newton_step(J: np.ndarray, F: np.ndarray, scale: np.ndarray):
     """The Newton step of P(x) - x = 0, solved in scaled variables; None when M - I is singular."""
-    A = (J - np.eye(2)) * scale[None, :] / scale[:, None]
+    A = newton_matrix(J, scale)
     if not np.all(np.isfinite(A)) or np.linalg.svd(A, compute_uv=False)[-1] < SINGULAR_SIGMA:
         return None
     return -np.linalg.solve(A, F / scale) * scale

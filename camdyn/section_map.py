@@ -22,13 +22,14 @@ caller that has just run the map at x (the continuation's corrector) passes that
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 
-from .engine.config import LOOK_AHEAD, SolverOptions
+from .engine.config import LOOK_AHEAD, MAP_OPTIONS, SolverOptions
 from .engine.driver import Trajectory, integrate
 from .engine.kernels import python_kernels
 from .engine.problem import Problem
@@ -36,13 +37,26 @@ from .engine.rules import across, initial_mode
 from .engine.tables import tables
 from .errors import CamdynError, ParameterError
 from .model import Model
+from .pieces import integrate_in_pieces
 
-#: the map's default solver tolerances: the Newton tolerance of :mod:`camdyn.orbits` and the
-#: finite-difference step below are chosen from them
-DEFAULT_OPTIONS = SolverOptions(rtol=1e-10, atol=1e-13)
+#: the map's default solver tolerances (camdyn.engine.config.MAP_OPTIONS: rtol 1e-10, atol 1e-13)
+DEFAULT_OPTIONS = MAP_OPTIONS
 #: at most this many cam periods per map evaluation: the engine is called once, in its own
 #: time, which stays below 2 x 100 kernel periods (camdyn.pieces integrates longer runs in pieces)
 MAX_PERIODS = 100
+
+
+def warm_up(model: Model, t_end: float, y0, t_eval, options: SolverOptions = DEFAULT_OPTIONS,
+            backend: str = "compiled") -> Trajectory:
+    """The run every periodic analysis starts from: ``model`` from ``y0`` (None: the static
+    equilibrium) at t = 0 to ``t_end``, in pieces (:mod:`camdyn.pieces`), sampled at ``t_eval``
+    (ending at t_end).  Raises :class:`MapFailure` when it fails."""
+    y0 = model.static_state() if y0 is None else np.asarray(y0, dtype=float)
+    run = functools.partial(integrate, backend=backend)
+    tr = integrate_in_pieces(run, model, (0.0, t_end), y0, np.asarray(t_eval, dtype=float), options)
+    if not tr.outcome.ok or tr.t.size != len(t_eval):
+        raise MapFailure(f"the warm-up run failed: {tr.outcome.message}", tr.outcome)
+    return tr
 
 
 class MapFailure(CamdynError):

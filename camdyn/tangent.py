@@ -34,12 +34,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE_ALPHA, STATE_ALPHA_DOT
-from .engine.config import LOOK_AHEAD, SolverOptions, step_control
+from .engine.config import LOOK_AHEAD, SCIPY_CONTROL, SolverOptions, StepControl, step_control
 from .engine.driver import integrate
 from .engine.kernels import compiled_jacobian, compiled_kernels
 from .engine.loop import ALPHA, ALPHA_DOT
 from .engine.saltation import switch_saltation
-from .engine.stepper import SCIPY_CONTROL, StepControl
 from .engine.tableau import method_of
 from .engine.tables import transition_rows
 from .engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,

@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import importlib
 
-from .config import BACKENDS, METHODS, EventSettings, SolverOptions
-from .stepper import PI_CONTROL, SCIPY_CONTROL, StepControl
+from .config import BACKENDS, METHODS, PI_CONTROL, SCIPY_CONTROL, EventSettings, SolverOptions, StepControl
 
 #: names loaded on first use (PEP 562): the driver imports numba, the settings do not
 _LAZY = {"integrate": ".driver", "Switch": ".switches", "Switches": ".switches", "Trajectory": ".driver"}

@@ -15,10 +15,30 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
-from .stepper import CONTROLS, PI_CONTROL, StepControl
 from .tableau import TABLEAUS
 
 _EPS = float(np.finfo(float).eps)
+
+
+class StepControl(NamedTuple):
+    """A step-size controller as data: after an accepted attempt the next step is the accepted
+    one times SAFETY err^(-a/k) err_prev^(b/k), k the error estimate's order + 1 (the method's
+    exponent is -1/k) and err_prev the previous accepted attempt's error
+    (:func:`camdyn.engine.stepper.accepted_factor`)."""
+
+    name: str
+    a: float
+    b: float
+
+
+#: SciPy's integral controller (the accepted step's error alone: the steps are ``solve_ivp``'s)
+SCIPY_CONTROL = StepControl("scipy", 1.0, 0.0)
+#: the proportional-integral controller (Gustafsson, ACM TOMS 17, 1991; Hairer & Wanner, Solving
+#: ODEs II, Sec. IV.2), which also reads the previous accepted step's error and so damps the growth
+#: after a step whose estimate dipped
+PI_CONTROL = StepControl("pi", 0.7, 0.4)
+#: the controllers by name (the names SolverOptions accepts besides the objects)
+CONTROLS = {c.name: c for c in (SCIPY_CONTROL, PI_CONTROL)}
 
 #: this many switches within CHATTER_WINDOW (relative) of time is chatter, not dynamics
 CHATTER_SWITCHES = 20
@@ -39,7 +59,7 @@ REACH_FACTOR = 2.0
 #: |alpha| beyond this is the singular 90 degrees of Eq. 11 (tan, sec)
 ANGLE_LIMIT = math.pi / 2 - 0.02
 METHODS = tuple(TABLEAUS)
-#: the step-size controller by default (a stepper.StepControl): the PI controller, which at equal
+#: the step-size controller by default (a StepControl): the PI controller, which at equal
 #: error takes less time than SciPy's on the contact ring-downs of docs/performance.md (fewer
 #: rejected attempts where DOP853's error estimate jumps with the vibration's phase)
 STEP_CONTROL = PI_CONTROL
@@ -103,7 +123,7 @@ class SolverOptions:
     max_step: float = math.inf
     events: EventSettings = field(default_factory=EventSettings)
     ledger: bool = False   # integrate the work of the drive, contact damping and friction
-    step_control: StepControl = STEP_CONTROL   # a stepper.StepControl, or its name ("pi", "scipy")
+    step_control: StepControl = STEP_CONTROL   # a StepControl, or its name ("pi", "scipy")
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -118,6 +138,12 @@ class SolverOptions:
         if not isinstance(self.events, EventSettings):
             raise ParameterError("events", self.events, "an EventSettings")
         object.__setattr__(self, "step_control", step_control(self.step_control))
+
+
+#: the tolerances of the periodic analyses (the stroboscopic map, shooting, continuation, tangent
+#: dynamics, Lyapunov exponents): their Newton tolerance and finite-difference steps are chosen
+#: from them (camdyn.orbits, camdyn.derivatives); the command line's default for them too
+MAP_OPTIONS = SolverOptions(rtol=1e-10, atol=1e-13)
 
 
 class Settings(NamedTuple):

@@ -4,9 +4,9 @@ compiled and the interpreted loop (:mod:`camdyn.engine.jit`).
 **The rules of a step, written once** for every state size: the error estimate's norm
 (:func:`rms`, and DOP853's blend of its 5th- and 3rd-order estimates, :func:`blended`), the
 first step's two guesses (:func:`first_guess`, :func:`second_guess`: SciPy's
-``select_initial_step``), the step-size controller as data (:class:`StepControl`: SciPy's
-integral controller and the PI controller) with the factors after an accepted and a rejected
-attempt (:func:`accepted_factor`, :func:`rejected_factor`), and the smallest step
+``select_initial_step``), the factors of the step-size controller (a
+:class:`~camdyn.engine.config.StepControl`: SciPy's integral controller or the PI controller)
+after an accepted and a rejected attempt (:func:`accepted_factor`, :func:`rejected_factor`), and the smallest step
 (:func:`min_step`).  The loop's 2-component state (below) and the tangent dynamics' augmented
 state (:mod:`.variational`) each sum their stages in their own arithmetic and call these.  (A
 stepper over state arrays of any size, one function for both, gives the loop's runs the same
@@ -30,7 +30,6 @@ times smaller, instead of poisoning the step size with NaN.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 from .jit import jitable
 
@@ -39,24 +38,6 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 
 
-class StepControl(NamedTuple):
-    """A step-size controller as data: after an accepted attempt the next step is the accepted
-    one times SAFETY err^(-a/k) err_prev^(b/k), k the error estimate's order + 1 (the method's
-    exponent is -1/k) and err_prev the previous accepted attempt's error (:func:`accepted_factor`)."""
-
-    name: str
-    a: float
-    b: float
-
-
-#: SciPy's integral controller (the accepted step's error alone: the steps are ``solve_ivp``'s)
-SCIPY_CONTROL = StepControl("scipy", 1.0, 0.0)
-#: the proportional-integral controller (Gustafsson, ACM TOMS 17, 1991; Hairer & Wanner, Solving
-#: ODEs II, Sec. IV.2), which also reads the previous accepted step's error and so damps the growth
-#: after a step whose estimate dipped
-PI_CONTROL = StepControl("pi", 0.7, 0.4)
-#: the controllers by name (the names SolverOptions accepts besides the objects)
-CONTROLS = {c.name: c for c in (SCIPY_CONTROL, PI_CONTROL)}
 #: the previous error a run's first step reads, and the least one any step passes on (Hairer's
 #: DOPRI codes' FACOLD): a tiny estimate does not unleash the next step's growth
 ERR_FLOOR = 1e-4

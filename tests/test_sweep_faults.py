@@ -17,7 +17,7 @@ import camdyn
 from camdyn import sweep as S
 from camdyn.cli import main
 from registry import RIG
-from sweep_faults import Faulty
+from sweep_faults import Faulty, WithDeathSignal
 
 xr = pytest.importorskip("xarray")
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -64,6 +64,50 @@ def test_dask_worker_killed_mid_sweep(serial, tmp_path):
         xr.testing.assert_equal(ds, serial)
         plain = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=client.get_executor(), chunksize=5, **KW)
     xr.testing.assert_identical(plain, serial)  # determinism on dask, attributes included
+
+
+class ClosingAfter:
+    """A dask executor whose client is closed (the cluster lost) when the sweep submits task
+    number ``n + 1``: the tasks in flight are cancelled and no more can be submitted."""
+
+    def __init__(self, client, n: int):
+        self._client, self.executor, self.n = client, client.get_executor(), n
+
+    def submit(self, *args, **kwargs):
+        if self.n == 0:
+            self._client.close()
+        self.n -= 1
+        return self.executor.submit(*args, **kwargs)
+
+
+def test_dask_cluster_lost_mid_sweep_records_not_run_and_resume_runs_them(serial, tmp_path, caplog):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "map.nc"
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+    with cluster:
+        client = distributed.Client(cluster)
+        ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=ClosingAfter(client, 4), chunksize=1, out=out, **KW)
+    lost = ds["outcome"] == NOT_RUN
+    assert 8 <= int(lost.sum()) < 12 and int((ds["outcome"] == 0).sum()) == 12 - int(lost.sum())
+    assert all("ClosedClientError" in m for m in ds["message"].values[lost.values])
+    assert f"{int(lost.sum())} of 12 points could not run: recorded as NOT_RUN" in caplog.text
+    assert (tmp_path / "map.nc.parts").is_dir()
+    xr.testing.assert_identical(S.resume(out, progress=False), serial)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's prctl")
+def test_process_pool_workers_end_with_their_parent_also_after_a_break(tmp_path):
+    """Every point ran in a worker that the kernel kills when the sweep's process dies: those of
+    process_pool, and those of the pool that replaces it after a worker died."""
+    marker = tmp_path / "killed"
+    with S.process_pool(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, WithDeathSignal(1100.0, "exit_once", str(marker)), executor=pool,
+                     chunksize=1, **KW)
+    assert marker.exists() and (ds["outcome"] == 0).all()
+    assert (ds["death_signal"] == signal.SIGKILL).all()
+    with ProcessPoolExecutor(1) as plain:  # the check can fail: a plain pool's workers have none
+        ds = S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, WithDeathSignal(0.0, ""), executor=plain, **KW)
+    assert (ds["death_signal"] == 0).all()
 
 
 # --- interrupted, then resumed ----------------------------------------------------------------------

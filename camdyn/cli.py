@@ -11,7 +11,8 @@ shows it).  Exit codes, for scripts:
   1  a check failed (``regenerate --check``: generated/ differs from what derive/ produces)
   2  bad input: an unknown option or value, an invalid rig or parameter, an unreadable
      or unwritable file, a scene that is not generated
-  3  a simulation stopped before the end (see its outcome: chatter, angle limit, ...);
+  3  a simulation stopped before the end (see its outcome: chatter, angle limit, ...), or
+     a sweep has points that did not succeed (not those skipped with --skip-invalid);
      whatever was computed is still written
   4  an optional part is missing: matplotlib for plots (``pip install "camdyn[plot]"``),
      SymPy for regenerate (``camdyn[derive]``), or a module not installed in this version
@@ -44,8 +45,9 @@ EXIT_INTERRUPTED, EXIT_BROKEN_PIPE = 130, 141
 
 EXIT_CODES_HELP = """exit codes:
   0 success; 1 a check failed (regenerate --check); 2 bad input; 3 a simulation stopped
-  early (outputs still written); 4 an optional part is missing (matplotlib, SymPy, ...);
-  5 internal error (please report, with --traceback); 130 interrupted; 141 output pipe closed"""
+  early, or sweep points did not succeed (outputs still written); 4 an optional part is
+  missing (matplotlib, SymPy, ...); 5 internal error (please report, with --traceback);
+  130 interrupted; 141 output pipe closed"""
 
 
 class UsageError(CamdynError, ValueError):
@@ -642,8 +644,9 @@ def _sweep_module():
 
 
 @contextlib.contextmanager
-def _executor(args):
-    """None (serial), a local process pool (--jobs N), or a dask cluster (--dask ADDRESS)."""
+def _executor(args, sweeps):
+    """None (serial), a local process pool (--jobs N: its workers end with this process, even
+    killed), or a dask cluster (--dask ADDRESS)."""
     if args.dask:
         try:
             from distributed import Client
@@ -652,9 +655,7 @@ def _executor(args):
         with Client(args.dask) as client:
             yield client.get_executor()
     elif args.jobs > 1:
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(args.jobs) as pool:
+        with sweeps.process_pool(args.jobs) as pool:
             yield pool
     else:
         yield None
@@ -694,8 +695,8 @@ def cmd_sweep(args) -> int:
     solver = dict(method=args.method, rtol=args.rtol, atol=args.atol)
     if args.backend:
         solver["backend"] = args.backend
-    with _executor(args) as executor, _sweep_interrupted(args.out):
-        common = dict(executor=executor, progress=_sweep_progress(args), out=args.out,
+    with _executor(args, sweeps) as executor, _sweep_interrupted(args, args.out):
+        common = dict(executor=executor, progress=_sweep_progress(args), out=args.out, overwrite=args.overwrite,
                       invalid="skip" if args.skip_invalid else "raise", **solver)
         try:
             ds = _new_sweep(sweeps, args, rig, scene, speeds, values, common)
@@ -705,19 +706,143 @@ def cmd_sweep(args) -> int:
                              "--skip-invalid runs the others") from None
     if args.out:
         print(f"  wrote {args.out}")
-    return _sweep_report(ds, args, sweeps)
+    return _sweep_report(ds, args, sweeps, args.out)
 
 
 def _resume_sweep(sweeps, args) -> int:
-    if args.speeds or args.param or args.values or args.out:
-        raise UsageError("--resume FILE takes the grid, rig, scene and settings from FILE's sweep; "
-                         "give only --jobs, --dask, --plot")
+    """--resume FILE: the sweep's own grid, rig, scene and settings; the options that say how to
+    run it apply, and any other option typed must match the sweep's (else it is refused)."""
+    attrs, grid = sweeps.settings_of(args.resume)   # a file that is not a sweep is refused here
+    applied, matched = _resume_options(args, attrs, grid, sweeps)
     _check_outputs(args, "plot")
-    running = Path(args.resume + ".parts").exists()
-    with _executor(args) as executor, _sweep_interrupted(args.resume):
+    running = sweeps.parts_folder(args.resume).exists()
+    if running:
+        sweeps.refuse_if_in_use(args.resume)
+        print(f"  resuming {args.resume} with its own grid, rig, scene and settings"
+              + (f"; applied: {', '.join(applied)}" if applied else "")
+              + (f"; the same as the sweep's: {', '.join(matched)}" if matched else ""))
+    with _executor(args, sweeps) as executor, _sweep_interrupted(args, args.resume):
         ds = sweeps.resume(args.resume, executor=executor, progress=_sweep_progress(args))
     print(f"  wrote {args.resume}" if running else f"  {args.resume} was complete: nothing to run")
-    return _sweep_report(ds, args, sweeps)
+    return _sweep_report(ds, args, sweeps, args.resume)
+
+
+#: sweep options that say how to run a resumed sweep, or what to draw: --resume applies them
+_RESUME_APPLIES = ("resume", "jobs", "dask", "plot")
+
+
+def _resume_options(args, attrs: dict, grid: dict, sweeps) -> tuple[list[str], list[str]]:
+    """(the options typed that --resume applies, those that match the sweep's own settings);
+    UsageError naming the first that differs from the sweep's (or that makes no sense there)."""
+    applied, matched = [], []
+    recorded = _recorded_settings(attrs, grid, args.resume, sweeps)
+    for dest in _typed_options(args):
+        flag = _flag(args, dest)
+        if dest in _RESUME_APPLIES:
+            applied += [] if dest == "resume" else [_shown_option(args, dest, flag)]
+        elif dest not in recorded:
+            raise UsageError(f"{flag} starts a new sweep: it does not go with --resume, which continues "
+                             f"{args.resume} as it was started")
+        elif not _same_setting(typed := _typed_setting(args, dest), recorded[dest]):
+            raise UsageError(f"{_shown_option(args, dest, flag)}: {args.resume} was swept "
+                             f"{_recorded_text(dest, recorded[dest], typed)}; --resume takes every setting from "
+                             f"it: drop {flag} (or start a new sweep to change it)")
+        else:
+            matched.append(flag)
+    return applied, matched
+
+
+def _typed_options(args) -> list[str]:
+    """The sweep options typed on the command line (dests), not their defaults: the command line
+    read again with every default of the command suppressed."""
+    parser = _parser()
+    command = parser.commands[args.command]
+    argv = getattr(args, "argv", None)
+    if argv is None:   # called without main(): the options that differ from their defaults
+        return [a.dest for a in command._actions if a.dest != "help" and getattr(args, a.dest, None) != a.default]
+    for action in command._actions:
+        action.default = argparse.SUPPRESS
+        if isinstance(action, _FileOption):
+            action.deprecated_for = None   # said once already
+    typed = parser.parse_args(argv)
+    return [a.dest for a in command._actions if a.dest != "help" and hasattr(typed, a.dest)]
+
+
+def _recorded_settings(attrs: dict, grid: dict, out: str, sweeps) -> dict:
+    """The resumed sweep's settings as the sweep options would give them, by option dest."""
+    import dataclasses
+
+    from .scene import Scene
+
+    param = next((name for name in grid if name != "speed_rpm"), None)
+    recorded = {f.name: attrs.get(f"scene_{f.name}") for f in dataclasses.fields(Scene)}
+    recorded.update({name: attrs.get(f"simulate_{name}") for name in ("revolutions", "method", "rtol", "atol",
+                                                                         "backend")})
+    recorded.update(transient_revolutions=attrs.get("measure_transient_revolutions"),
+                    samples_per_revolution=attrs.get("samples_per_revolution"), no_stop="simulate_stop" not in attrs,
+                    speeds=grid.get("speed_rpm"), param=param, values=grid.get(param), out=Path(out),
+                    rig=sweeps.rig_of(attrs))
+    return recorded
+
+
+def _typed_setting(args, dest: str):
+    """An option's value in the terms of :func:`_recorded_settings`."""
+    if dest == "rig":
+        return _rig(args)
+    if dest in ("speeds", "values"):
+        return _parse_values(getattr(args, dest), "--" + dest)
+    return Path(args.out) if dest == "out" else getattr(args, dest)
+
+
+def _same_setting(typed, recorded) -> bool:
+    import numpy as np
+
+    from .rig import PARAMETERS
+
+    if hasattr(recorded, "k_s"):  # a rig: the same physics (its name may differ)
+        return all(getattr(typed, p.name) == getattr(recorded, p.name) for p in PARAMETERS)
+    if isinstance(recorded, Path):
+        return typed.resolve() == recorded.resolve()
+    if isinstance(typed, list) or isinstance(recorded, np.ndarray):
+        return recorded is not None and np.array_equal(np.asarray(typed, dtype=float), np.asarray(recorded))
+    if isinstance(typed, (int, float)) and not isinstance(typed, bool) and recorded is not None:
+        return not isinstance(recorded, str) and float(typed) == float(recorded)
+    return typed == recorded
+
+
+def _shown_option(args, dest: str, flag: str) -> str:
+    value = getattr(args, dest)
+    return flag if isinstance(value, bool) else f"{flag} {value}"
+
+
+def _recorded_text(dest: str, value, typed) -> str:
+    """How the resumed sweep was run, for 'FILE was swept ...' (``typed``: the option's value)."""
+    import numpy as np
+
+    from .rig import PARAMETERS
+
+    if hasattr(value, "k_s"):
+        name = next(p.name for p in PARAMETERS if getattr(typed, p.name) != getattr(value, p.name))
+        return f"on rig {value.name!r}, whose {name} is {getattr(value, name)!r} (not {getattr(typed, name)!r})"
+    if isinstance(value, bool):
+        return "with it" if value else "without it"
+    if isinstance(value, Path):
+        return f"into {value}"
+    if isinstance(value, np.ndarray):
+        return f"over {value.size} values of {dest}, {value.min():g} to {value.max():g}"
+    if value is None:
+        return f"without {dest}"
+    return f"with {dest} = " + (repr(value) if isinstance(value, str) else f"{value:g}")
+
+
+def _resume_command(args, out) -> str:
+    """The command that resumes ``out`` with the options of this one that say how to run it."""
+    import shlex
+
+    words = ["camdyn"] + (["--no-progress"] if args.no_progress else []) + ["sweep", "--resume", str(out)]
+    words += (["--jobs", str(args.jobs)] if args.jobs > 1 else []) + (["--dask", args.dask] if args.dask else [])
+    words += ["--plot", args.plot] if args.plot else []
+    return shlex.join(words)
 
 
 def _new_sweep(sweeps, args, rig, scene, speeds, values, common):
@@ -744,34 +869,42 @@ def _sweep_progress(args) -> bool:
 
 
 @contextlib.contextmanager
-def _sweep_interrupted(out):
-    """On Ctrl-C, say where the finished points are and how to go on."""
+def _sweep_interrupted(args, out):
+    """On Ctrl-C, say where the finished points are and how to go on (with this run's options)."""
     try:
         yield
     except KeyboardInterrupt:
         if out:
-            print(f"camdyn: the finished points are kept in {out}.parts; 'camdyn sweep --resume {out}' runs the rest",
+            print(f"camdyn: the finished points are kept in {out}.parts; '{_resume_command(args, out)}' runs the rest",
                   file=sys.stderr)
         raise
 
 
-def _sweep_report(ds, args, sweeps) -> int:
-    """Print what the sweep found, plot it; exit 3 if any point did not succeed."""
+def _sweep_report(ds, args, sweeps, out) -> int:
+    """Print what the sweep found, plot it; exit 3 if a point did not succeed (a point skipped as
+    INVALID, as --skip-invalid asked, is not a failure)."""
     import numpy as np
 
     rig, scene = sweeps.rig_of(ds.attrs), sweeps.scene_of(ds.attrs)
     names = _outcome_names(ds)
-    success = next((c for c, n in names.items() if n == "SUCCESS"), 0)
-    ok = ds["outcome"].values == success
+    codes = {name: code for code, name in names.items()}
+    outcome = ds["outcome"].values
+    ok, skipped = outcome == codes.get("SUCCESS", 0), outcome == codes.get("INVALID")
     impacts = ds["impacts_per_rev"].values if "impacts_per_rev" in ds else np.zeros(ok.shape)  # an API sweep's measure
     impacting = np.nan_to_num(impacts) > 0
-    regimes = np.where(ok, impacting.astype(int), 2)
-    failed = int(np.sum(~ok))
-    print(f"sweep of {scene.slug} on rig {rig.name!r}: {regimes.size} runs, "
-          f"{int(np.sum(regimes == 0))} without impacts after the transient, {int(np.sum(regimes == 1))} impacting, "
-          f"{failed} did not succeed")
-    for code in sorted(set(ds["outcome"].values.ravel().tolist()) - {success}):
-        print(f"  {int(np.sum(ds['outcome'].values == code))} {names.get(int(code), code)}")
+    regimes = np.where(ok, np.where(impacting, "impacting", "sliding"), np.where(skipped, "skipped", "failed"))
+    failed = int(np.sum(~ok & ~skipped))
+    print(f"sweep of {scene.slug} on rig {rig.name!r}: {outcome.size} points, "
+          f"{int(np.sum(ok & ~impacting))} without impacts after the transient, {int(np.sum(ok & impacting))} "
+          f"impacting, " + (f"{int(np.sum(skipped))} skipped as invalid (--skip-invalid), " if skipped.any() else "")
+          + f"{failed} did not succeed")
+    for code in sorted(set(outcome.ravel().tolist()) - {codes.get("SUCCESS", 0)}):
+        print(f"  {int(np.sum(outcome == code))} {names.get(int(code), code)}")
+    if "revolutions_run_total" in ds.attrs:
+        print(f"  {sweeps.stop_summary(ds)}")
+    not_run = int(np.sum(outcome == codes.get("NOT_RUN")))
+    if not_run and out:
+        print(f"  the {not_run} NOT_RUN points are kept for later: '{_resume_command(args, out)}' runs them")
     if args.plot:
         if "alpha_section" not in ds and (ds["outcome"].ndim != 2 or "speed_rpm" not in ds.dims):
             raise UsageError("--plot draws a bifurcation sweep or a (parameter, speed_rpm) map, not this sweep")
@@ -780,6 +913,7 @@ def _sweep_report(ds, args, sweeps) -> int:
 
 
 def _sweep_plot(ds, rig, scene, regimes):
+    """The bifurcation diagram or the map; points skipped as invalid are left out of its axes."""
     from .metadata import describe_scene
 
     plots = _plot_modules()
@@ -798,7 +932,8 @@ def _sweep_plot(ds, rig, scene, regimes):
 
     alpha_star = static_equilibrium(rig, scene.contact).alpha
     span = f"{ds.attrs.get('measure_transient_revolutions', 0):g}-{ds.attrs.get('simulate_revolutions', 0):g}"
-    return plots.bifurcation(speeds, ds["alpha_section"].values, relative_to=alpha_star,
+    ran = regimes != "skipped"
+    return plots.bifurcation(speeds[ran], ds["alpha_section"].values[ran], relative_to=alpha_star,
                              contact_loss_rpm=contact_loss_speed(rig), title=f"{title}: revolutions {span}")
 
 
@@ -1273,9 +1408,14 @@ def _parser() -> argparse.ArgumentParser:
     _add_solver(g)
     _add_file(g, "--netcdf", "netcdf", "save the sweep as NetCDF (.nc), streaming to FILE.parts/ meanwhile", dest="out")
     _add_file(g, "--out", "netcdf", argparse.SUPPRESS, deprecated_for="--netcdf")
-    _add_file(g, "--resume", "netcdf", "continue the interrupted sweep whose --netcdf was FILE")
+    _add_file(g, "--resume", "netcdf", "continue the interrupted sweep whose --netcdf was FILE, with its own grid, "
+                                       "rig, scene and settings (--jobs, --dask, --plot apply; another option must "
+                                       "match the sweep's)")
+    g.add_argument("--overwrite", action="store_true",
+                   help="replace an existing --netcdf FILE (never replaced otherwise)")
     g.add_argument("--skip-invalid", action="store_true", dest="skip_invalid",
-                   help="record invalid grid points (outcome INVALID) and run the others")
+                   help="record invalid grid points (outcome INVALID) and run the others; they are left out of "
+                        "the plot and of the exit code")
     _add_file(g, "--plot", "plot", "save the bifurcation diagram or contact map (.png, .pdf, .svg...)")
 
     p = command("continue", "follow a branch of periodic orbits in cam speed or a rig parameter, with its bifurcations",

@@ -67,9 +67,10 @@ QUANTITIES = {name: (symbol, _units(name)) for name, symbol in _SYMBOLS.items()}
 MIN_FONT_PT = 8.5
 _PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
 _SCALABLE = {"rad", "m", "m/s", "N", "J", "W"}
-#: regime codes of contact_map, with their colours
-REGIME_CODES = {"sliding": 0, "impacting": 1, "failed": 2}
-_REGIME_COLOURS = ("#cfe3f3", "#f4b183", "#bfbfbf")
+#: regime codes of contact_map, with their colours ("skipped": a point not run on purpose, e.g. a
+#: sweep's INVALID point with invalid="skip"; rows and columns of nothing else are left out)
+REGIME_CODES = {"sliding": 0, "impacting": 1, "failed": 2, "skipped": 3}
+_REGIME_COLOURS = ("#cfe3f3", "#f4b183", "#bfbfbf", "#ffffff")
 _FREE_SHADE = "0.9"
 _MAX_HARMONIC_LINES = 60
 
@@ -498,8 +499,10 @@ def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_
     """Contact regimes over the (cam speed, k_s) plane, as in Fig. 9.
 
     ``regime[i, j]`` is the regime at ``k_s[i]``, ``speed_rpm[j]``: a code of
-    :data:`REGIME_CODES` (0 sliding, 1 impacting, 2 failed) or its name.  ``loss_curve=(speeds,
-    k_s)`` overlays a curve, e.g. the contact-loss speed by inverse kinematics for each k_s.
+    :data:`REGIME_CODES` (0 sliding, 1 impacting, 2 failed, 3 skipped; NaN: failed) or its name.
+    A row or column of skipped points only is left out of the axes (and of ``loss_curve``'s
+    k_s range); other skipped points are drawn blank.  ``loss_curve=(speeds, k_s)`` overlays a
+    curve, e.g. the contact-loss speed by inverse kinematics for each k_s.
     """
     _pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap
@@ -514,12 +517,14 @@ def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_
         raise ValueError(f"regime has shape {codes.shape}; expected (len(k_s), len(speed_rpm)) = "
                          f"{(ks.size, speeds.size)}")
     codes = np.where(np.isfinite(codes), codes, REGIME_CODES["failed"])
+    speeds, ks, codes, loss_curve = _without_skipped(speeds, ks, codes, loss_curve)
     with _style():
         fig, (ax,) = _figure(ax, figsize=(5.6, 3.8))
         cmap = ListedColormap(_REGIME_COLOURS)
-        ax.pcolormesh(speeds, ks, codes, cmap=cmap, norm=BoundaryNorm([-0.5, 0.5, 1.5, 2.5], 3), shading="nearest")
-        handles = [Patch(color=_REGIME_COLOURS[c], label=name) for name, c in REGIME_CODES.items()
-                   if np.any(codes == c)]
+        bounds = np.arange(len(_REGIME_COLOURS) + 1) - 0.5
+        ax.pcolormesh(speeds, ks, codes, cmap=cmap, norm=BoundaryNorm(bounds, len(_REGIME_COLOURS)), shading="nearest")
+        handles = [Patch(facecolor=_REGIME_COLOURS[c], edgecolor="0.6" if name == "skipped" else _REGIME_COLOURS[c],
+                         label=name) for name, c in REGIME_CODES.items() if np.any(codes == c)]
         if loss_curve is not None:
             ls, lk = (np.asarray(v, dtype=float) for v in loss_curve)
             handles.append(ax.plot(ls, lk, color="k", lw=1.2, label="contact loss (inverse kinematics)")[0])
@@ -533,6 +538,23 @@ def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_
         if title:
             ax.set_title(title)
     return fig
+
+
+def _without_skipped(speeds, ks, codes, loss_curve):
+    """contact_map's grid without the rows and columns that hold skipped points only; the loss
+    curve within the k_s range left."""
+    skipped = codes == REGIME_CODES["skipped"]
+    rows, columns = ~skipped.all(axis=1), ~skipped.all(axis=0)
+    if rows.all() and columns.all():
+        return speeds, ks, codes, loss_curve
+    if not rows.any():
+        raise ValueError("every point of the map is skipped: nothing to draw")
+    ks, speeds, codes = ks[rows], speeds[columns], codes[rows][:, columns]
+    if loss_curve is not None:
+        ls, lk = (np.asarray(v, dtype=float) for v in loss_curve)
+        inside = (lk >= ks.min()) & (lk <= ks.max())
+        loss_curve = (ls[inside], lk[inside])
+    return speeds, ks, codes, loss_curve
 
 
 def work_precision(records, *, ax=None, title: str | None = None, error_label: str = "error"):

@@ -108,7 +108,11 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     result = _result(model, traj, backend)
     if watch is None:
         return result
-    result.stats["revolutions_run"] = round((result.t[-1] - t_start) / model.period, 6) if result.t.size else 0.0
+    # integrated up to: the end, unless it stopped (periodic, or early: its last sample); the last
+    # sample of a run to the end can fall a sample interval short of it (the samples' rounding)
+    ran_to = t_start + duration if result.ok and not traj.stats.get("stopped") else \
+        (result.t[-1] if result.t.size else t_start)
+    result.stats["revolutions_run"] = round((ran_to - t_start) / model.period, 6)
     result.stats["stop_period"] = watch.period if traj.stats.get("stopped") else 0
     if traj.stats.get("stopped"):
         # the samples the full run would have: the engine gives none past t_end (one rounded beyond it)

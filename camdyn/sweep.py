@@ -19,8 +19,15 @@ Sweeps at scale lose nothing:
 * with ``out="map.nc"`` the finished chunks stream to ``map.nc.parts/`` as they complete
   (:mod:`camdyn.sweep_store`); after Ctrl-C, a crash or a killed process, :func:`resume`
   runs only the missing points, and the result equals an uninterrupted sweep's;
+* ``out`` is checked before any work: a folder, a missing or read-only parent folder, and a
+  finished file (unless ``overwrite=True``) are refused; the process writing ``map.nc.parts/``
+  holds its lock, so a second sweep or resume of it is refused while the first runs (a killed
+  process releases it); a file that is not a camdyn sweep is refused by :func:`resume`
+  (:class:`NotASweepError`);
 * a worker that dies costs a retry of its chunk (:mod:`camdyn.sweep_run`); a chunk that
-  cannot run is recorded as NOT_RUN and the sweep says so (a warning on ``camdyn.sweep``);
+  cannot run, also because the executor or its dask cluster was lost, is recorded as NOT_RUN
+  and the sweep says so (a warning on ``camdyn.sweep``); :func:`resume` runs it later;
+  the workers of :func:`process_pool` end when the sweep's process dies;
 * the Dataset is the same serially (``executor=None``), on local processes
   (``ProcessPoolExecutor``) or on a dask cluster (``distributed.Client(...).get_executor()``),
   for any chunk size and worker count: each point's values depend only on the point;
@@ -53,9 +60,10 @@ from .scene import Scene
 from .simulation import BACKENDS
 from .stopping import StopWhenPeriodic
 from .sweep_check import InvalidGridError, check_by_running, check_grid, check_settings
-from .sweep_run import Dispatch, chunks_of, run_serial, worker_count
+from .sweep_run import Dispatch, chunks_of, process_pool, run_serial, worker_count
 from .sweep_spec import ALL_CODES, ERROR, INVALID, NOT_RUN, OUTCOME_CODES, SweepSpec, chunk_of, grid_axes
-from .sweep_store import FolderStore, MemoryStore, StoreError, assemble, done_mask, parts_folder, rig_of, scene_of
+from .sweep_store import (FolderStore, MemoryStore, NotASweepError, StoreError, assemble, check_out, done_mask,
+                          load_sweep, parts_folder, refuse_if_in_use, rig_of, scene_of, stop_summary)
 
 log = logging.getLogger("camdyn.sweep")
 
@@ -125,8 +133,8 @@ def _whole(value, least: int) -> bool:
 
 def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: Callable = Summary(), *,
           executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
-          samples_per_revolution: int | None = None, out=None, invalid: str = "raise", retries: int = 2,
-          stop: StopWhenPeriodic | None = None, **simulate_kwargs):
+          samples_per_revolution: int | None = None, out=None, overwrite: bool = False, invalid: str = "raise",
+          retries: int = 2, stop: StopWhenPeriodic | None = None, **simulate_kwargs):
     """Simulate every point of ``grid`` and measure it (see the module doc).
 
     Parameters
@@ -149,7 +157,11 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
         Each point's sample rate from its own cam period (1: a Poincare section).
     out : str or os.PathLike, optional
         A netCDF file to write.  The finished chunks stream to the folder ``<out>.parts``
-        while the sweep runs; an interrupted sweep is continued by :func:`resume`.
+        while the sweep runs; an interrupted sweep is continued by :func:`resume`.  Checked
+        before any work (:class:`StoreError`): not a folder, in a writable folder, and not an
+        existing file unless ``overwrite``.
+    overwrite : bool
+        Replace an existing ``out`` (when the sweep has finished; until then it is kept).
     invalid : {"raise", "skip"}
         A grid with points that cannot run: "raise" refuses to start and lists every one
         (:class:`InvalidGridError`); "skip" records them as INVALID and runs the others.
@@ -179,7 +191,7 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
                                  "every samples_per_revolution-th sample)")
         simulate_kwargs = {**simulate_kwargs, "stop": stop}
     spec = _spec(rig, scene, grid, measure, samples_per_revolution, simulate_kwargs)
-    return _start(spec, out, invalid, _RunOptions(executor, progress, chunksize, retries))
+    return _start(spec, _Output(out, overwrite), invalid, _RunOptions(executor, progress, chunksize, retries))
 
 
 def resume(out, *, executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
@@ -189,23 +201,35 @@ def resume(out, *, executor: Executor | None = None, progress: bool = True, chun
 
     The grid, rig, scene, measure and settings come from the folder; ``executor``,
     ``progress``, ``chunksize`` and ``retries`` are as in :func:`sweep` and may differ from
-    the first run's.  A sweep that already finished returns its file's Dataset.
+    the first run's.  A sweep that already finished returns its file's Dataset.  A folder that
+    another process is writing (its lock is held) is refused with :class:`StoreError`, a file
+    that is not a camdyn sweep with :class:`NotASweepError`.
     """
     options = _RunOptions(executor, progress, chunksize, retries)
     if not parts_folder(out).exists() and Path(out).is_file():
-        import xarray as xr
-
         log.info("%s is complete: nothing to resume", out)
-        return xr.load_dataset(out, engine="scipy")
-    store = FolderStore.open(out)
-    return _run(store.spec(), store, options)
+        return load_sweep(out)
+    with FolderStore.open(out) as store:
+        return _run(store.spec(), store, options)
 
 
 def load_partial(out):
     """The Dataset of an unfinished sweep writing ``out``, as far as it got: the points not
-    run yet are NOT_RUN (NaN values).  Nothing runs."""
-    store = FolderStore.open(out)
+    run yet are NOT_RUN (NaN values).  Nothing runs (and nothing is locked)."""
+    store = FolderStore.open(out, lock=False)
     return assemble(store.spec(), store.chunks())
+
+
+def settings_of(out) -> tuple[dict, dict[str, np.ndarray]]:
+    """(attributes, grid) of the sweep writing ``out`` (its folder's manifest) or written to it
+    (the file's attributes and coordinates): how it was run, without running or locking it."""
+    if parts_folder(out).exists():
+        manifest = FolderStore.open(out, lock=False).manifest()
+        return manifest["attributes"], {k: np.asarray(v, dtype=float) for k, v in manifest["grid"].items()}
+    if not Path(out).is_file():
+        raise StoreError(f"{out}: no sweep to resume (neither the file nor {parts_folder(out)} exists)")
+    ds = load_sweep(out)
+    return dict(ds.attrs), {name: ds[name].values for name in ds.attrs["grid"].split()}
 
 
 def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finish=None) -> SweepSpec:
@@ -230,10 +254,28 @@ def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finis
     return SweepSpec(rig, scene, axes, measure, kwargs, samples_per_revolution, finish)
 
 
-def _start(spec: SweepSpec, out, invalid: str, options: _RunOptions):
-    """Check every point, then run the sweep into memory or into ``out``'s folder."""
+@dataclass(frozen=True)
+class _Output:
+    """Where a sweep goes: the file ``out`` (None: memory only), and whether it may replace one."""
+
+    out: object = None
+    overwrite: bool = False
+
+    def check(self) -> None:
+        if not isinstance(self.overwrite, bool):
+            raise ParameterError("overwrite", self.overwrite, "True or False")
+        if self.out is not None:
+            check_out(self.out, self.overwrite)
+
+    def store(self, spec: SweepSpec):
+        return MemoryStore() if self.out is None else FolderStore.create(self.out, spec, self.overwrite)
+
+
+def _start(spec: SweepSpec, output: _Output, invalid: str, options: _RunOptions):
+    """Check the output and every point, then run the sweep into memory or into the output's folder."""
     if invalid not in ("raise", "skip"):
         raise ParameterError("invalid", invalid, "'raise' or 'skip'")
+    output.check()
     check_settings(spec)
     bad, lines = check_grid(spec)
     if bad and invalid == "raise":
@@ -241,17 +283,17 @@ def _start(spec: SweepSpec, out, invalid: str, options: _RunOptions):
     first = next((i for i in range(spec.size) if i not in bad), None)
     if first is not None:
         check_by_running(spec, first)
-    if out is not None or isinstance(options.executor, ProcessPoolExecutor):
+    if output.out is not None or isinstance(options.executor, ProcessPoolExecutor):
         try:
             pickle.dumps(spec)
         except Exception as exc:
             raise TypeError(f"the sweep's measure and settings must be picklable to run in other processes "
                             f"or to be resumed ({type(exc).__name__}: {exc})") from None
-    store = FolderStore.create(out, spec) if out is not None else MemoryStore()
-    if bad:
-        indices = sorted(bad)
-        store.put(chunk_of(indices, [(INVALID, bad[i], {}) for i in indices]))
-    return _run(spec, store, options)
+    with output.store(spec) as store:
+        if bad:
+            indices = sorted(bad)
+            store.put(chunk_of(indices, [(INVALID, bad[i], {}) for i in indices]))
+        return _run(spec, store, options)
 
 
 def _run(spec: SweepSpec, store, options: _RunOptions):
@@ -298,12 +340,12 @@ class _Progress:
 
 def _report(ds, store) -> None:
     codes = ds["outcome"].values
-    errors, not_run = int(np.sum(codes == ERROR)), int(np.sum(codes == NOT_RUN))
+    errors, not_run, skipped = (int(np.sum(codes == c)) for c in (ERROR, NOT_RUN, INVALID))
     if "revolutions_run_total" in ds.attrs:
-        a = ds.attrs
-        log.info("stopped once periodic: %d of %d points; %.6g of %.6g revolutions run (%.1f %%)",
-                 a["points_stopped_converged"], codes.size, a["revolutions_run_total"],
-                 a["revolutions_requested_total"], 100 * a["revolutions_run_total"] / a["revolutions_requested_total"])
+        log.info("%s", stop_summary(ds))
+    if skipped:
+        log.info("%d of %d points skipped as INVALID (invalid='skip'; the message variable says why)", skipped,
+                 codes.size)
     if errors:
         log.warning("%d of %d points raised: recorded as ERROR (the message variable says why)", errors, codes.size)
     if not_run:
@@ -331,14 +373,15 @@ def bifurcation(rig: Rig, scene: Scene, speeds_rpm: Sequence[float], *, revoluti
 def contact_loss_map(rig: Rig, scene: Scene, k_s: Sequence[float], speeds_rpm: Sequence[float], *,
                      revolutions: float = 6, transient_revolutions: float = 3, samples_per_revolution: int = 64,
                      executor: Executor | None = None, progress: bool = True, chunksize: int | None = None,
-                     out=None, invalid: str = "raise", retries: int = 2, **simulate_kwargs):
+                     out=None, overwrite: bool = False, invalid: str = "raise", retries: int = 2,
+                     **simulate_kwargs):
     """Where the follower leaves the cam: ``impacts_per_rev`` over (k_s, speed_rpm) from simulation,
     ``contact_lost`` (1 with impacts after the transient, 0 without, NaN where the run did not
     succeed), and ``loss_speed_predicted`` (k_s), the inverse-kinematics contact-loss speed
     (Section 6) -- the curve of the paper's Fig. 9.  Other keywords as in :func:`sweep`."""
     spec = _spec(rig, scene, {"k_s": k_s, "speed_rpm": speeds_rpm}, Summary(transient_revolutions),
                  samples_per_revolution, {"revolutions": revolutions, **simulate_kwargs}, finish=add_contact_loss)
-    return _start(spec, out, invalid, _RunOptions(executor, progress, chunksize, retries))
+    return _start(spec, _Output(out, overwrite), invalid, _RunOptions(executor, progress, chunksize, retries))
 
 
 def add_contact_loss(ds, spec: SweepSpec):
@@ -361,5 +404,7 @@ def _loss_speed(rig: Rig, k_s: float) -> float:
         return math.nan
 
 
-__all__ = ["sweep", "resume", "StopWhenPeriodic", "load_partial", "Summary", "PoincareSection", "bifurcation", "contact_loss_map",
-           "InvalidGridError", "StoreError", "ALL_CODES", "rig_of", "scene_of"]
+__all__ = ["sweep", "resume", "StopWhenPeriodic", "load_partial", "load_sweep", "settings_of", "process_pool",
+           "Summary", "PoincareSection", "bifurcation", "contact_loss_map", "InvalidGridError", "StoreError",
+           "NotASweepError", "ALL_CODES", "rig_of", "scene_of", "stop_summary", "check_out", "parts_folder",
+           "refuse_if_in_use"]

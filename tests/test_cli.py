@@ -131,7 +131,7 @@ def test_sweep_bifurcation_and_contact_map(tmp_path, capsys):
         assert ds["alpha_section"].shape == (2, 3)  # after revolutions 2, 3, 4
         assert np.all(np.isfinite(ds["alpha_section"].values))
         assert np.all(ds["impacts_per_rev"].values > 0)
-    assert "2 runs" in capsys.readouterr().out
+    assert "2 points" in capsys.readouterr().out
     nc2, png2 = tmp_path / "map.nc", tmp_path / "map.png"
     assert main(["sweep", "--speeds", "1200,1500", "--param", "k_s", "--values", "200,400",
                  "--revolutions", "2", "--transient-revolutions", "1", "--samples-per-revolution", "20",

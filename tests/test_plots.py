@@ -133,6 +133,21 @@ def test_contact_map_codes_names_and_loss_curve(tmp_path):
     saves(fig, tmp_path)
 
 
+def test_contact_map_leaves_skipped_points_out():
+    """A column of skipped points (a speed out of range, skipped by the sweep) is not on the axes;
+    a skipped point among others is drawn as skipped, not failed; the curve stays on the map."""
+    speeds, ks = np.array([100.0, 200.0, 1e6]), np.array([1e3, 1e4, 1e7])
+    regime = np.array([["sliding", "impacting", "skipped"], ["skipped", "sliding", "skipped"],
+                       ["skipped", "skipped", "skipped"]])
+    fig = plots.contact_map(speeds, ks, regime, loss_curve=([150, 250, 300], [1e3, 1e4, 1e7]))
+    ax = fig.axes[0]
+    assert ax.get_xlim()[1] < 1e3 and ax.get_ylim()[1] < 1e6
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "sliding", "impacting", "skipped", "contact loss (inverse kinematics)"]
+    with pytest.raises(ValueError, match="every point of the map is skipped"):
+        plots.contact_map(speeds[:1], ks[:1], [["skipped"]])
+
+
 def test_work_precision_is_log_log_with_tolerances(tmp_path):
     records = [{"label": "DOP853", "error": e, "seconds": s, "rtol": r}
                for e, s, r in [(1e-6, 1.0, 1e-6), (1e-9, 2.0, 1e-9)]]

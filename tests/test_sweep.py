@@ -4,16 +4,20 @@ every point checked first, a failing point recorded, results streamed to a self-
 from __future__ import annotations
 
 import math
+import os
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import camdyn
 from camdyn import sweep as S
-from camdyn.errors import ParameterError
+from camdyn.errors import CamdynError, ParameterError
+from camdyn.files import write_netcdf
+from camdyn.sweep_store import TITLE, FolderStore
 from registry import RIG
-from sweep_faults import Faulty
+from sweep_faults import Faulty, InterruptAfter
 
 xr = pytest.importorskip("xarray")
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -248,3 +252,129 @@ def test_a_method_the_engine_does_not_have_refuses_the_sweep():
     ERROR at every point)."""
     with pytest.raises(ParameterError, match="method"):
         S.sweep(RIG, SCENE, {"speed_rpm": [900.0, 1000.0]}, revolutions=1, method="Radau", progress=False)
+
+
+# --- the output and the folder: nothing lost, nothing ignored ---------------------------------------
+ONE = {"speed_rpm": [900.0]}
+
+
+def test_a_finished_file_is_replaced_only_with_overwrite(tmp_path):
+    out = tmp_path / "done.nc"
+    S.sweep(RIG, SCENE, ONE, S.Summary(1), out=out, **KW)
+    before = out.read_bytes()
+    with pytest.raises(S.StoreError, match=r"done.nc exists: .*overwrite=True"):
+        S.sweep(RIG, SCENE, {"speed_rpm": [1000.0]}, S.Summary(1), out=out, **KW)
+    assert out.read_bytes() == before and not (tmp_path / "done.nc.parts").exists()
+    S.sweep(RIG, SCENE, {"speed_rpm": [1000.0]}, S.Summary(1), out=out, overwrite=True, **KW)
+    with xr.open_dataset(out, engine="scipy") as ds:
+        assert ds["speed_rpm"].values.tolist() == [1000.0]
+
+
+def test_out_is_checked_before_any_point_runs(tmp_path, monkeypatch):
+    marker = tmp_path / "measured"
+    measure = Faulty(900.0, "mark", str(marker))
+    (tmp_path / "folder.nc").mkdir()
+    with pytest.raises(S.StoreError, match="folder.nc is a folder"):
+        S.sweep(RIG, SCENE, ONE, measure, out=tmp_path / "folder.nc", **KW)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode: False if Path(path) == locked else real_access(path, mode))
+    with pytest.raises(S.StoreError, match="locked is not writable"):
+        S.sweep(RIG, SCENE, ONE, measure, out=locked / "map.nc", **KW)
+    assert not marker.exists()  # no point was measured
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder.nc", "locked"]
+
+
+def test_a_folder_is_locked_by_the_process_that_writes_it(tmp_path):
+    out = tmp_path / "map.nc"
+    (tmp_path / "map.nc.parts").mkdir()
+    with pytest.raises(S.StoreError, match="unfinished"):
+        S.sweep(RIG, SCENE, ONE, S.Summary(1), out=out, **KW)
+    (tmp_path / "map.nc.parts").rmdir()
+    with InterruptAfter(0) as executor, pytest.raises(KeyboardInterrupt):  # leaves an unfinished folder
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, out=out, **KW)
+    with FolderStore.open(out):
+        with pytest.raises(S.StoreError, match="map.nc.parts is in use by this process"):
+            S.resume(out, progress=False)
+        with pytest.raises(S.StoreError, match="in use by this process"):
+            S.sweep(RIG, SCENE, GRID, S.Summary(1), out=out, **KW)
+    ds = S.resume(out, progress=False)  # released: resume runs it
+    assert (ds["outcome"] == 0).all() and not (tmp_path / "map.nc.parts").exists()
+
+
+def test_a_file_that_is_not_a_sweep_is_refused_in_one_line(tmp_path):
+    run = camdyn.simulate(RIG, SCENE, speed_rpm=900.0, revolutions=0.5, sample_rate_Hz=2000.0)
+    write_netcdf(run, tmp_path / "run.nc", RIG)
+    (tmp_path / "garbage.nc").write_bytes(b"half a file")
+    (tmp_path / "empty.nc").write_bytes(b"")
+    xr.Dataset({"x": ("n", [1.0])}, attrs={"title": TITLE}).to_netcdf(tmp_path / "cut.nc", engine="scipy")
+    cases = {"run.nc": "its title is 'camdyn run: ", "garbage.nc": "it is not a netCDF3 file",
+             "empty.nc": "the file is empty", "cut.nc": "has no 'outcome'"}
+    for name, what in cases.items():
+        for read in (S.resume, S.settings_of):
+            with pytest.raises(S.NotASweepError, match="is not a") as info:
+                read(tmp_path / name)
+            text = str(info.value)
+            assert isinstance(info.value, CamdynError) and str(tmp_path / name) in text and what in text
+            assert "\n" not in text and "netcdf4" not in text
+
+
+def _unfinished(tmp_path):
+    """A folder of a sweep interrupted before its first chunk."""
+    out = tmp_path / "map.nc"
+    with InterruptAfter(0) as executor, pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, GRID, Faulty(1100.0, "raise"), executor=executor, out=out, **KW)
+    return out, tmp_path / "map.nc.parts"
+
+
+def test_a_damaged_manifest_is_named(tmp_path):
+    out, folder = _unfinished(tmp_path)
+    manifest = folder / "manifest.json"
+    manifest.write_text("{not json")
+    with pytest.raises(S.StoreError, match=r"map.nc.parts/manifest.json cannot be read \(JSONDecodeError: .*delete"):
+        S.resume(out, progress=False)
+    manifest.unlink()
+    for read in (lambda: S.resume(out, progress=False), lambda: S.settings_of(out), lambda: S.load_partial(out)):
+        with pytest.raises(S.StoreError, match="map.nc.parts/manifest.json is missing"):
+            read()
+
+
+def test_a_damaged_pickle_gets_no_import_hint(tmp_path):
+    out, folder = _unfinished(tmp_path)
+    pickled = folder / "sweep.pickle"
+    good = pickled.read_bytes()
+    pickled.write_bytes(b"garbage")
+    with pytest.raises(S.StoreError, match="map.nc.parts/sweep.pickle is damaged") as info:
+        S.resume(out, progress=False)
+    assert "importable" not in str(info.value)
+    pickled.write_bytes(good.replace(b"sweep_faults", b"sweep_faulty"))  # a measure this process cannot import
+    with pytest.raises(S.StoreError, match="must be importable"):
+        S.resume(out, progress=False)
+    pickled.write_bytes(good)
+    assert int((S.resume(out, progress=False)["outcome"] == S.ALL_CODES["ERROR"]).sum()) == 2  # not locked
+
+
+def test_a_damaged_chunk_is_named_in_one_line_and_runs_again(tmp_path, caplog):
+    out = tmp_path / "map.nc"
+    with InterruptAfter(2) as executor, pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, chunksize=2, out=out, **KW)
+    damaged = sorted((tmp_path / "map.nc.parts" / "chunks").glob("*.nc"))[0]
+    damaged.write_bytes(b"half a file")
+    ds = S.resume(out, progress=False)
+    lines = [r.getMessage() for r in caplog.records if damaged.name in r.getMessage()]
+    assert lines == [f"{damaged} cannot be read (it is not a netCDF3 file); its points will run again"]
+    assert (ds["outcome"] == 0).all()
+
+
+def test_a_stopping_sweep_says_what_it_saved(caplog):
+    """Runs too short to stop (16 revolutions at the least) ran every revolution asked for, though
+    their last sample falls a revolution short at one sample per revolution."""
+    caplog.set_level("INFO", logger="camdyn.sweep")
+    ds = S.bifurcation(RIG, SCENE, [900.0, 1000.0], revolutions=4, transient_revolutions=2, progress=False)
+    assert ds["revolutions_run"].values.tolist() == [4.0, 4.0] and (ds["stop_period"] == 0).all()
+    assert "stopped once periodic: 0 of the 2 points that ran; 8 of 8 revolutions run, 0 (0 %) saved" in caplog.text
+    ds = S.bifurcation(RIG, SCENE, [700.0], revolutions=40, transient_revolutions=2, progress=False)
+    run = ds["revolutions_run"].item()
+    assert ds["stop_period"].item() > 0 and run < 40  # below contact loss the section settles: it stopped
+    assert f"1 of the 1 points that ran; {run:g} of 40 revolutions run, {40 - run:g}" in caplog.text

@@ -7,7 +7,7 @@ import signal
 import subprocess
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -15,9 +15,10 @@ import pytest
 
 import camdyn
 from camdyn import sweep as S
+from camdyn import cli
 from camdyn.cli import main
 from registry import RIG
-from sweep_faults import Faulty
+from sweep_faults import Faulty, InterruptAfter, WithDeathSignal
 
 xr = pytest.importorskip("xarray")
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -66,21 +67,51 @@ def test_dask_worker_killed_mid_sweep(serial, tmp_path):
     xr.testing.assert_identical(plain, serial)  # determinism on dask, attributes included
 
 
-# --- interrupted, then resumed ----------------------------------------------------------------------
-class InterruptAfter(ThreadPoolExecutor):
-    """One worker thread; Ctrl-C lands in the sweep's loop when it submits task number ``n + 1``."""
+class ClosingAfter:
+    """A dask executor whose client is closed (the cluster lost) when the sweep submits task
+    number ``n + 1``: the tasks in flight are cancelled and no more can be submitted."""
 
-    def __init__(self, n: int):
-        super().__init__(1)
-        self.n = n
+    def __init__(self, client, n: int):
+        self._client, self.executor, self.n = client, client.get_executor(), n
 
     def submit(self, *args, **kwargs):
         if self.n == 0:
-            raise KeyboardInterrupt
+            self._client.close()
         self.n -= 1
-        return super().submit(*args, **kwargs)
+        return self.executor.submit(*args, **kwargs)
 
 
+def test_dask_cluster_lost_mid_sweep_records_not_run_and_resume_runs_them(serial, tmp_path, caplog):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "map.nc"
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+    with cluster:
+        client = distributed.Client(cluster)
+        ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=ClosingAfter(client, 4), chunksize=1, out=out, **KW)
+    lost = ds["outcome"] == NOT_RUN
+    assert 8 <= int(lost.sum()) < 12 and int((ds["outcome"] == 0).sum()) == 12 - int(lost.sum())
+    assert all("ClosedClientError" in m for m in ds["message"].values[lost.values])
+    assert f"{int(lost.sum())} of 12 points could not run: recorded as NOT_RUN" in caplog.text
+    assert (tmp_path / "map.nc.parts").is_dir()
+    xr.testing.assert_identical(S.resume(out, progress=False), serial)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's prctl")
+def test_process_pool_workers_end_with_their_parent_also_after_a_break(tmp_path):
+    """Every point ran in a worker that the kernel kills when the sweep's process dies: those of
+    process_pool, and those of the pool that replaces it after a worker died."""
+    marker = tmp_path / "killed"
+    with S.process_pool(2) as pool:
+        ds = S.sweep(RIG, SCENE, GRID, WithDeathSignal(1100.0, "exit_once", str(marker)), executor=pool,
+                     chunksize=1, **KW)
+    assert marker.exists() and (ds["outcome"] == 0).all()
+    assert (ds["death_signal"] == signal.SIGKILL).all()
+    with ProcessPoolExecutor(1) as plain:  # the check can fail: a plain pool's workers have none
+        ds = S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, WithDeathSignal(0.0, ""), executor=plain, **KW)
+    assert (ds["death_signal"] == 0).all()
+
+
+# --- interrupted, then resumed ----------------------------------------------------------------------
 def test_interrupt_after_half_the_chunks_then_resume_equals_the_uninterrupted_sweep(serial, tmp_path):
     out = tmp_path / "map.nc"
     chunks = tmp_path / "map.nc.parts" / "chunks"
@@ -138,7 +169,10 @@ def _when_chunks(chunks: Path, n: int, proc: subprocess.Popen, timeout: float = 
 
 
 def test_cli_sweep_killed_then_interrupted_then_resumed_equals_the_uninterrupted_one(tmp_path, capsys):
-    out = tmp_path / "bif.nc"
+    """Killed (its lock goes with it), resumed by a process that holds the folder's lock (a second
+    resume is refused), interrupted (the hint keeps its options), resumed to the end."""
+    pytest.importorskip("matplotlib")
+    out, png = tmp_path / "bif.nc", tmp_path / "bif.png"
     chunks = tmp_path / "bif.nc.parts" / "chunks"
     proc = _start(CLI + ["--out", str(out)])
     _when_chunks(chunks, 4, proc)
@@ -146,11 +180,17 @@ def test_cli_sweep_killed_then_interrupted_then_resumed_equals_the_uninterrupted
     proc.communicate()
     crashed = len(list(chunks.glob("*.nc")))
     assert 4 <= crashed < 12 and not out.exists()
-    proc = _start(["--no-progress", "sweep", "--resume", str(out)])
+    proc = _start(["--no-progress", "sweep", "--resume", str(out), "--jobs", "2", "--plot", str(png)])
+    _when_locked(tmp_path / "bif.nc.parts", proc)
+    capsys.readouterr()
+    assert main(["--no-progress", "sweep", "--resume", str(out)]) == 2  # a second resume, meanwhile
+    assert f"bif.nc.parts is in use by another camdyn sweep (process {proc.pid})" in capsys.readouterr().err
     _when_chunks(chunks, crashed + 2, proc)
     proc.send_signal(signal.SIGINT)  # Ctrl-C
-    _, err = proc.communicate()
-    assert proc.returncode == 130 and f"'camdyn sweep --resume {out}' runs the rest" in err
+    stdout, err = proc.communicate()
+    assert f"applied: --jobs 2, --plot {png}" in stdout
+    assert proc.returncode == 130
+    assert f"'camdyn --no-progress sweep --resume {out} --jobs 2 --plot {png}' runs the rest" in err
     assert crashed + 2 <= len(list(chunks.glob("*.nc"))) < 12
     assert main(["--no-progress", "sweep", "--resume", str(out)]) == 0
     reference = S.bifurcation(RIG, camdyn.Scene(), np.linspace(600, 900, 12), revolutions=60, transient_revolutions=20,
@@ -163,7 +203,76 @@ def test_cli_sweep_killed_then_interrupted_then_resumed_equals_the_uninterrupted
     assert "was complete: nothing to run" in capsys.readouterr().out
 
 
-def test_cli_lists_invalid_points_or_skips_them(tmp_path, capsys):
+def _when_locked(folder: Path, proc: subprocess.Popen, timeout: float = 60.0) -> None:
+    """Once the process holds the folder's lock (its id is in the lock file)."""
+    start = time.monotonic()
+    while not ((folder / "lock").exists() and (folder / "lock").read_text().strip() == str(proc.pid)):
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - start < timeout, "the resume never took the lock"
+        time.sleep(0.01)
+
+
+def test_cli_sweep_killed_leaves_no_workers(tmp_path):
+    """SIGKILL to 'camdyn sweep --jobs 2': its pool workers end too (and so release its pipes)."""
+    psutil = pytest.importorskip("psutil")
+    out = tmp_path / "bif.nc"
+    proc = _start(CLI + ["--jobs", "2", "--netcdf", str(out)])
+    _when_chunks(tmp_path / "bif.nc.parts" / "chunks", 1, proc)
+    workers = psutil.Process(proc.pid).children(recursive=True)
+    assert len(workers) >= 2
+    proc.kill()
+    proc.wait()
+    _, alive = psutil.wait_procs(workers, timeout=10)
+    for worker in alive:  # not left behind by a failing test
+        worker.kill()
+    assert not alive, alive
+    proc.communicate(timeout=10)  # the pipes closed: no worker holds them
+
+
+def test_cli_resume_refuses_an_option_that_differs_and_applies_the_run_options(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out, png, toml = tmp_path / "map.nc", tmp_path / "map.png", tmp_path / "stiff.toml"
+    with InterruptAfter(3) as executor, pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, chunksize=1, out=out, **KW)
+    RIG.replace(k_s=2500.0).to_toml(toml)
+    chunks = lambda: sorted((tmp_path / "map.nc.parts" / "chunks").glob("*.nc"))  # noqa: E731
+    kept = chunks()
+    refused = {("--damping", "B"): f"--damping B: {out} was swept with damping = 'D'",
+               ("--revolutions", "3"): f"--revolutions 3.0: {out} was swept with revolutions = 2",
+               ("--rtol", "1e-9"): f"--rtol 1e-09: {out} was swept with rtol = 1e-08",
+               ("--rig", str(toml)): f"{out} was swept on rig 'example', whose k_s is 2000.0 (not 2500.0)",
+               ("--speeds", "900,1000"): f"{out} was swept over 6 values of speeds, 900 to 1400",
+               ("--netcdf", str(tmp_path / "b.nc")): f"was swept into {out}",
+               ("--skip-invalid",): "--skip-invalid starts a new sweep: it does not go with --resume",
+               ("--overwrite",): "--overwrite starts a new sweep"}
+    for option, message in refused.items():
+        assert main(["sweep", "--resume", str(out), *option]) == 2, option
+        err = capsys.readouterr().err
+        assert message in err and len(err.splitlines()) == 1, err
+        assert f"drop {option[0]}" in err or "starts a new sweep" in message
+    assert kept and chunks() == kept  # nothing ran
+    same = ["--damping", "D", "--rtol", "1e-8", "--param", "k_s", "--values", "2000,3000", "--rig", "example"]
+    assert main(["sweep", "--resume", str(out), *same, "--jobs", "2", "--plot", str(png)]) == 0
+    stdout = capsys.readouterr().out
+    assert (f"applied: --jobs 2, --plot {png}; the same as the sweep's: --rig, --damping, --param, --values, --rtol"
+            in stdout)
+    assert png.read_bytes()[:4] == b"\x89PNG" and not (tmp_path / "map.nc.parts").exists()
+
+
+def test_cli_report_says_how_to_run_the_points_not_run(tmp_path, capsys):
+    out = tmp_path / "map.nc"
+    with InterruptAfter(0) as executor, pytest.raises(KeyboardInterrupt):
+        S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, out=out, **KW)
+    args = cli._parser().parse_args(["sweep", "--resume", str(out), "--jobs", "2"])
+    assert cli._sweep_report(S.load_partial(out), args, S, str(out)) == 3
+    report = capsys.readouterr().out
+    assert "12 points, 0 without impacts after the transient, 0 impacting, 12 did not succeed" in report
+    assert f"the 12 NOT_RUN points are kept for later: 'camdyn sweep --resume {out} --jobs 2' runs them" in report
+
+
+def test_cli_lists_invalid_points_or_skips_them(tmp_path, capsys, monkeypatch):
+    """Skipped on purpose (--skip-invalid): exit 0, counted as skipped, left out of the plot."""
+    pytest.importorskip("matplotlib")
     args = ["sweep", "--speeds", "900,1e6", "--param", "e", "--values", f"0.001,{1.5 * RIG.r_c}", "--revolutions", "2",
             "--transient-revolutions", "1", "--samples-per-revolution", "16"]
     assert main(args) == 2
@@ -171,8 +280,15 @@ def test_cli_lists_invalid_points_or_skips_them(tmp_path, capsys):
     assert "speed_rpm=1e+06 (every e): speed_rpm = 1000000.0 is out of range" in err and "e=0.0375 (every" in err
     assert "3 of 4 grid points are invalid (listed above); --skip-invalid runs the others" in err
     assert not list(tmp_path.iterdir())
-    assert main(args + ["--skip-invalid", "--out", str(tmp_path / "e.nc")]) == 3  # some points did not succeed
-    assert "3 INVALID" in capsys.readouterr().out
+    figures = []
+    monkeypatch.setattr(cli, "_save_figure", lambda fig, path: figures.append(fig))
+    assert main(args + ["--skip-invalid", "--out", str(tmp_path / "e.nc"), "--plot", str(tmp_path / "e.png")]) == 0
+    out = capsys.readouterr().out
+    assert "4 points, 1 without impacts after the transient, 0 impacting, 3 skipped as invalid (--skip-invalid), " \
+           "0 did not succeed" in out and "3 INVALID" in out
+    ax = figures[0].axes[0]
+    assert ax.get_xlim()[1] < 1e4 and ax.get_ylim()[1] < 1.5 * RIG.r_c  # the skipped speed and e are not on it
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["sliding"]  # nothing drawn as failed
     with xr.open_dataset(tmp_path / "e.nc", engine="scipy") as ds:
         assert int((ds["outcome"] == 0).sum()) == 1
     assert main(["sweep", "--resume", str(tmp_path / "e.nc"), "--speeds", "1"]) == 2

@@ -137,7 +137,7 @@ def _prime_factors(p: int) -> list[int]:
 
 def settling(section: np.ndarray, p: int, limit: float, blocks: int = SETTLE_BLOCKS) -> bool:
     """Whether a shorter cycle within a period-p cycle is still settling: for a prime factor r of
-    p and q = p / r, the largest |alpha_j - alpha_(j-q)| in each of the last ``blocks`` blocks of
+    p and q = p / r, the largest ``abs(alpha_j - alpha_(j-q))`` in each of the last ``blocks`` blocks of
     p values changes by more than ``limit`` over them, or strictly decreases or increases (see
     :data:`SETTLE_BLOCKS`).  True also while the run is too short to tell (fewer than
     ``blocks`` p + q values)."""

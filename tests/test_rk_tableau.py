@@ -17,6 +17,7 @@ from scipy.integrate import RK45 as SciRK45
 from scipy.integrate._ivp import dop853_coefficients as sci853
 
 from camdyn.engine import stepper, tableau
+from camdyn.engine.config import PI_CONTROL, SCIPY_CONTROL
 from camdyn.engine.kernels import RHS
 from camdyn.engine.problem import Kernels, Problem
 from camdyn.engine.tables import tables
@@ -43,13 +44,13 @@ def _problem(p) -> Problem:
 
 @numba.njit
 def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
-    """Drive stepper.step like SciPy's solver loop; records the accepted times."""
+    """Drive stepper.accepted_step like SciPy's solver loop; records the accepted times."""
     K = np.empty((method.n_rows, 2))
     K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t0, y0, y1, prob.p)
     h = stepper.initial_step(prob.kernels.rhs, prob.p, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
     t, n, nfev, err = t0, 0, 2, stepper.ERR_FLOOR
     while t < t_end:
-        status, t, y0, y1, h, f, _, err = stepper.step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K,
+        status, t, y0, y1, h, f, _, err = stepper.accepted_step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K,
                                                        cfg, err)
         nfev += f
         times[n] = t
@@ -67,7 +68,7 @@ def _fixed(prob, method, h, n_steps, y0, y1, theta):
     d0 = d1 = 0.0
     for _ in range(n_steps):
         K[0, 0], K[0, 1] = y1, prob.kernels.rhs(0, t, y0, y1, prob.p)
-        n0, n1 = stepper.step_impl(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, method, K)
+        n0, n1 = stepper.attempt(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, method, K)
         stepper.dense_coefficients(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, method, K, Q)
         d0, d1 = stepper.dense_eval(t + theta * h, t, h, y0, y1, Q)
         t, y0, y1 = t + h, n0, n1
@@ -176,7 +177,10 @@ def test_spacing_is_numpys_distance_to_the_next_float(t):
     assert stepper.spacing(t) == np.nextafter(t, np.inf) - t
 
 
-# --- the step-size controllers (stepper.CONTROLS) ------------------------------------------------
+SCIPY, PI = SCIPY_CONTROL[1:], PI_CONTROL[1:]      # (a, b): the factors' coefficients
+
+
+# --- the step-size controllers (engine.config.StepControl) ------------------------------------------------
 @pytest.mark.parametrize("err, err_prev, rejected", [(0.43, 0.2, 0), (1e-3, 0.5, 0), (0.9, 1e-4, 0), (0.3, 0.3, 1)])
 def test_scipy_control_is_scipys_formula_and_pi_reads_the_previous_error(err, err_prev, rejected):
     """SciPy's controller ignores the previous error (bitwise the formula of scipy's
@@ -185,17 +189,17 @@ def test_scipy_control_is_scipys_formula_and_pi_reads_the_previous_error(err, er
     scipy_factor = min(stepper.MAX_FACTOR, stepper.SAFETY * err ** exponent)
     if rejected:
         scipy_factor = min(1.0, scipy_factor)
-    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *stepper.CONTROLS["scipy"]) == scipy_factor
+    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *SCIPY) == scipy_factor
     pi = min(stepper.MAX_FACTOR, stepper.SAFETY * err ** (-0.7 / 8) * err_prev ** (0.4 / 8))
-    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *stepper.CONTROLS["pi"]) == pytest.approx(
+    assert stepper.accepted_factor(err, err_prev, rejected, exponent, *PI) == pytest.approx(
         min(1.0, pi) if rejected else pi, rel=1e-15)
 
 
 def test_a_step_after_a_dip_of_the_error_grows_less_under_pi():
     """After err_prev = 0.4, a step whose estimate dips to 1e-3 (an erratic estimate) grows the
     next step 2.1x under SciPy's controller and 1.6x under PI; err 0 grows it MAX_FACTOR."""
-    scipy_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *stepper.CONTROLS["scipy"])
-    pi_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *stepper.CONTROLS["pi"])
+    scipy_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *SCIPY)
+    pi_f = stepper.accepted_factor(1e-3, 0.4, 0, -1 / 8, *PI)
     assert 1.0 < pi_f < scipy_f
-    assert stepper.accepted_factor(0.0, 0.4, 0, -1 / 8, *stepper.CONTROLS["pi"]) == stepper.MAX_FACTOR
+    assert stepper.accepted_factor(0.0, 0.4, 0, -1 / 8, *PI) == stepper.MAX_FACTOR
     assert stepper.rejected_factor(float("nan"), -1 / 8) == stepper.MIN_FACTOR

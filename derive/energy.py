@@ -61,9 +61,36 @@ def real_logs(expr: sp.Expr) -> sp.Expr:
     return expr.replace(sp.log, LogAbs)
 
 
+def _log_abs(u: sp.Expr) -> sp.Expr:
+    """log|u| in SymPy's functions, well conditioned where u = sin(x) -+ 1 (a cubic spring's
+    antiderivative has both): log 2 + 2 log|sin(pi/4 - x/2)| and log 2 + 2 log|cos(pi/4 - x/2)|
+    (1 -+ sin x = 2 sin^2, 2 cos^2 of pi/4 - x/2)."""
+    x = sp.Wild("x")
+    for side, half in ((-1, sp.sin), (1, sp.cos)):
+        match = u.match(sp.sin(x) + side) or (-u).match(sp.sin(x) + side)
+        if match:
+            return sp.log(2) + 2 * sp.log(sp.Abs(half(sp.pi / 4 - match[x] / 2)))
+    return sp.log(sp.Abs(u))
+
+
+def _cos_squared(term: sp.Expr) -> sp.Expr | None:
+    """-c cos(x)^2 for a sum c sin(x)^2 - c (the denominators of SymPy's antiderivatives of
+    powers of sec), else None."""
+    x, c = sp.Wild("x"), sp.Wild("c", exclude=[0])
+    match = term.match(c * sp.sin(x) ** 2 - c) if term.is_Add else None
+    return -match[c] * sp.cos(match[x]) ** 2 if match else None
+
+
 def printable(expr: sp.Expr) -> sp.Expr:
-    """:class:`LogAbs` written with SymPy's own functions, log(Abs(u)), for code generation."""
-    return expr.replace(LogAbs, lambda u: sp.log(sp.Abs(u)))
+    """A potential as generated code computes it: :class:`LogAbs` written log(Abs(u)) with SymPy's
+    functions, and two forms of SymPy's antiderivatives that lose all precision near
+    alpha = +-pi/2 written as exact identities that keep it: sin(x) -+ 1 (in log|u|: _log_abs) and
+    c (sin(x)^2 - 1) (-c cos(x)^2).  In floats sin(x) rounds to 1 within 1e-8 rad of pi/2, so
+    those are 0 there (log(0), 1/0: an error in Python, inf in compiled code), where the
+    half-angle sine and cos(x) keep full precision; camdyn.analysis.energy_balance_peak
+    evaluates the potential at pi/2 - 1e-9."""
+    expr = expr.replace(LogAbs, _log_abs)
+    return expr.replace(lambda e: _cos_squared(e) is not None, _cos_squared)
 
 
 def moment_potential(force: Callable[[sp.Expr], sp.Expr]) -> sp.Expr:

@@ -194,6 +194,8 @@ def _provenance(result: cal.Calibration, exp_rig: camdyn.Rig) -> list[list[str]]
             status, why = "reported (ratio)", TIED_E[1]
         elif p.name in ASSUMED:
             status, why = "assumed", ASSUMED[p.name][1]
+        elif p.name in NEUTRAL:
+            status, why = "the paper's law", "a model edit's constant at its neutral value (derive/parameters.py)"
         else:
             status, why = "reported", REPORTED[p.name][1]
         value = f"{v:.6g}"

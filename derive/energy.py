@@ -62,14 +62,17 @@ def real_logs(expr: sp.Expr) -> sp.Expr:
 
 
 def _log_abs(u: sp.Expr) -> sp.Expr:
-    """log|u| in SymPy's functions, well conditioned where u = sin(x) -+ 1 (a cubic spring's
-    antiderivative has both): log 2 + 2 log|sin(pi/4 - x/2)| and log 2 + 2 log|cos(pi/4 - x/2)|
-    (1 -+ sin x = 2 sin^2, 2 cos^2 of pi/4 - x/2)."""
-    x = sp.Wild("x")
-    for side, half in ((-1, sp.sin), (1, sp.cos)):
-        match = u.match(sp.sin(x) + side) or (-u).match(sp.sin(x) + side)
-        if match:
-            return sp.log(2) + 2 * sp.log(sp.Abs(half(sp.pi / 4 - match[x] / 2)))
+    """log|u| in SymPy's functions, with the logarithms of a cubic spring's antiderivative in
+    log|cos x| where they can be: sin(x) - 1 as 2 log|cos x| - log|sin x + 1| (|sin x - 1|
+    |sin x + 1| = cos^2 x), which keeps its precision near x = pi/2, and sec(x)^n as
+    -n log|cos x|, one logarithm fewer."""
+    x, n = sp.Wild("x"), sp.Wild("n", properties=[lambda k: k.is_Integer])
+    match = u.match(sp.sin(x) - 1) or (-u).match(sp.sin(x) - 1)
+    if match:
+        return 2 * sp.log(sp.Abs(sp.cos(match[x]))) - sp.log(sp.Abs(sp.sin(match[x]) + 1))
+    match = u.match(sp.sec(x) ** n)
+    if match:
+        return -match[n] * sp.log(sp.Abs(sp.cos(match[x])))
     return sp.log(sp.Abs(u))
 
 
@@ -84,11 +87,12 @@ def _cos_squared(term: sp.Expr) -> sp.Expr | None:
 def printable(expr: sp.Expr) -> sp.Expr:
     """A potential as generated code computes it: :class:`LogAbs` written log(Abs(u)) with SymPy's
     functions, and two forms of SymPy's antiderivatives that lose all precision near
-    alpha = +-pi/2 written as exact identities that keep it: sin(x) -+ 1 (in log|u|: _log_abs) and
-    c (sin(x)^2 - 1) (-c cos(x)^2).  In floats sin(x) rounds to 1 within 1e-8 rad of pi/2, so
-    those are 0 there (log(0), 1/0: an error in Python, inf in compiled code), where the
-    half-angle sine and cos(x) keep full precision; camdyn.analysis.energy_balance_peak
-    evaluates the potential at pi/2 - 1e-9."""
+    alpha = pi/2 written as exact identities in cos(x), which keeps it: sin(x) - 1 in a log
+    (:func:`_log_abs`) and c (sin(x)^2 - 1) (as -c cos(x)^2).  In floats sin(x) rounds to 1
+    within 1e-8 rad of pi/2, so those are 0 there (log(0), 1/0: an error in Python, inf in
+    compiled code); camdyn.analysis.energy_balance_peak evaluates the potential at
+    pi/2 - 1e-9.  (Near -pi/2, log|sin x + 1| and the paper's spring's log|tan x + sec x| lose
+    it alike: the follower does not swing there.)"""
     expr = expr.replace(LogAbs, _log_abs)
     return expr.replace(lambda e: _cos_squared(e) is not None, _cos_squared)
 

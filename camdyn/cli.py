@@ -10,7 +10,8 @@ shows it).  Exit codes, for scripts:
   0  success
   1  a check failed (``regenerate --check``: generated/ differs from what derive/ produces)
   2  bad input: an unknown option or value, an invalid rig or parameter, an unreadable
-     or unwritable file, a scene that is not generated
+     or unwritable file, a scene that is not generated, a derive/ edit that makes an
+     expression complex (``regenerate``)
   3  a simulation stopped before the end (see its outcome: chatter, angle limit, ...), or
      a sweep has points that did not succeed (not those skipped with --skip-invalid);
      whatever was computed is still written
@@ -25,6 +26,7 @@ import argparse
 import contextlib
 import csv
 import importlib
+import importlib.util
 import inspect
 import json
 import math
@@ -954,10 +956,15 @@ except ImportError:
     sys.exit(4)
 writer = importlib.import_module(package + ".writer")
 catalog = importlib.import_module(package + ".catalog")
+codegen = importlib.import_module(package + ".codegen")
 from tqdm import tqdm
 specs = tuple(sorted(set(catalog.CATALOG), key=lambda s: s.slug))
 bar = dict(total=len(specs), desc="deriving scenes", unit="scene", file=sys.stderr, disable=None)
-files = writer.render(specs, jobs=jobs, progress=lambda done: tqdm(done, **bar))
+try:
+    files = writer.render(specs, jobs=jobs, progress=lambda done: tqdm(done, **bar))
+except codegen.ComplexExpressionError as exc:  # the edit made a law complex: nothing is written
+    print(f"camdyn: error: {exc}", file=sys.stderr)
+    sys.exit(2)
 if not check_only:
     changed = writer.write(files, out)
     print(f"{len(files)} files generated in {out}; changed: {', '.join(changed) or 'none'}")
@@ -1014,12 +1021,41 @@ def cmd_regenerate(args) -> int:
     code = subprocess.call([sys.executable, "-c", _REGENERATE, str(args.derive or ""), str(out),
                             "1" if args.check else "0", str(jobs)])
     if code != 0:
-        return EXIT_MISSING if code == 4 else EXIT_CHECK_FAILED if code == 1 else EXIT_INTERNAL
+        return {4: EXIT_MISSING, 1: EXIT_CHECK_FAILED, 2: EXIT_USAGE}.get(code, EXIT_INTERNAL)
     code = subprocess.call([sys.executable, "-c", _IMPORT_CHECK, str(out)])
     if code != 0:
         return EXIT_CHECK_FAILED
-    if not args.check and out.resolve() != _default_generated():
-        print(f"  the scenes in {out} are not camdyn.generated; see docs/model-editing.md to use them")
+    if not _regenerates_own_package(args, out):
+        if not args.check:
+            print(f"  the scenes in {out} are not camdyn.generated; see docs/model-editing.md to use them")
+        return EXIT_OK
+    return _neutral_values_in_presets(args.check)
+
+
+def _regenerates_own_package(args, out: Path) -> bool:
+    """Whether this regenerate derives camdyn.derive into camdyn.generated (not a copy)."""
+    own_derive = Path(importlib.util.find_spec("camdyn.derive").submodule_search_locations[0]).resolve()
+    return out.resolve() == _default_generated() and (not args.derive or Path(args.derive).resolve() == own_derive)
+
+
+def _neutral_values_in_presets(check: bool) -> int:
+    """The shipped rig files give every parameter declared with a neutral value (the value that
+    gives the paper's law, camdyn.derive.parameters): write the missing ones and say so, or,
+    with --check, fail while one is missing."""
+    from . import presets
+
+    if check:
+        lacking = presets.lacking_neutral_values()
+        for path, names in lacking.items():
+            print(f"{path.name}: does not give {', '.join(names)} (declared with a neutral value in "
+                  "derive/parameters.py): run camdyn regenerate", file=sys.stderr)
+        print(f"presets check: {len(presets.preset_files()) - len(lacking)} of {len(presets.preset_files())} "
+              "shipped rig files give every parameter declared with a neutral value")
+        return EXIT_CHECK_FAILED if lacking else EXIT_OK
+    for path, names in presets.add_neutral_values().items():
+        values = ", ".join(f"{n} = {presets.NEUTRAL[n]!r}" for n in names)
+        print(f"updated the shipped rig {path}: added {values}, the neutral value declared in "
+              "derive/parameters.py (the paper's law), so the scenes that read it run this rig as before")
     return EXIT_OK
 
 
@@ -1472,6 +1508,9 @@ def _parser() -> argparse.ArgumentParser:
                 "  camdyn regenerate --derive my/derive --out my/generated   # an edited copy\n\n"
                 "Derives every scene of derive/catalog.py, writes the modules, checks that the folder\n"
                 "now matches derive/ exactly (drift check), and imports every module without SymPy.\n"
+                "Refuses (exit 2, nothing written) an expression that holds a complex number. For\n"
+                "camdyn.generated itself, also writes the neutral value of a new parameter (declared in\n"
+                "derive/parameters.py) into the shipped rig files that lack it, and says which.\n"
                 "See docs/model-editing.md.", cmd_regenerate)
     p.add_argument("--check", action="store_true", help="only check: exit 1 if the folder differs from derive/")
     p.add_argument("--derive", metavar="DIR", help="a derive/ folder to use instead of the installed camdyn.derive")

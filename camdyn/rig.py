@@ -12,7 +12,11 @@ rules. Two kinds of rule:
   30 rad as 30 degrees) with an error message that says so.
 
 Optional parameters (contact length, friction, damping) default to ``None``, meaning "not
-given"; a scene that needs one demands it with :meth:`Rig.require`.
+given"; a scene that needs one demands it with :meth:`Rig.require`. A constant that a model
+edit adds to one of the paper's laws may declare a *neutral* value, the one that gives the
+paper's law back (:data:`NEUTRAL`): it is still not a default (a rig that does not give it is
+refused, with that value in the message); ``camdyn regenerate`` writes it into the shipped
+rig files (docs/model-editing.md).
 
 A rig file is TOML: top-level ``name`` and ``description`` strings and a ``[parameters]``
 table of SI numbers::
@@ -47,7 +51,7 @@ else:  # pragma: no cover
 from .derive.parameters import RIG_PARAMETERS, RigParameter, Rule
 from .errors import ParameterError, RigFileError
 
-__all__ = ["PARAMETERS", "Parameter", "Rule", "Rig"]
+__all__ = ["PARAMETERS", "NEUTRAL", "Parameter", "Rule", "Rig"]
 
 
 #: the units of :data:`PARAMETERS` that people read differently ("1": a pure number)
@@ -69,11 +73,25 @@ class Parameter:
     required: bool
     ref: str
     rules: tuple[Rule, ...] = ()
+    neutral: float | None = None
 
     @classmethod
     def declared(cls, row: RigParameter) -> Parameter:
         return cls(row.name, _UNIT_WORDS.get(row.unit, row.unit), row.description, row.required, row.ref,
-                   row.rules)
+                   row.rules, row.neutral)
+
+    @property
+    def neutral_hint(self) -> str:
+        """How to give a parameter that has a neutral value ('' for the others): the value
+        that gives the paper's law, and where to write it."""
+        if self.neutral is None:
+            return ""
+        return (f"{self.name} = {self.neutral!r} gives the paper's law: add the line '{self.name} = {self.neutral!r}' "
+                f"to the [parameters] table of the rig file, or use rig.replace({self.name}={self.neutral!r})")
+
+    def toml_line(self, value: float) -> str:
+        """The line of a rig file that gives ``value``: name, value (``repr``: exact), meaning."""
+        return f"{self.name:<8} = {value!r:<22} # {self.meaning}"
 
     @property
     def valid(self) -> str:
@@ -112,6 +130,10 @@ class Parameter:
 #: ``camdyn.derive.parameters``; the "0-state" is the follower just touching the cam at
 #: Theta = theta0, alpha = alpha0.
 PARAMETERS: tuple[Parameter, ...] = tuple(Parameter.declared(row) for row in RIG_PARAMETERS)
+#: The values that reduce the laws of a model edit to the paper's, by parameter (declared with
+#: ``neutral=`` in ``camdyn.derive.parameters``; empty for the paper's model): what a rig built
+#: to reproduce the paper gives for them.
+NEUTRAL: dict[str, float] = {p.name: p.neutral for p in PARAMETERS if p.neutral is not None}
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
 _TEXT_FIELDS = ("name", "description")
@@ -191,7 +213,8 @@ class Rig:
         missing = [n for n in names if getattr(self, n) is None]
         if missing:
             first, *others = missing
-            reason = _BY_NAME[first].meaning + (f"; also not given: {', '.join(others)}" if others else "")
+            reason = "; ".join(x for x in (_BY_NAME[first].meaning, _BY_NAME[first].neutral_hint,
+                                           f"also not given: {', '.join(others)}" if others else "") if x)
             raise ParameterError(first, None, f"required by {why}" if why else "required", reason=reason)
 
     def replace(self, **changes: Any) -> Rig:
@@ -266,7 +289,7 @@ class Rig:
         for p in PARAMETERS:
             value = getattr(self, p.name)
             if value is not None:
-                lines.append(f"{p.name:<8} = {value!r:<22} # {p.meaning}")
+                lines.append(p.toml_line(value))
         Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -276,6 +299,8 @@ def _parameter_docs() -> str:
     for p in PARAMETERS:
         out.append(f"    {p.name} : float, {p.unit}, {'required' if p.required else 'optional (None: not given)'}")
         text = f"{p.description[0].upper()}{p.description[1:]} ({p.ref}). Valid: {p.valid}."
+        if p.neutral is not None:
+            text += f" {p.name} = {p.neutral!r} gives the paper's law."
         for rule in p.rules:
             if rule.guard:
                 text += f" Rejected unless {rule.text} ({rule.hint})."

@@ -6,6 +6,7 @@ import os
 import sys
 from pathlib import Path
 
+from .codegen import ComplexExpressionError
 from .writer import DEFAULT_OUT, check, render, write
 
 
@@ -16,7 +17,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=DEFAULT_OUT, help="generated package folder")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="processes to use")
     args = parser.parse_args(argv)
-    files = render(jobs=max(1, args.jobs))
+    try:
+        files = render(jobs=max(1, args.jobs))
+    except ComplexExpressionError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     if args.check:
         problems = check(files, args.out)
         for p in problems:

@@ -331,6 +331,55 @@ def _universe(f: Function, automaton: Automaton) -> set:
     return {()}
 
 
+# --- the real-arithmetic guard ---------------------------------------------------------------
+class ComplexExpressionError(ValueError):
+    """An expression to be written holds a complex number: generated code computes in float64,
+    and a compiled kernel cannot even store a complex value in its real output."""
+
+
+def _complex_numbers(expr: sp.Expr) -> set:
+    """The complex numbers in ``expr``: SymPy's I (a complex Float is written with it too), or
+    a number that is not an extended real (complex infinity)."""
+    return {a for a in sp.sympify(expr).atoms() if a is sp.I or (a.is_number and a.is_extended_real is False)}
+
+
+def _shorter(text: str, width: int) -> str:
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
+def refuse_complex(scene: str, kernel: str, name: str, expr: sp.Expr) -> None:
+    """Raise :class:`ComplexExpressionError` naming the scene, the kernel and the expression
+    (``name = expr``) if ``expr`` holds a complex number; return otherwise."""
+    numbers = _complex_numbers(expr)
+    if not numbers:
+        return
+    expr = sp.sympify(expr)
+    terms = sorted((str(m) for m in expr.atoms(sp.Mul) if numbers & set(m.args)), key=len)
+    where = f" in the term {_shorter(terms[0], 120)}" if terms else ""
+    raise ComplexExpressionError(
+        f"scene {scene}, kernel {kernel}: {name} = {_shorter(str(expr), 160)} holds the complex number "
+        f"{', '.join(sorted(map(str, numbers)))}{where}; generated code computes in real arithmetic: "
+        "make the law real for real arguments (docs/model-editing.md, 'Things to know')")
+
+
+def _refuse_complex_kernels(mod: SceneModule, families: dict) -> None:
+    """:func:`refuse_complex` on every expression a scene's kernels write: first the named
+    quantities of each case (the clearest message), then what common subexpressions and the
+    trigonometric economy made of them (the x_k and the constants pack() computes)."""
+    slug, A = mod.spec.slug, mod.automaton
+    for f in mod.functions + mod.variational:
+        for case in f.cases:
+            mode = f" (mode {A.modes[case.key[0]].name})" if f.dispatch[:1] == ("m",) else ""
+            for d in case.kernel.definitions:
+                refuse_complex(slug, f.name + mode, d.name, d.expr)
+            for name, r in zip(f.results, case.kernel.results):
+                refuse_complex(slug, f.name + mode, name, r)
+        fams = families[f.name]
+        for fam in (x for group in fams for x in group) if f.style == "separate" else fams:
+            for expr in fam.expressions() + list(fam.constants.values()):
+                refuse_complex(slug, f.name, "a common subexpression", expr)
+
+
 # --- the module -----------------------------------------------------------------------------
 def _hash(mod: SceneModule) -> str:
     h = hashlib.sha256(repr(sorted(mod.spec.derived_options().items())).encode())
@@ -483,6 +532,7 @@ class _Layout:
             for fam in fams:
                 constants.update(fam.constants)
                 exprs += fam.expressions()
+        _refuse_complex_kernels(mod, families)
         constants = dict(sorted(constants.items(), key=lambda kv: kv[0].name))
         return cls(mod, families, _param_names(exprs), constants)
 

@@ -19,6 +19,7 @@ with dE/dt = P_in - D_c - D_f, an identity checked symbolically in the tests.
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import Callable
 
 import sympy as sp
 
@@ -31,25 +32,90 @@ def kinetic() -> sp.Expr:
     return S.I_Pb * alpha.diff(t) ** 2 / 2
 
 
-@lru_cache(maxsize=None)  # pure: an integral, asked for by every scene
-def spring_potential() -> sp.Expr:
-    """V_s(alpha), the potential of the spring moment of Eq. 10 (zero at alpha = 0)."""
-    a = sp.Symbol("a", real=True)
-    integrand = S.d_x * laws.spring_force(a)  # follows an edited spring law
-    return sp.integrate(integrand, (a, 0, alpha))
+class LogAbs(sp.Function):
+    """log|u|: a real antiderivative of u'/u on any interval where u keeps its sign.
+
+    Its derivative is written out, u'/u (d log|u| = du/u for real u != 0), so a potential
+    built with it differentiates back to its integrand symbolically, and at a number it is
+    log|u|, a real number (SymPy's log(-1) is i pi).  :func:`printable` writes it as
+    log(Abs(u)) for code generation."""
+
+    @classmethod
+    def eval(cls, u):
+        if u.is_number:
+            return sp.log(sp.Abs(u))
+        return None
+
+    def fdiff(self, argindex=1):
+        return 1 / self.args[0]
 
 
 def real_logs(expr: sp.Expr) -> sp.Expr:
-    """The real definite integral from SymPy's: log(u) -> log|u|.
+    """An antiderivative with its logarithms made real: log(u) -> log|u| (:class:`LogAbs`).
 
-    An antiderivative of a real trigonometric-rational integrand holds each log(u) from the
-    integral of u'/u with a real coefficient; SymPy writes log(u) where the real antiderivative
-    is log|u|, and the two differ by i pi where u < 0 (a cubic spring gives log(sin(alpha) - 1)).
-    In F(alpha) - F(0) those i pi cancel when u keeps its sign between 0 and alpha (it cannot
-    cross zero there: the integrand would have a pole), so log|u| gives the same real value
-    and generated code does not take the log of a negative number.
-    """
-    return expr.replace(sp.log, lambda u: sp.log(sp.Abs(u)))
+    SymPy's antiderivative of a real trigonometric-rational integrand holds each log(u) from
+    the integral of u'/u with a real coefficient, and writes log(u) where the real
+    antiderivative is log|u|: the two differ by the constant i pi where u < 0 (a cubic spring
+    gives log(sin(a) - 1), negative for every follower angle).  log|u| has the same
+    derivative u'/u, so it is an antiderivative too, and a real one."""
+    return expr.replace(sp.log, LogAbs)
+
+
+def _log_abs(u: sp.Expr) -> sp.Expr:
+    """log|u| in SymPy's functions, with the logarithms of a cubic spring's antiderivative in
+    log|cos x| where they can be: sin(x) - 1 as 2 log|cos x| - log|sin x + 1| (|sin x - 1|
+    |sin x + 1| = cos^2 x), which keeps its precision near x = pi/2, and sec(x)^n as
+    -n log|cos x|, one logarithm fewer."""
+    x, n = sp.Wild("x"), sp.Wild("n", properties=[lambda k: k.is_Integer])
+    match = u.match(sp.sin(x) - 1) or (-u).match(sp.sin(x) - 1)
+    if match:
+        return 2 * sp.log(sp.Abs(sp.cos(match[x]))) - sp.log(sp.Abs(sp.sin(match[x]) + 1))
+    match = u.match(sp.sec(x) ** n)
+    if match:
+        return -match[n] * sp.log(sp.Abs(sp.cos(match[x])))
+    return sp.log(sp.Abs(u))
+
+
+def _cos_squared(term: sp.Expr) -> sp.Expr | None:
+    """-c cos(x)^2 for a sum c sin(x)^2 - c (the denominators of SymPy's antiderivatives of
+    powers of sec), else None."""
+    x, c = sp.Wild("x"), sp.Wild("c", exclude=[0])
+    match = term.match(c * sp.sin(x) ** 2 - c) if term.is_Add else None
+    return -match[c] * sp.cos(match[x]) ** 2 if match else None
+
+
+def printable(expr: sp.Expr) -> sp.Expr:
+    """A potential as generated code computes it: :class:`LogAbs` written log(Abs(u)) with SymPy's
+    functions, and two forms of SymPy's antiderivatives that lose all precision near
+    alpha = pi/2 written as exact identities in cos(x), which keeps it: sin(x) - 1 in a log
+    (:func:`_log_abs`) and c (sin(x)^2 - 1) (as -c cos(x)^2).  In floats sin(x) rounds to 1
+    within 1e-8 rad of pi/2, so those are 0 there (log(0), 1/0: an error in Python, inf in
+    compiled code); camdyn.analysis.energy_balance_peak evaluates the potential at
+    pi/2 - 1e-9.  (Near -pi/2, log|sin x + 1| and the paper's spring's log|tan x + sec x| lose
+    it alike: the follower does not swing there.)"""
+    expr = expr.replace(LogAbs, _log_abs)
+    return expr.replace(lambda e: _cos_squared(e) is not None, _cos_squared)
+
+
+def moment_potential(force: Callable[[sp.Expr], sp.Expr]) -> sp.Expr:
+    """V(alpha) = F(alpha) - F(0), the potential of the moment d_x force(alpha) of a vertical
+    spring force at arm d_x (Eq. 10), with F a real antiderivative (:func:`real_logs`).
+
+    Not SymPy's definite integral: its F(0) keeps log(-1) = i pi for a law whose antiderivative
+    has log(u) with u(0) < 0 (the cubic spring of docs/model-editing.md: log(sin(a) - 1)), a
+    complex constant that compiled code cannot store in a real output.  A potential is defined
+    up to a constant; this one is real, 0 at alpha = 0, and its derivative is the moment
+    (checked by :func:`camdyn.derive.fields.checked_potential`)."""
+    a = sp.Symbol("a", real=True)
+    F = real_logs(sp.integrate(S.d_x * force(a), a))
+    return F.subs(a, alpha) - F.subs(a, 0)
+
+
+@lru_cache(maxsize=None)  # pure: an integral, asked for by every scene
+def spring_potential() -> sp.Expr:
+    """V_s(alpha), the potential of the spring moment of Eq. 10 (zero at alpha = 0), real; it
+    follows an edited spring law (:func:`camdyn.derive.laws.spring_force`)."""
+    return moment_potential(laws.spring_force)
 
 
 def spring_potential_printed() -> sp.Expr:

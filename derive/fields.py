@@ -246,17 +246,38 @@ def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
     return stuck + (Definition(Q.F_f, (Q.alpha_ddot - a0) / a1, "friction force that keeps the follower stuck"),)
 
 
+def _identically_zero(expr: sp.Expr) -> bool:
+    """Whether an expression of alpha is 0 for every alpha: as a rational function of
+    sin(alpha) and cos(alpha) whose numerator vanishes modulo sin^2 + cos^2 - 1 (exact, and
+    quick for a polynomial spring law), else by ``sp.simplify``."""
+    sn, cs = sp.Dummy("sin"), sp.Dummy("cos")
+    x = S.alpha_s
+    rational = expr.subs({sp.tan(x): sn / cs, sp.sec(x): 1 / cs}).subs({sp.sin(x): sn, sp.cos(x): cs})
+    if rational.has(x):  # other functions of alpha: let SymPy decide
+        return sp.simplify(expr) == 0
+    numerator = sp.expand(sp.numer(sp.together(rational)))
+    return sp.rem(numerator, sn**2 + cs**2 - 1, sn) == 0
+
+
+def checked_potential(V: sp.Expr, moment: sp.Expr) -> sp.Expr:
+    """A potential of ``moment`` (plain symbols) as generated code computes it, after checking
+    that it is real (no complex number), 0 at alpha = 0 and that its derivative is ``moment``,
+    symbolically (log|u| differentiates as du/u: :class:`derive.energy.LogAbs`); its log|u| is
+    written log(Abs(u)) (:func:`derive.energy.printable`)."""
+    if not _identically_zero(V.diff(S.alpha_s) - moment):
+        raise RuntimeError(f"dV/dalpha is not the moment {moment}: check derive.energy.moment_potential")
+    at_0 = sp.simplify(V.subs(S.alpha_s, 0))
+    if V.has(sp.I) or at_0 != 0:
+        raise RuntimeError(f"the potential is not real and 0 at alpha = 0 (there: {at_0}): check "
+                           "derive.energy.moment_potential")
+    return energy.printable(V)
+
+
 @lru_cache(maxsize=None)
 def spring_potential() -> sp.Expr:
-    """V_s(alpha) in plain symbols, as generated code computes it.
-
-    Built as the integral of the spring moment d_x F_s (derive.energy), so its derivative is
-    d_x F_s: checked here; then written with real logarithms (:func:`derive.energy.real_logs`)."""
-    V_s = S.to_plain(energy.spring_potential())
-    moment = S.d_x * laws.spring_force(S.alpha_s)
-    if sp.simplify(V_s.diff(S.alpha_s) - moment) != 0:
-        raise RuntimeError("dV_s/dalpha is not the spring moment d_x F_s: check derive.energy.spring_potential")
-    return energy.real_logs(V_s)
+    """V_s(alpha) in plain symbols, as generated code computes it: the integral of the spring
+    moment d_x F_s (derive.energy), checked (:func:`checked_potential`)."""
+    return checked_potential(S.to_plain(energy.spring_potential()), S.d_x * laws.spring_force(S.alpha_s))
 
 
 @lru_cache(maxsize=None)

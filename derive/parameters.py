@@ -5,7 +5,8 @@ its SymPy symbols from these rows (:mod:`camdyn.derive.symbols`: a lower bound o
 the ``positive`` or ``nonnegative`` assumption), and the runtime's :class:`camdyn.Rig` reads
 them for its fields, its validation, its error messages, its TOML files and its documentation.
 A model edit that adds a constant (a cubic spring coefficient, say) adds a row to
-:data:`RIG_PARAMETERS` and uses the symbol in a law; nothing in ``camdyn/`` changes.
+:data:`RIG_PARAMETERS`, with the value that gives the paper's law back (``neutral=``), and
+uses the symbol in a law; nothing in ``camdyn/`` changes.
 
 Three groups:
 
@@ -78,7 +79,14 @@ class Constant:
 @dataclass(frozen=True)
 class RigParameter:
     """One rig parameter: ``required`` ones every scene reads; the others (None: not given)
-    only the scenes whose laws use them, which demand them by name."""
+    only the scenes whose laws use them, which demand them by name.
+
+    ``neutral``: for a constant that a model edit adds to one of the paper's laws (a cubic
+    spring coefficient), the value that reduces the law to the paper's (0 for an added term).
+    ``camdyn regenerate`` writes it into the shipped rig files that lack the parameter, and
+    says so; a rig that does not give the parameter is still refused by the scenes that read
+    it (the message names this value), so no rig runs an edited law on a value it never gave.
+    """
 
     name: str
     unit: str
@@ -86,6 +94,16 @@ class RigParameter:
     required: bool
     ref: str
     rules: tuple[Rule, ...] = ()
+    neutral: Union[float, None] = None
+
+    def __post_init__(self):
+        if self.neutral is not None and self.required:
+            raise ValueError(f"RigParameter {self.name!r}: a neutral value is for an optional parameter "
+                             "(a required one is in every rig file)")
+        broken = [r.text for r in self.rules if self.neutral is not None and not isinstance(r.bound, str)
+                  and not r.holds(self.neutral, {})]
+        if broken:
+            raise ValueError(f"RigParameter {self.name!r}: its neutral value {self.neutral!r} must be {broken[0]}")
 
     @property
     def sign(self) -> str:

@@ -16,7 +16,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from .codegen import module_name, sources
+from .codegen import ComplexExpressionError, module_name, sources
 from .vocabulary import SceneOptionError, SceneSpec
 
 
@@ -48,7 +48,11 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, TypeError, SceneOptionError) as exc:
         print(f"not a scene: {exc}", file=sys.stderr)
         return 2
-    write_scene(spec, Path(args[1]))
+    try:
+        write_scene(spec, Path(args[1]))
+    except ComplexExpressionError as exc:
+        print(f"not derived: {exc}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -8,7 +8,6 @@ once for every scene, and each scene's kernels once, both cached (:mod:`.cache`)
 from __future__ import annotations
 
 import math
-import importlib
 from functools import lru_cache
 from types import ModuleType
 
@@ -92,9 +91,11 @@ def _check_compilable(K: ModuleType) -> None:
 
 
 @lru_cache(maxsize=None)
-def _compiled(module_name: str) -> Kernels:
-    """rhs, surface and reset of a scene as cfuncs; outputs is :func:`_compiled_outputs`'s."""
-    K = importlib.import_module(module_name)
+def _compiled(K: ModuleType) -> Kernels:
+    """rhs, surface and reset of a scene as cfuncs; outputs is :func:`_compiled_outputs`'s.
+
+    Kept per module object, not per name: a scene module imported again under the same name
+    (an edited scene reloaded in one session, docs/model-editing.md recipe 4) is compiled anew."""
     surface = _cfunc(SURFACE, K.surface) if hasattr(K, "surface") else no_surface()
     reset = _cfunc(FILL, K.reset) if hasattr(K, "reset") else no_fill
     kernel = _with_rate(K)
@@ -103,8 +104,8 @@ def _compiled(module_name: str) -> Kernels:
 
 
 @lru_cache(maxsize=None)
-def _compiled_outputs(module_name: str):
-    return _cfunc(FILL, importlib.import_module(module_name).outputs)
+def _compiled_outputs(K: ModuleType):
+    return _cfunc(FILL, K.outputs)
 
 
 def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
@@ -115,20 +116,20 @@ def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
     scene's outputs, the largest of its kernels, are then compiled only when a result's output
     quantities are read (:class:`camdyn.result.Outputs`), about a second of a cold start."""
     _check_compilable(K)
-    kernels = _compiled(K.__name__)
-    return kernels._replace(outputs=_compiled_outputs(K.__name__)) if outputs else kernels
+    kernels = _compiled(K)
+    return kernels._replace(outputs=_compiled_outputs(K)) if outputs else kernels
 
 
 @lru_cache(maxsize=None)
-def _compiled_jacobian(module_name: str):
-    return _cfunc(FILL, importlib.import_module(module_name).jacobian)
+def _compiled_jacobian(K: ModuleType):
+    return _cfunc(FILL, K.jacobian)
 
 
 def compiled_jacobian(K: ModuleType):
     """The generated ``jacobian`` kernel of a scene module as a cfunc (the tangent dynamics',
     :mod:`camdyn.tangent`; compiled on first use, then from the disk cache)."""
     _check_compilable(K)
-    return _compiled_jacobian(K.__name__)
+    return _compiled_jacobian(K)
 
 
 def _guarded(fn):

@@ -15,6 +15,7 @@ import camdyn
 from camdyn import calibrate as cal
 from camdyn.analysis import contact_loss_speed, static_equilibrium
 from camdyn.cam import ConstantSpeed
+from camdyn.rig import NEUTRAL
 
 from .common import PAPER, Context, StudyOutput, default_data_dir, fmt, md_table, recorded_numbers
 
@@ -138,7 +139,7 @@ def starting_rig(start: dict[str, float], geometry: dict[str, float] | None = No
     values.update(geo)
     values.update(I_Pb=start["I_Pb"], w_b=start["w_b"], L_us=start["L_us"], alpha0=start["alpha0"],
                   theta0=theta0_for(start["alpha0"]) + offset, e=0.1 * values["r_c"])
-    return camdyn.Rig(**values)
+    return camdyn.Rig(**{**NEUTRAL, **values})  # a model edit's new constants: the paper's law (camdyn.rig.NEUTRAL)
 
 
 def identify(start: dict[str, float] | None = None, geometry: dict[str, float] | None = None) -> cal.Calibration:
@@ -193,6 +194,8 @@ def _provenance(result: cal.Calibration, exp_rig: camdyn.Rig) -> list[list[str]]
             status, why = "reported (ratio)", TIED_E[1]
         elif p.name in ASSUMED:
             status, why = "assumed", ASSUMED[p.name][1]
+        elif p.name in NEUTRAL:
+            status, why = "the paper's law", "a model edit's constant at its neutral value (derive/parameters.py)"
         else:
             status, why = "reported", REPORTED[p.name][1]
         value = f"{v:.6g}"

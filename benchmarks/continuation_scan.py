@@ -15,7 +15,7 @@ speed L, in two runs (the two period-1 branches the brute-force diagram shows):
 
 It prints the wall time of each (the compiled loop is loaded before the first timing), the
 outcome, the events, and the grazing speed against L with the first-order compliance shift
-(camdyn.analysis.compliance_shift).
+(camdyn.analysis.statics.compliance_shift).
 """
 from __future__ import annotations
 
@@ -24,8 +24,8 @@ import time
 import warnings
 
 import camdyn
-from camdyn.analysis import compliance_shift
-from camdyn.continuation import continue_orbit, events_table
+from camdyn.analysis.statics import compliance_shift
+from camdyn.orbits.continuation import continue_orbit, events_table
 
 
 def main(argv=None):

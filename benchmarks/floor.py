@@ -46,7 +46,7 @@ from camdyn.engine.loop import Samples, Start, run_compiled
 from camdyn.engine.problem import Problem
 from camdyn.engine.tableau import TABLEAUS, arrays
 from camdyn.engine.tables import tables, transition_rows
-from camdyn.model import Model
+from camdyn.model.model import Model
 
 # --- DOP853, from camdyn's tableau: rows of A are the 12 stages, the FSAL stage, the 3 extra
 # stages of the interpolant; P the interpolant in power form over all 16 (numba freezes globals)

@@ -24,7 +24,7 @@ from camdyn.engine import stepper as S
 from camdyn.engine.config import SolverOptions, settings
 from camdyn.engine.kernels import compiled_kernels
 from camdyn.engine.tableau import method_of
-from camdyn.model import Model
+from camdyn.model.model import Model
 
 
 @njit

@@ -18,7 +18,7 @@ C B A, ...) so that a busy spell of the machine falls on all of them alike.
   automaton without event location (a mode register in the RHS, moved on whenever the state is
   across one of the mode's surfaces; see :func:`peer_field`).
 * Start-up: cold (empty numba cache) and warm, each in fresh processes.
-* Sweeps (optional): the bifurcation diagram and contact-loss map timed with camdyn.sweep; the
+* Sweeps (optional): the bifurcation diagram and contact-loss map timed with camdyn.sweep.api; the
   diagram stopping once periodic and shooting from the quasi-static warm start (sweep_stop.py).
 """
 from __future__ import annotations
@@ -46,14 +46,14 @@ from numba.extending import register_jitable
 import camdyn
 import floor
 import sweep_stop
-from camdyn.derive.vocabulary import WITH_RATE_RATE, WITH_RATE_VALUE
+from camdyn.vocabulary import WITH_RATE_RATE, WITH_RATE_VALUE
 from camdyn.engine import rules, stepper
 from camdyn.engine.jit import jitable
 from camdyn.engine.config import EventSettings, SolverOptions
 from camdyn.engine.driver import integrate
 from camdyn.engine.kernels import compiled_kernels
 from camdyn.engine.tables import tables
-from camdyn.model import Model
+from camdyn.model.model import Model
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS, IMG = ROOT / "docs", ROOT / "docs" / "img"
@@ -624,7 +624,7 @@ def permanent_contact_tolerance(revolutions: int) -> dict:
 
 
 def _bifurcation_parts(rig, scene, grid, loss, revolutions) -> tuple[list, dict]:
-    from camdyn import sweep as S
+    from camdyn.sweep import api as S
     parts, seconds = [], {}
     for name, part in (("permanent contact", grid[grid <= loss]), ("impacting", grid[grid > loss])):
         t0 = time.perf_counter()
@@ -641,8 +641,8 @@ def sweep_timing(cfg: Config) -> dict:
     and above it (impacting), every point to the end (stop=None); the contact-loss map; the
     tolerance study of one point; the same diagram stopping once periodic (benchmarks/sweep_stop.py)."""
     import xarray as xr
-    from camdyn import analysis
-    from camdyn import sweep as S
+    from camdyn.analysis import statics as analysis
+    from camdyn.sweep import api as S
     rig, scene = RIG.replace(l_lambda=0.016), camdyn.Scene(damping="D", friction="coulomb")
     loss = camdyn.contact_loss_speed(rig)
     grid = np.linspace(0.8 * loss, 1.6 * loss, cfg.speeds)

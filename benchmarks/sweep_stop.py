@@ -6,7 +6,7 @@
 In one run, side by side on the bifurcation benchmark of ``benchmarks/performance.py`` (line
 16 mm, damping D, Coulomb, 0.8-1.6 x the contact-loss speed, rtol 1e-7, ProcessPoolExecutor(2)):
 the diagram by brute force (every point to the end, ``stop=None``) and with convergence-aware
-stopping (``camdyn.StopWhenPeriodic()``, the default of ``camdyn.sweep.bifurcation``), the
+stopping (``camdyn.StopWhenPeriodic()``, the default of ``camdyn.sweep.api.bifurcation``), the
 revolutions each ran and the agreement of their sections; then one permanent-contact orbit shot
 from the quasi-static warm start against the warm-up run.  ``performance.py`` calls
 :func:`measure` and :func:`lines` for its Sweeps section.
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import camdyn
-from camdyn import sweep as S
+from camdyn.sweep import api as S
 
 RIG = camdyn.example_rig().replace(l_lambda=0.016)
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -101,7 +101,7 @@ def diagrams(speeds: int, revolutions: int) -> dict:
 
 def _leg(leg: tuple) -> tuple:
     """One continuation (start, end, phase_fraction) and its wall time in its process."""
-    from camdyn.continuation import continue_orbit
+    from camdyn.orbits.continuation import continue_orbit
     start, end, phase = leg
     t0 = time.perf_counter()
     ds = continue_orbit(RIG, SCENE, "speed_rpm", start, end, phase_fraction=phase)
@@ -134,7 +134,7 @@ def continued(loss: float, fast) -> dict:
     finite-difference step leaves the contact mode); the wall time of both, their events, and the
     agreement of the stable period-1 points with the stopped diagram's period-1 sections, where
     both exist (the branch interpolated linearly to the diagram's speeds inside it)."""
-    from camdyn.continuation import events_table
+    from camdyn.orbits.continuation import events_table
     out, events = {}, []
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:         # the two directions at once, one per core

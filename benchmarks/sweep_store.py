@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 import camdyn
-from camdyn import sweep as S
+from camdyn.sweep import api as S
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
@@ -47,7 +47,7 @@ class StoreClock:
     """Time spent in FolderStore's methods (this process only)."""
 
     def __init__(self):
-        from camdyn.sweep_store import FolderStore
+        from camdyn.sweep.store import FolderStore
 
         self.seconds = 0.0
         for name in ("create", "put", "chunks", "finish"):

@@ -13,61 +13,48 @@ cheap and ``import camdyn.derive`` does not pull in the runtime.
 """
 from __future__ import annotations
 
-import importlib
+from ._lazy import lazy
 
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "Rig": "camdyn.rig",
-    "load_rig": "camdyn.presets",
-    "example_rig": "camdyn.presets",
-    "Scene": "camdyn.scene",
-    "ConstantSpeed": "camdyn.cam",
-    "Oscillating": "camdyn.cam",
-    "UserMotion": "camdyn.cam",
-    "Model": "camdyn.model",
-    "simulate": "camdyn.simulation",
-    "Result": "camdyn.result",
+    "Rig": "camdyn.model.rig",
+    "load_rig": "camdyn.model.presets",
+    "example_rig": "camdyn.model.presets",
+    "Scene": "camdyn.model.scene",
+    "ConstantSpeed": "camdyn.model.cam",
+    "Oscillating": "camdyn.model.cam",
+    "UserMotion": "camdyn.model.cam",
+    "Model": "camdyn.model.model",
+    "simulate": "camdyn.runs.simulation",
+    "Result": "camdyn.runs.result",
     "Outcome": "camdyn.outcome",
-    "static_equilibrium": "camdyn.analysis",
-    "natural_frequency": "camdyn.analysis",
-    "contact_loss_speed": "camdyn.analysis",
-    "rigid_contact_angle": "camdyn.analysis",
-    "energy_balance_peak": "camdyn.analysis",
+    "static_equilibrium": "camdyn.analysis.statics",
+    "natural_frequency": "camdyn.analysis.statics",
+    "contact_loss_speed": "camdyn.analysis.statics",
+    "rigid_contact_angle": "camdyn.analysis.statics",
+    "energy_balance_peak": "camdyn.analysis.statics",
     "ParameterError": "camdyn.errors",
     "GeometryError": "camdyn.errors",
     "EquilibriumError": "camdyn.errors",
     "SceneError": "camdyn.errors",
     "CompileNotice": "camdyn.errors",
-    "periodic_orbit": "camdyn.orbits",
-    "PeriodicOrbit": "camdyn.orbits",
-    "OrbitOutcome": "camdyn.orbits",
-    "StroboscopicMap": "camdyn.section_map",
-    "lyapunov_exponents": "camdyn.lyapunov",
-    "LyapunovExponents": "camdyn.lyapunov",
-    "LyapunovSettings": "camdyn.lyapunov",
-    "continue_orbit": "camdyn.continuation",
-    "ContinuationSettings": "camdyn.continuation",
-    "ContinuationOutcome": "camdyn.continuation",
-    "zero_one_test": "camdyn.chaos01",
-    "StopWhenPeriodic": "camdyn.stopping",
-    "quasi_static_orbit": "camdyn.quasistatic",
-    "QuasiStaticOrbit": "camdyn.quasistatic",
-    "QuasiStaticOutcome": "camdyn.quasistatic",
+    "periodic_orbit": "camdyn.orbits.shooting",
+    "PeriodicOrbit": "camdyn.orbits.shooting",
+    "OrbitOutcome": "camdyn.orbits.shooting",
+    "StroboscopicMap": "camdyn.orbits.section_map",
+    "lyapunov_exponents": "camdyn.orbits.lyapunov",
+    "LyapunovExponents": "camdyn.orbits.lyapunov",
+    "LyapunovSettings": "camdyn.orbits.lyapunov",
+    "continue_orbit": "camdyn.orbits.continuation",
+    "ContinuationSettings": "camdyn.orbits.continuation",
+    "ContinuationOutcome": "camdyn.orbits.continuation",
+    "zero_one_test": "camdyn.analysis.chaos01",
+    "StopWhenPeriodic": "camdyn.runs.stopping",
+    "quasi_static_orbit": "camdyn.runs.quasistatic",
+    "QuasiStaticOrbit": "camdyn.runs.quasistatic",
+    "QuasiStaticOutcome": "camdyn.runs.quasistatic",
 }
 
+__getattr__, __dir__ = lazy(__name__, _EXPORTS)
 __all__ = sorted(_EXPORTS) + ["__version__"]
-
-
-def __getattr__(name: str):
-    try:
-        module = _EXPORTS[name]
-    except KeyError:
-        raise AttributeError(f"module 'camdyn' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return __all__

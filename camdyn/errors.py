@@ -122,5 +122,5 @@ class SceneError(CamdynError, ValueError):
 class CompileNotice(UserWarning):
     """Issued once when camdyn is about to make code on first use: compile its integration
     loop (a first run on this machine, or after an upgrade), or derive a scene that is not
-    in the catalog (:mod:`camdyn.ondemand`): the run takes seconds longer, once.  Silence it with
+    in the catalog (:mod:`camdyn.model.ondemand`): the run takes seconds longer, once.  Silence it with
     ``warnings.filterwarnings("ignore", category=camdyn.CompileNotice)``."""

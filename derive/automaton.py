@@ -39,7 +39,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .vocabulary import SceneSpec, mode_name
+from camdyn.vocabulary import SceneSpec, mode_name
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ it by its options, with no edit in ``camdyn/``.
 """
 from __future__ import annotations
 
-from .vocabulary import SceneSpec
+from camdyn.vocabulary import SceneSpec
 
 _IMPACT = [SceneSpec(contact="line", damping=d, friction="coulomb") for d in ("none", "A", "B", "C", "D", "E")]
 

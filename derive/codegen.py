@@ -35,7 +35,7 @@ from . import trig
 from .automaton import Automaton
 from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
-from .vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, SceneSpec
+from camdyn.vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, SceneSpec
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
@@ -567,7 +567,7 @@ def _scene_source(L: _Layout) -> str:
             "UNITS = " + repr({n: UNITS.get(n, "1" if _is_constant(n) else None)
                                for n in L.params + [i for i in inputs if i not in L.params]})]
     data += _automaton_code(A)
-    data += ["# --- output quantities (camdyn.derive.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
+    data += ["# --- output quantities (camdyn.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
     data += _index_constants("OUT", OUTPUTS)
     return _module_text(L.header(), _module_doc(spec, A, companion), [_MATH, "", "import numpy"], data,
                         [pack] + L.kernels(L.mod.functions))

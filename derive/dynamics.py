@@ -15,7 +15,8 @@ from types import SimpleNamespace
 import sympy as sp
 from sympy.physics.vector import Point, Vector
 
-from . import laws, vocabulary
+from . import laws
+from camdyn import vocabulary
 from . import symbols as S
 from .graph import Definition, flatten, quantity, substitutions
 from .geometry import N, E_to_Gc, P_to_Ob, chi, follower_frame, psi_i_conditioned, psi_j_conditioned

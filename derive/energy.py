@@ -90,7 +90,7 @@ def printable(expr: sp.Expr) -> sp.Expr:
     alpha = pi/2 written as exact identities in cos(x), which keeps it: sin(x) - 1 in a log
     (:func:`_log_abs`) and c (sin(x)^2 - 1) (as -c cos(x)^2).  In floats sin(x) rounds to 1
     within 1e-8 rad of pi/2, so those are 0 there (log(0), 1/0: an error in Python, inf in
-    compiled code); camdyn.analysis.energy_balance_peak evaluates the potential at
+    compiled code); camdyn.analysis.statics.energy_balance_peak evaluates the potential at
     pi/2 - 1e-9.  (Near -pi/2, log|sin x + 1| and the paper's spring's log|tan x + sec x| lose
     it alike: the follower does not swing there.)"""
     expr = expr.replace(LogAbs, _log_abs)

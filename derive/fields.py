@@ -30,7 +30,7 @@ from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
 from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
-from .vocabulary import CONTINUATION_PARAMETERS, JACOBIAN, OUTPUTS, SURFACE_GRADIENT, SceneSpec
+from camdyn.vocabulary import CONTINUATION_PARAMETERS, JACOBIAN, OUTPUTS, SURFACE_GRADIENT, SceneSpec
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ def _equilibrium_rates(contact: str, name: str) -> tuple[tuple[sp.Symbol, sp.Exp
     """(quantity, its derivative by parameter ``name``) for the equilibrium's alpha*, chi* and
     vartheta, where not zero: M(alpha*) = 0 (Eq. 18) gives dalpha*/dq = -M_q / M_alpha (implicit
     function theorem), chi* = chi0 - psi_j*(alpha*) (Eq. 17) and vartheta = sqrt(-M_alpha / I_Pb)
-    (Eq. 23), all at alpha = alpha*, as the runtime solves them (camdyn.model)."""
+    (Eq. 23), all at alpha = alpha*, as the runtime solves them (camdyn.model.model)."""
     q = S.PARAMS[name].symbol
     M = S.to_plain(equilibrium.static_moment(contact))
     psi_j = S.to_plain(equilibrium.static_gap()[1])

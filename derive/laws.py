@@ -8,7 +8,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import symbols as S
-from .vocabulary import CONTACT_LAWS, DAMPING_MODELS, DAMPING_SIGNS, FRICTION_MODELS  # noqa: F401
+from camdyn.vocabulary import CONTACT_LAWS, DAMPING_MODELS, DAMPING_SIGNS, FRICTION_MODELS  # noqa: F401
 
 
 def spring_compression(a: sp.Expr) -> sp.Expr:

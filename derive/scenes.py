@@ -40,8 +40,7 @@ from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
 from .graph import Definition, quantity
-from .vocabulary import (CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError,  # noqa: F401  (re-exported)
-                         SceneSpec)
+from camdyn.vocabulary import CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError, SceneSpec
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
 
@@ -186,7 +185,7 @@ def build(spec: SceneSpec) -> SceneModule:
                                       "Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) "
                                       "under mode m's laws, bitwise as surface computes each, in one call: "
                                       "out[WITH_RATE_VALUE] = value, out[WITH_RATE_RATE] = rate "
-                                      "(camdyn.derive.vocabulary); nan for a surface without a rate.",
+                                      "(camdyn.vocabulary); nan for a surface without a rate.",
                                       "separate"))
     functions.append(Function("jacobian", _state_args(spec, "m", out=True), ("m",),
                               ("dalpha_ddot_dalpha", "dalpha_ddot_dalpha_dot"),

@@ -3,7 +3,7 @@
 The modules are :func:`camdyn.derive.codegen.sources` of the scene, the same text
 ``python -m camdyn.derive`` writes for it into ``generated/``: the scene's module to OUT_FILE
 and, where the scene has variational kernels, their companion module beside it.  The runtime
-calls this in a separate process to derive a scene on demand (``camdyn.ondemand``), so
+calls this in a separate process to derive a scene on demand (``camdyn.model.ondemand``), so
 ``import camdyn`` itself never imports SymPy.  Each file appears whole or not at all (written
 beside, then renamed), so two processes deriving the same scene do not read half a module;
 the companion is written first, so a scene module on disk always has its companion.
@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from .codegen import ComplexExpressionError, module_name, sources
-from .vocabulary import SceneOptionError, SceneSpec
+from camdyn.vocabulary import SceneOptionError, SceneSpec
 
 
 def _write(text: str, out: Path) -> None:

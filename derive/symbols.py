@@ -1,6 +1,6 @@
 """Symbols of the model, by the paper's notation, with units and meaning.
 
-The constants are declared once, in :mod:`camdyn.derive.parameters` (name, unit, meaning,
+The constants are declared once, in :mod:`camdyn.vocabulary.parameters` (name, unit, meaning,
 valid range, shared with the runtime's :class:`camdyn.Rig`); here each becomes a SymPy
 symbol with the assumptions its range gives (positive lengths, real angles), and a
 module-level name so that the derivation reads like the paper.
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.physics.vector import dynamicsymbols
 
-from . import parameters as declared
+from camdyn.vocabulary import parameters as declared
 
 t = dynamicsymbols._t  # the time symbol dynamicsymbols differentiate with
 
@@ -35,7 +35,7 @@ class Param:
 
 
 def _param(row) -> Param:
-    """The symbol of a declared constant (:mod:`camdyn.derive.parameters`), real, with the
+    """The symbol of a declared constant (:mod:`camdyn.vocabulary.parameters`), real, with the
     sign its declaration gives."""
     assumptions = {row.sign: True} if row.sign else {}
     return Param(sp.Symbol(row.name, real=True, **assumptions), row.unit, row.description)

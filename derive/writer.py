@@ -8,7 +8,7 @@ from pathlib import Path
 
 from .catalog import CATALOG
 from .codegen import module_name, sources
-from .vocabulary import SceneSpec
+from camdyn.vocabulary import SceneSpec
 
 DEFAULT_OUT = Path(__file__).resolve().parent.parent / "generated"
 #: the files of the package that derive writes (any other file of these names is stale)
@@ -22,7 +22,7 @@ def registry_source(specs: tuple[SceneSpec, ...]) -> str:
 """Generated scene kernels of camdyn (written by ``camdyn.derive``, committed).
 
 Each ``scene_<slug>`` module holds the plain-arithmetic kernels of one scene that a run needs;
-:data:`SCENES` maps a scene's slug (``camdyn.derive.vocabulary.SceneSpec.slug``) to its module.
+:data:`SCENES` maps a scene's slug (``camdyn.vocabulary.SceneSpec.slug``) to its module.
 A ``variational_<slug>`` module holds the scene's variational kernels (surface gradients,
 parameter derivatives), imported only for tangent dynamics: the scene module's VARIATIONAL names it.
 """

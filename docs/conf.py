@@ -28,6 +28,9 @@ myst_heading_anchors = 3
 
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
+# a class exported at the top level is documented twice (camdyn.Scene and camdyn.model.scene.Scene):
+# a type hint "Scene" then has two targets, both the same class ("more than one target found")
+suppress_warnings = ["ref.python"]
 autodoc_default_options = {"members": True, "show-inheritance": True}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True

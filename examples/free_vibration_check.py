@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 import camdyn
-from camdyn import analysis, signal
+from camdyn.analysis import statics as analysis, signal
 
 
 def main() -> None:

@@ -18,9 +18,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 import camdyn
-from camdyn import plots
-from camdyn.analysis import contact_loss_speed, natural_frequency
-from camdyn.metadata import describe_scene
+from camdyn.io import plots
+from camdyn.analysis.statics import contact_loss_speed, natural_frequency
+from camdyn.io.metadata import describe_scene
 
 SPEEDS_RPM = (300.0, 1100.0)
 REVOLUTIONS = 3

@@ -2,7 +2,7 @@
 """Generated scene kernels of camdyn (written by ``camdyn.derive``, committed).
 
 Each ``scene_<slug>`` module holds the plain-arithmetic kernels of one scene that a run needs;
-:data:`SCENES` maps a scene's slug (``camdyn.derive.vocabulary.SceneSpec.slug``) to its module.
+:data:`SCENES` maps a scene's slug (``camdyn.vocabulary.SceneSpec.slug``) to its module.
 A ``variational_<slug>`` module holds the scene's variational kernels (surface gradients,
 parameter derivatives), imported only for tangent dynamics: the scene module's VARIATIONAL names it.
 """

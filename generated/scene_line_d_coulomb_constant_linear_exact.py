@@ -62,7 +62,7 @@ INITIAL = ((MODE_CONTACT_FWD, ((SURFACE_SLIP, 1), )), (MODE_CONTACT_BWD, ()),)
 #: target whose conditions hold
 TRANSITIONS = (
 )
-# --- output quantities (camdyn.derive.vocabulary.OUTPUTS) ---
+# --- output quantities (camdyn.vocabulary.OUTPUTS) ---
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
 OUT_PSI_I = 0
 OUT_PSI_J = 1

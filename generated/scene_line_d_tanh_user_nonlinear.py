@@ -71,7 +71,7 @@ TRANSITIONS = (
     (MODE_CONTACT_LOADING, SURFACE_GAP_RATE, +1, ((MODE_CONTACT_UNLOADING, ()),), RESET_IDENTITY),
     (MODE_CONTACT_UNLOADING, SURFACE_GAP, +1, ((MODE_FREE, ()),), RESET_IDENTITY),
 )
-# --- output quantities (camdyn.derive.vocabulary.OUTPUTS) ---
+# --- output quantities (camdyn.vocabulary.OUTPUTS) ---
 OUTPUTS = ('psi_i', 'psi_j', 'psi_i_dot', 'F_s', 'F_n', 'F_f', 'v_r', 'N_x', 'alpha_i', 'energy', 'P_in', 'D_c', 'D_f')
 OUT_PSI_I = 0
 OUT_PSI_J = 1
@@ -271,7 +271,7 @@ def surface(m, s, t, alpha, alpha_dot, p, cam):
 
 
 def surface_with_rate(m, s, t, alpha, alpha_dot, p, cam, out):
-    """Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) under mode m's laws, bitwise as surface computes each, in one call: out[WITH_RATE_VALUE] = value, out[WITH_RATE_RATE] = rate (camdyn.derive.vocabulary); nan for a surface without a rate.
+    """Switching surface s's value and its declared rate's (RATE_OF_SURFACE[s]) under mode m's laws, bitwise as surface computes each, in one call: out[WITH_RATE_VALUE] = value, out[WITH_RATE_RATE] = rate (camdyn.vocabulary); nan for a surface without a rate.
 
     Arguments: m, s, t, alpha, alpha_dot, p, cam, out (see the module docstring).
     Returns (written to out): value (m, m/s or m/s^2), rate (the value's unit per s).

@@ -20,7 +20,7 @@ import numpy as np
 
 import camdyn
 from camdyn.engine import SolverOptions, integrate
-from camdyn.model import Model
+from camdyn.model.model import Model
 
 PATH = Path(__file__).resolve().parent / "data" / "run_fingerprints.json"
 RIG = camdyn.example_rig()
@@ -80,7 +80,7 @@ def benchmark_runs():
 def hard_runs():
     """The reach rule's hard cases (tests/test_hard_cases.py::_reach_cases), by simulate."""
     loss = camdyn.contact_loss_speed(RIG)
-    eq = camdyn.analysis.static_equilibrium(RIG)
+    eq = camdyn.analysis.statics.static_equilibrium(RIG)
     d_coulomb = camdyn.Scene(damping="D", friction="coulomb")
     d_free = camdyn.Scene(damping="D", friction="none")
     preloaded = RIG.replace(e=0.7 * RIG.r_c)
@@ -103,7 +103,7 @@ def hard_runs():
 
 def orbit_runs():
     """A stroboscopic map's run and its tangent dynamics (the variational provider's work)."""
-    from camdyn.tangent import tangent
+    from camdyn.orbits.tangent import tangent
     model = Model(RIG, camdyn.Scene(damping="D", friction="coulomb"), camdyn.ConstantSpeed(1500.0))
     x = np.array([0.02898769, 6.93660094])
     r = tangent(model, (0.0, model.period), x, options=SolverOptions(rtol=1e-10, atol=1e-13))

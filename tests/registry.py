@@ -6,7 +6,7 @@ import math
 import camdyn
 from camdyn import generated
 from camdyn.engine.config import METHODS as _METHODS
-from camdyn.simulation import BACKENDS as _BACKENDS  # "compiled", "python"
+from camdyn.runs.simulation import BACKENDS as _BACKENDS  # "compiled", "python"
 
 RIG = camdyn.example_rig()
 
@@ -23,7 +23,7 @@ def cam_for(scene: camdyn.Scene, speed_rpm: float = 300.0):
         return camdyn.ConstantSpeed(speed_rpm)
     if scene.motion == "oscillating":
         return camdyn.Oscillating(amplitude_pp=math.pi, frequency_rpm=40.0)
-    omega = speed_rpm * camdyn.cam.RPM
+    omega = speed_rpm * camdyn.model.cam.RPM
     th0 = RIG.theta0
     return camdyn.UserMotion(lambda t: th0 + omega * t, lambda t: omega + 0 * t, lambda t: 0 * t,
                              period=2 * math.pi / abs(omega) if omega else math.inf)

@@ -13,7 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from camdyn.sweep import Summary
+from camdyn.sweep.api import Summary
 
 
 @dataclass(frozen=True)

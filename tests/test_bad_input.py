@@ -10,9 +10,9 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import camdyn
-from camdyn.cli import main as cli_main
+from camdyn.cli.commands import main as cli_main
 from camdyn.errors import CamdynError, ParameterError
-from camdyn.rig import PARAMETERS
+from camdyn.model.rig import PARAMETERS
 from registry import BACKENDS, RIG
 
 hostile_numbers = st.one_of(
@@ -146,7 +146,7 @@ def test_a_cam_at_rest_is_refused_by_the_periodic_analyses_saying_why():
     ([0.0] * 20, "series has shape (20,): must be a 1-D series of at least 100 values"),
 ])
 def test_the_zero_one_test_says_what_is_wrong_with_a_series(series, says):
-    from camdyn.chaos01 import zero_one_test
+    from camdyn.analysis.chaos01 import zero_one_test
     with pytest.raises(ParameterError) as info:
         zero_one_test(series)
     assert says in str(info.value) and "not a real number" not in str(info.value)

@@ -1,4 +1,4 @@
-"""camdyn.calibrate: recovers known parameters from their own computed targets; states the
+"""camdyn.analysis.calibrate: recovers known parameters from their own computed targets; states the
 degrees of freedom; rejects ill-posed problems with errors naming the parameter."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 import pytest
 
 import camdyn
-from camdyn import calibrate as cal
+from camdyn.analysis import calibrate as cal
 
 RIG = camdyn.load_rig("example")
 LINE = camdyn.Scene(contact="line", damping="D", friction="coulomb")

@@ -50,7 +50,7 @@ Long runs are restarted every CHUNK revolutions at t = 0 from the end state (the
 periodic, so it is the same motion), which bounds the memory of the samples.  (It also
 worked around a cost that grew with t at rtol 1e-11 -- the same 300 revolutions took 8.2e3
 steps from t = 0, 4.6e4 from t = 1000 T, 1.2e6 from 5000 T, 7.0e6 from 20000 T -- which
-simulate() now avoids itself by integrating in phase-wrapped pieces, camdyn.pieces.)
+simulate() now avoids itself by integrating in phase-wrapped pieces, camdyn.runs.pieces.)
 """
 from __future__ import annotations
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn.chaos01 import _mean_square_displacement, zero_one_test
+from camdyn.analysis.chaos01 import _mean_square_displacement, zero_one_test
 from camdyn.errors import ParameterError
 
 N = 2000

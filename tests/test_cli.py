@@ -10,8 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-from camdyn import cli
-from camdyn.cli import main
+from camdyn.cli import commands as cli
+from camdyn.cli.commands import main
 
 PNG = b"\x89PNG\r\n\x1a\n"
 QUICK = ["--speed-rpm", "1100", "--revolutions", "2", "--sample-rate-Hz", "5000"]  # impacting, < 1 s
@@ -220,7 +220,7 @@ def test_bad_input_is_one_line_and_exit_code_2(argv, words, capsys):
 
 
 def test_a_scene_outside_the_catalog_without_sympy_is_exit_code_2(capsys, monkeypatch, tmp_path):
-    from camdyn import ondemand
+    from camdyn.model import ondemand
     monkeypatch.setenv("CAMDYN_CACHE_DIR", str(tmp_path))  # nothing derived earlier
     monkeypatch.setattr(ondemand, "sympy_version", lambda: None)
     assert main(["simulate", "--speed-rpm", "300", "--contact", "point", "--damping", "B"]) == 2
@@ -228,17 +228,17 @@ def test_a_scene_outside_the_catalog_without_sympy_is_exit_code_2(capsys, monkey
 
 
 def test_a_run_that_stops_early_exits_3_and_still_writes(tmp_path, monkeypatch, capsys):
-    import camdyn.simulation
+    import camdyn.runs.simulation
     from camdyn.outcome import Outcome
 
-    real = camdyn.simulation.simulate
+    real = camdyn.runs.simulation.simulate
 
     def stopping(*args, **kwargs):
         result = real(*args, **kwargs)
         result.outcome = Outcome.CHATTER
         return result
 
-    monkeypatch.setattr(camdyn.simulation, "simulate", stopping)
+    monkeypatch.setattr(camdyn.runs.simulation, "simulate", stopping)
     out = tmp_path / "run.csv"
     assert main(["simulate", *QUICK, "--csv", str(out)]) == 3
     assert out.exists()
@@ -263,16 +263,16 @@ def test_reproduce_lists_and_checks_study_names(capsys):
 
 
 def test_backend_option_reaches_simulate(monkeypatch, capsys):
-    import camdyn.simulation
+    import camdyn.runs.simulation
 
-    real = camdyn.simulation.simulate
+    real = camdyn.runs.simulation.simulate
     seen = []
 
     def spy(*args, **kwargs):
         seen.append(kwargs.get("backend"))
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(camdyn.simulation, "simulate", spy)
+    monkeypatch.setattr(camdyn.runs.simulation, "simulate", spy)
     assert main(["simulate", *QUICK, "--backend", "python"]) == 0
     assert seen == ["python"]
 
@@ -324,12 +324,12 @@ def test_parse_values():
 @pytest.fixture
 def no_simulation(monkeypatch):
     """simulate() fails the test if called: the command must stop before any work."""
-    import camdyn.simulation
+    import camdyn.runs.simulation
 
     def forbidden(*args, **kwargs):
         raise AssertionError("simulate() was called: the error should come before any work")
 
-    monkeypatch.setattr(camdyn.simulation, "simulate", forbidden)
+    monkeypatch.setattr(camdyn.runs.simulation, "simulate", forbidden)
 
 
 def test_a_cam_at_rest_asks_for_t_end_not_revolutions(capsys, no_simulation):
@@ -367,7 +367,7 @@ def test_messages_name_the_option_suggest_and_point_at_the_commands_help(argv, w
 def test_solver_names_come_from_the_engine():
     """The CLI's backends and methods are the engine's (one helper), not a list of its own."""
     from camdyn.engine.tableau import TABLEAUS
-    from camdyn.simulation import BACKENDS
+    from camdyn.runs.simulation import BACKENDS
 
     backends, methods = cli._solvers()
     assert tuple(backends) == tuple(BACKENDS) and set(methods) == set(TABLEAUS)
@@ -488,12 +488,12 @@ def test_warnings_print_as_one_note_line_not_python_source(capsys, monkeypatch):
     """A CompileNotice (or any warning) on the command line: `camdyn: note: ...`, no file and line."""
     import warnings
 
-    import camdyn.presets
+    import camdyn.model.presets
 
     def noisy():
         warnings.warn("compiling, once", camdyn.CompileNotice)
         return ["example"]
-    monkeypatch.setattr(camdyn.presets, "available", noisy)
+    monkeypatch.setattr(camdyn.model.presets, "available", noisy)
     assert main(["scenes"]) == 0
     err = capsys.readouterr().err
     assert "camdyn: note: compiling, once" in err and ".py:" not in err
@@ -530,8 +530,8 @@ def _words_left(text: str) -> list[str]:
 def test_every_piece_of_advice_a_command_prints_is_one_of_its_options(command, extra):
     """The outcomes a command can print (a branch's, its first orbit's, a run's) advise changing
     settings by the library's names; printed by the command they name its flags, which it has."""
-    from camdyn.continuation import ContinuationOutcome
-    from camdyn.orbits import OrbitOutcome
+    from camdyn.orbits.continuation import ContinuationOutcome
+    from camdyn.orbits.shooting import OrbitOutcome
     from camdyn.outcome import Outcome
     args = cli._parser().parse_args([command, *extra])
     enums = (ContinuationOutcome, OrbitOutcome, Outcome) if command == "continue" else (Outcome,)

@@ -3,7 +3,7 @@ points, its multipliers are periodic_orbit's, its events are where the brute-for
 the inverse kinematics put them, and the period-doubling switch gives a period-2 orbit.
 
 The cases, on the example rig (line contact 1.6 mm, damping D, Coulomb friction), found while
-writing this module (see the module's docstring in camdyn.continuation):
+writing this module (see the module's docstring in camdyn.orbits.continuation):
 
 * 1650 -> 1850 rev/min: the impacting period-1 orbit (one impact per revolution) loses
   stability by a period doubling at 1710.2 rev/min; the switched period-2 branch doubles
@@ -23,15 +23,14 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn.analysis import compliance_shift
-from camdyn.continuation import (EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit,
-                                 events_table)
+from camdyn.analysis.statics import compliance_shift
+from camdyn.orbits.continuation import EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
 from camdyn.engine.config import SolverOptions
 from camdyn.errors import ParameterError
-from camdyn.model import Model
-from camdyn.derivatives import SHRINK, finite_difference_steps, finite_differences
-from camdyn.section_map import MapValue, StroboscopicMap
-from camdyn.sweep import bifurcation
+from camdyn.model.model import Model
+from camdyn.orbits.derivatives import SHRINK, finite_difference_steps, finite_differences
+from camdyn.orbits.section_map import MapValue, StroboscopicMap
+from camdyn.sweep.api import bifurcation
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -163,9 +162,9 @@ def test_a_fold_turns_the_branch_back_and_a_jump_of_the_multipliers_is_not_a_bif
     impacting orbit folds at 1289.6 rev/min (the diagram of benchmarks/performance.py loses it
     near 1320, where the long runs leave for another attractor) and comes back unstable, until at
     1510.70 rev/min the test functions change sign across a point whose differences cross other
-    switches than its orbit (unresolved, camdyn.derivatives): the map is not smooth there, the
+    switches than its orbit (unresolved, camdyn.orbits.derivatives): the map is not smooth there, the
     event is a multiplier jump, and no branch is switched to.  (Before the rule of
-    camdyn.derivatives, differences straddling the jump placed it at 1509.6.)"""
+    camdyn.orbits.derivatives, differences straddling the jump placed it at 1509.6.)"""
     rig = RIG.replace(l_lambda=0.016)
     loss = camdyn.contact_loss_speed(rig)
     ds = continue_orbit(rig, SCENE, "speed_rpm", 1.6 * loss, 0.8 * loss)
@@ -205,7 +204,7 @@ def test_any_jacobian_provider_plugs_in(pd_branch):
 def impacting_start():
     """A first point whose finite differences resolve at their first pair of steps (the example
     rig at 1650 rev/min, one impact per revolution), its problem and scale."""
-    from camdyn import continuation as C
+    from camdyn.orbits import continuation as C
     problem = C.Problem(RIG, SCENE, "speed_rpm", 1650.0, 1700.0)
     first, scale = C._start(problem, 20, ContinuationSettings())
     assert first is not None, scale
@@ -215,7 +214,7 @@ def impacting_start():
 
 def _counting(monkeypatch):
     """The engine runs made from now on (every run of a map goes through section_map's integrate)."""
-    import camdyn.section_map as SM
+    import camdyn.orbits.section_map as SM
     runs, real = [], SM.integrate
     monkeypatch.setattr(SM, "integrate", lambda *a, **k: runs.append(1) or real(*a, **k))
     return runs
@@ -231,11 +230,11 @@ def _first_pair(problem, p, scale) -> bool:
 
 def test_a_converged_point_runs_its_orbit_once(impacting_start, monkeypatch):
     """A step's orbit is run once: the corrector's last run gives the point's largest gap and
-    the map's value to the provider, which does not run it again (camdyn.continuation._orbit_run).
+    the map's value to the provider, which does not run it again (camdyn.orbits.continuation._orbit_run).
     So a step that converges in k chord iterations costs k + 1 runs, and its derivatives 12 where
     each of the 3 differences (2 columns, lambda) resolves at its first pair of steps (h and
-    h / 4, 2 runs each: camdyn.derivatives); the first point 1 + 12."""
-    from camdyn import continuation as C
+    h / 4, 2 runs each: camdyn.orbits.derivatives); the first point 1 + 12."""
+    from camdyn.orbits import continuation as C
     problem, first, scale = impacting_start
     evaluations = []
     real_evaluate = C._evaluate
@@ -292,7 +291,7 @@ def test_the_dataset_round_trips_through_netcdf(pd_branch, tmp_path):
 
 def test_the_branches_plot_over_a_diagram(pd_branch):
     pytest.importorskip("matplotlib")
-    from camdyn import plots
+    from camdyn.io import plots
     diagram = bifurcation(RIG, SCENE, [1700.0, 1750.0], revolutions=20, transient_revolutions=10, progress=False)
     fig = plots.branches(pd_branch, diagram=diagram)
     ax = fig.axes[0]
@@ -335,10 +334,10 @@ def test_bad_settings_name_the_setting(kwargs, name):
     (-2.0, float("nan"), 0.45),         # hi has no value (a failed step): the midpoint
     (1.0, 1.0, 0.45)])                  # no slope: the midpoint
 def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f_hi, expected):
-    """The secant trial of the event location (camdyn.continuation._trial) stays tol/2 inside
+    """The secant trial of the event location (camdyn.orbits.continuation._trial) stays tol/2 inside
     [lo, hi] = [0.2, 0.7] (tol = 1e-3), so every trial shrinks the bracket by at least that and
     the location ends; the midpoint when an end has no value."""
-    from camdyn.continuation import _trial
+    from camdyn.orbits.continuation import _trial
     assert _trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)
 
 
@@ -354,10 +353,10 @@ def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f
     (0.2, 0.7, [(0.7, -1.0), (0.5, -0.5)], -1.0, 0.3 - 2.5e-4),          # contact side at hi: past root 0.3 toward lo
 ])
 def test_each_grazing_trial_aims_from_the_contact_side(lo, hi, contact, far, expected):
-    """camdyn.continuation._grazing_trial (tol = 1e-3): past the contact-side secant's root by
+    """camdyn.orbits.continuation._grazing_trial (tol = 1e-3): past the contact-side secant's root by
     tol / 4 (GRAZING_PAST), short of it by its change while that exceeds tol / 4, never nearer
     the far end than 0.75 tol nor the contact end than tol / 4; the midpoint otherwise."""
-    from camdyn.continuation import _grazing_trial
+    from camdyn.orbits.continuation import _grazing_trial
     assert _grazing_trial(lo, hi, contact, far, 1e-3) == pytest.approx(expected, rel=1e-12)
 
 
@@ -366,7 +365,7 @@ def grazing_step():
     """Two orbits of the benchmark rig's contact branch (line contact 16 mm, section at T/2) on
     either side of its grazing at 0.999998 x the contact-loss speed L: p at 0.995 L in permanent
     contact, q 0.6 of the range 0.995-1.005 L on, at 1.001 L, in flight."""
-    from camdyn import continuation as C
+    from camdyn.orbits import continuation as C
     loss = camdyn.contact_loss_speed(RIG.replace(l_lambda=0.016))
     problem = C.Problem(RIG.replace(l_lambda=0.016), SCENE, "speed_rpm", 0.995 * loss, 1.005 * loss, phase_fraction=0.5)
     p, scale = C._start(problem, 20, ContinuationSettings())
@@ -380,7 +379,7 @@ def test_grazing_is_located_where_bisection_locates_it_in_fewer_trials(grazing_s
     trial), between the same two orbits: both brackets hold the grazing within locate_tol of
     arclength, so their points agree to twice that; measured 8 trials against 20, and the
     located orbits 1.0e-7 of the range apart."""
-    from camdyn import continuation as C
+    from camdyn.orbits import continuation as C
     problem, p, q, scale = grazing_step
     settings = ContinuationSettings()
     trials = []
@@ -417,7 +416,7 @@ class _AnalyticMap:
 
 @dataclasses.dataclass(frozen=True)
 class _AnalyticProblem:
-    """What camdyn.continuation reads of its Problem, for a map given in closed form; its
+    """What camdyn.orbits.continuation reads of its Problem, for a map given in closed form; its
     Jacobian is central differences with a step of 1e-6 (error ~1e-12 on these polynomials)."""
 
     f: object
@@ -442,7 +441,7 @@ class _AnalyticProblem:
 
 def _continued(f, start, end, monkeypatch):
     """Follow the fixed point x = 0 of f from start to end: the branch and its events."""
-    from camdyn import continuation as C
+    from camdyn.orbits import continuation as C
 
     def run(problem, lam, x, mode, periods):          # P_n(x) alone: no engine run to sample
         return C._Run(None, problem.section_map(lam, mode).evaluate(x), None, np.zeros(0))

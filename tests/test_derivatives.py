@@ -6,7 +6,7 @@ differences of the map stepped across the orbit's contact margin, the perturbed 
 and re-impacted while the orbit stayed in contact, and the Floquet multipliers were off by up to
 0.96, reported CONVERGED.  On the same kind of rig with a point contact, the perturbed runs keep
 the contact but the Hertz law is so curved at the step's scale that the difference is off by
-0.01-0.03.  camdyn.derivatives now takes a difference only along the base run's hybrid path and
+0.01-0.03.  camdyn.orbits.derivatives now takes a difference only along the base run's hybrid path and
 only once two steps agree, else falls back to the variational provider, else says the
 multipliers are unresolved.
 
@@ -21,13 +21,13 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn.analysis import contact_loss_speed
-from camdyn.derivatives import (SHRINK, Column, FiniteDifferences, Unresolved, finite_differences,
-                                resolved_difference, step_floor)
+from camdyn.analysis.statics import contact_loss_speed
+from camdyn.orbits.derivatives import (SHRINK, Column, FiniteDifferences, Unresolved, finite_differences,
+                                       resolved_difference, step_floor)
 from camdyn.engine.config import SolverOptions
-from camdyn.orbits import OrbitOutcome
-from camdyn.section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue
-from camdyn.tangent import variational
+from camdyn.orbits.shooting import OrbitOutcome
+from camdyn.orbits.section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue
+from camdyn.orbits.tangent import variational
 
 RTOL = DEFAULT_OPTIONS.rtol
 

@@ -66,7 +66,7 @@ def unhertz(expr):
 
 def example_values(**override) -> dict:
     """The shipped example rig as {symbol: value}, Y_e from Eq. 14."""
-    from camdyn.presets import example_rig
+    from camdyn.model.presets import example_rig
 
     d = {k: v for k, v in example_rig().to_dict().items() if k in S.PARAMS and v is not None}
     d.update(override)

@@ -16,7 +16,38 @@ import camdyn
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 #: the public modules the reference must cover (the engine's modules join after its rewrite)
-MODULES = ["analysis", "orbits", "quasistatic", "stopping", "section_map", "tangent", "lyapunov", "continuation", "chaos01", "sweep", "ondemand", "plots", "signal", "cam", "rig", "result", "outcome", "errors", "metadata", "files"]
+MODULES = [
+    "model.rig",
+    "model.cam",
+    "model.scene",
+    "model.model",
+    "model.presets",
+    "model.ondemand",
+    "runs.simulation",
+    "runs.result",
+    "runs.stopping",
+    "runs.quasistatic",
+    "runs.pieces",
+    "orbits.section_map",
+    "orbits.derivatives",
+    "orbits.shooting",
+    "orbits.tangent",
+    "orbits.lyapunov",
+    "orbits.continuation",
+    "analysis.statics",
+    "analysis.calibrate",
+    "analysis.chaos01",
+    "analysis.signal",
+    "sweep.api",
+    "io.files",
+    "io.metadata",
+    "io.plots",
+    "vocabulary.scenes",
+    "vocabulary.names",
+    "vocabulary.parameters",
+    "outcome",
+    "errors",
+]
 
 
 @pytest.fixture(scope="module")

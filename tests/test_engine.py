@@ -21,7 +21,7 @@ from camdyn.engine.loop import SUCCESS, Samples, Start, run_compiled, run_interp
 from camdyn.engine.tableau import DOP853, arrays
 from camdyn.engine.tables import IDENTITY, tables
 from camdyn.errors import ParameterError
-from camdyn.model import Model
+from camdyn.model.model import Model
 from registry import RIG, SCENES, cam_for, scene_from_slug
 from toy import bounce_problem, settings
 

@@ -47,7 +47,7 @@ def test_drift_check_catches_a_hand_edit(tmp_path):
     """A hand edit of a generated file makes --check fail and names the file."""
     pytest.importorskip("sympy")
     from camdyn.derive.writer import check, render
-    from camdyn.derive.vocabulary import SceneSpec
+    from camdyn.vocabulary import SceneSpec
     spec = SceneSpec(damping="none", friction="none")
     files = render((spec,))
     assert sorted(files) == ["__init__.py", f"scene_{spec.slug}.py", f"variational_{spec.slug}.py"]
@@ -73,7 +73,7 @@ def test_render_in_processes_gives_the_same_bytes_as_in_one():
     """render(jobs=2) (slowest scenes first, caches per process) writes exactly what jobs=1
     writes, in the same order, and both match the committed files."""
     pytest.importorskip("sympy")
-    from camdyn.derive.vocabulary import SceneSpec
+    from camdyn.vocabulary import SceneSpec
     from camdyn.derive.writer import render
     specs = (SceneSpec(damping="none", friction="none"), SceneSpec(contact="point", damping="none", friction="none"),
              SceneSpec(damping="D", friction="tanh", motion="oscillating"))
@@ -126,7 +126,7 @@ def test_a_companion_shares_its_scenes_layout(slug):
 
 
 def test_runtime_never_imports_sympy_and_a_run_not_the_variational_kernels():
-    code = ("import sys, camdyn, camdyn.simulation, camdyn.analysis\n"
+    code = ("import sys, camdyn, camdyn.runs.simulation, camdyn.analysis.statics\n"
             "r = camdyn.simulate(camdyn.example_rig(), camdyn.Scene(), speed_rpm=300, t_end=0.01)\n"
             "assert r.ok\nprint('sympy' in sys.modules, sorted(m for m in sys.modules if 'variational_' in m))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -305,7 +305,7 @@ def test_surface_with_rate_is_surface_bit_for_bit(slug):
     assert checked >= len(mod.MODES)
 
 
-#: kernels only the tangent dynamics and the continuation use (camdyn.tangent, camdyn.continuation)
+#: kernels only the tangent dynamics and the continuation use (camdyn.orbits.tangent, camdyn.orbits.continuation)
 STABILITY_KERNELS = ("surface_gradient", "field_sensitivity")
 
 

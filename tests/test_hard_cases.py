@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import analysis
+from camdyn.analysis import statics as analysis
 from camdyn.engine import EventSettings
 from registry import METHODS, RIG
 
@@ -308,7 +308,7 @@ CHAOTIC_SPEED = 196.0  # rev/min: the chaotic case of tests/test_chaos.py
 @pytest.mark.parametrize("method", METHODS)
 def test_a_run_late_in_time_costs_what_it_costs_at_the_start(method):
     """The same 20 revolutions started at t = 0 and at t = 20000 T (same cam phase) at rtol 1e-11.
-    Without phase-wrapped pieces (camdyn.pieces) the rounding of t perturbs every stage time by
+    Without phase-wrapped pieces (camdyn.runs.pieces) the rounding of t perturbs every stage time by
     ~1e-16 t and the late run took 504,959 steps against 589 (measured, compiled, DOP853).  With
     them: the same step count within 1 %, and the same motion over the first 3 revolutions
     (chaotic: e^0.62 growth per revolution; bound 1e-9 rad, measured ~1e-11)."""
@@ -331,7 +331,7 @@ def test_pieces_join_into_the_same_run(method, monkeypatch):
     differ by local errors: measured 2.3e-10 s and 1.4e-9 rad compiled, 1.3e-9 s SciPy), and the
     energy ledger continuous
     and balanced across the joins (bound as test_energy_ledger_balances)."""
-    from camdyn import pieces
+    from camdyn.runs import pieces
     kw = dict(speed_rpm=1300, revolutions=10, sample_rate_Hz=5000, rtol=1e-10, atol=1e-14, energy_ledger=True,
               method=method)
     whole = camdyn.simulate(RIG, D_COULOMB, **kw)

@@ -11,8 +11,8 @@ import pytest
 
 import camdyn
 from camdyn.engine.config import SolverOptions
-from camdyn.lyapunov import LyapunovSettings, lyapunov_exponents
-from camdyn.orbits import periodic_orbit
+from camdyn.orbits.lyapunov import LyapunovSettings, lyapunov_exponents
+from camdyn.orbits.shooting import periodic_orbit
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")

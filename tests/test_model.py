@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import analysis
+from camdyn.analysis import statics as analysis
 from camdyn.errors import EquilibriumError, GeometryError, ParameterError, SceneError
-from camdyn.model import Model
+from camdyn.model.model import Model
 from registry import RIG
 
 
@@ -115,7 +115,7 @@ def test_scene_errors(options, text):
 
 
 def test_unknown_scene_says_how_to_generate_it(monkeypatch, tmp_path):
-    from camdyn import ondemand
+    from camdyn.model import ondemand
     monkeypatch.setenv("CAMDYN_CACHE_DIR", str(tmp_path))  # nothing derived earlier
     monkeypatch.setattr(ondemand, "sympy_version", lambda: None)  # and it cannot be derived here
     with pytest.raises(SceneError) as info:
@@ -163,7 +163,7 @@ def test_follower_leaving_for_good_stops_with_a_clear_outcome():
 def test_static_kernels_get_the_rigs_zeros_and_nan_for_what_they_never_read():
     """Regression: placeholders were once filled with `value or 1.0`, turning alpha0 = 0.0 into
     1.0 rad in the reach check.  Zeros must pass through; unread slots are NaN, never a number."""
-    from camdyn.model import static_parameters
+    from camdyn.model.model import static_parameters
     K = camdyn.Scene().kernels()
     rig = RIG.replace(alpha0=0.0, e=0.0)
     p = static_parameters(rig, K)
@@ -196,13 +196,13 @@ def test_fastest_rate_of_the_undamped_frictionless_contact_is_vartheta():
     assert rate.value == pytest.approx(model.equilibrium.vartheta, rel=1e-6)
 
 
-@pytest.mark.parametrize("preset", camdyn.presets.available())
+@pytest.mark.parametrize("preset", camdyn.model.presets.available())
 def test_no_shipped_rig_comes_near_the_rate_limit(preset):
     """simulation.MAX_RATE refuses runs an explicit method cannot finish; the shipped rigs, in
     every generated scene with a constant-speed cam, stay 100x below it."""
-    from camdyn.simulation import MAX_RATE
+    from camdyn.runs.simulation import MAX_RATE
     from registry import SCENES, cam_for, scene_from_slug
-    rig = camdyn.presets.load_rig(preset)
+    rig = camdyn.model.presets.load_rig(preset)
     rates = {}
     for slug in SCENES:
         scene = scene_from_slug(slug)

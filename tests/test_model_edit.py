@@ -39,9 +39,9 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import presets
-from camdyn import rig as rig_module
-from camdyn.cli import main
+from camdyn.model import presets
+from camdyn.model import rig as rig_module
+from camdyn.cli.commands import main
 from camdyn.errors import ParameterError
 
 sp = pytest.importorskip("sympy")
@@ -86,11 +86,14 @@ def doc_edits(title: str) -> list[tuple[str, str, str]]:
 
 
 def apply_doc_edits(title: str, derive: Path) -> list[tuple[str, str, str]]:
-    """Apply a section's edits to the copy ``derive`` of derive/; each old text must occur once."""
+    """Apply a section's edits to the copy ``derive`` of derive/ (and an edit of the vocabulary,
+    ``camdyn/vocabulary/...``, to the vocabulary beside it: the copy's package holds both); each
+    old text must occur once."""
     edits = doc_edits(title)
     for path, old, new in edits:
-        assert path.startswith("derive/"), path
-        file = derive / path.removeprefix("derive/")
+        assert path.startswith(("derive/", "camdyn/vocabulary/")), path
+        file = derive / path.removeprefix("derive/") if path.startswith("derive/") else \
+            derive.parent / path.removeprefix("camdyn/")
         text = file.read_text()
         assert text.count(old) == 1, (f"docs/model-editing.md, {title!r}: {path} does not contain, once, "
                                       f"the lines\n{old}\nupdate the page (and this test's expectations)")
@@ -122,7 +125,7 @@ def copy_tree(src: Path, dst: Path) -> Path:
 def one_scene_catalog(derive: Path, *specs: str) -> None:
     """Cut the copy's catalog down to ``specs`` (``SceneSpec(...)`` texts)."""
     (derive / "catalog.py").write_text(
-        "from .vocabulary import SceneSpec\n\nCATALOG = (\n" + "".join(f"    {s},\n" for s in specs) + ")\n")
+        "from camdyn.vocabulary import SceneSpec\n\nCATALOG = (\n" + "".join(f"    {s},\n" for s in specs) + ")\n")
 
 
 def full_copy(tmp_path: Path) -> Path:
@@ -136,9 +139,10 @@ def full_copy(tmp_path: Path) -> Path:
 
 
 def runtime_files(pkg: Path) -> dict[Path, bytes]:
-    """The runtime's modules in a copy (all but derive/ and generated/), to show none changed."""
+    """The runtime's modules in a copy (all but derive/, generated/ and the vocabulary both read),
+    to show none changed."""
     return {p.relative_to(pkg): p.read_bytes() for p in pkg.rglob("*.py")
-            if p.relative_to(pkg).parts[0] not in ("derive", "generated")}
+            if p.relative_to(pkg).parts[0] not in ("derive", "generated", "vocabulary")}
 
 
 def copy_env(tmp_path: Path) -> dict:
@@ -159,7 +163,7 @@ def scratch_cli(tmp_path: Path):
 
 def csv_columns(path: Path) -> dict[str, np.ndarray]:
     """The numeric columns of a ``camdyn simulate --csv`` file by quantity name (``alpha (rad)`` -> ``alpha``)."""
-    from camdyn.metadata import parse_column_header
+    from camdyn.io.metadata import parse_column_header
     rows = list(csv.reader(path.open()))
     names = [parse_column_header(h) for h in rows[0]]
     return {n: np.array([float(r[i]) for r in rows[1:]]) for i, n in enumerate(names) if n != "regime"}
@@ -194,10 +198,12 @@ def test_regenerate_refuses_a_folder_that_is_not_derive(tmp_path, capsys):
 
 @pytest.mark.parametrize("title", [RECIPE_1, RECIPE_2, RECIPE_3, NEW_PARAMETER])
 def test_every_documented_edit_applies_to_derive_as_written(tmp_path, title):
-    """The page's diffs match today's derive/ (the end-to-end tests below run them)."""
+    """The page's diffs match today's derive/ and vocabulary (the end-to-end tests below run them)."""
     derive = copy_tree(package_dir("camdyn.derive"), tmp_path / "derive")
+    copy_tree(package_dir("camdyn.vocabulary"), tmp_path / "vocabulary")
     for path, old, new in apply_doc_edits(title, derive):
-        assert new in (derive / path.removeprefix("derive/")).read_text()
+        assert new in (tmp_path / path.removeprefix("camdyn/")).read_text() if path.startswith("camdyn/") \
+            else new in (derive / path.removeprefix("derive/")).read_text()
 
 
 def cubic_spring(k_s3):
@@ -215,7 +221,7 @@ def test_a_cubic_spring_has_a_real_potential_whose_derivative_is_its_moment():
     log(-1) = i pi (compiled code cannot store it in the real energy output); the potential
     the derivation builds is real, 0 at alpha = 0, its derivative is the moment (symbolically,
     in fields.checked_potential), and the code's form of it keeps full precision up to
-    pi/2 - 1e-9 rad, where camdyn.analysis.energy_balance_peak evaluates it."""
+    pi/2 - 1e-9 rad, where camdyn.analysis.statics.energy_balance_peak evaluates it."""
     import mpmath
 
     from camdyn.derive import energy, fields, symbols as S
@@ -265,7 +271,7 @@ def test_code_generation_refuses_a_complex_number_naming_scene_kernel_and_expres
 
 
 def test_a_neutral_value_is_declared_for_an_optional_parameter_within_its_range():
-    from camdyn.derive.parameters import RigParameter, Rule
+    from camdyn.vocabulary.parameters import RigParameter, Rule
 
     RigParameter("k_s3", "N/m^3", "cubic stiffness", False, "a model edit", (Rule(">=", 0.0),), neutral=0.0)
     with pytest.raises(ValueError, match="optional"):
@@ -479,7 +485,7 @@ def regenerated_with_a_new_parameter(tmp_path: Path):
     regeneration's output.  A copy of the example rig file, as the user had it before the
     edit, is ``mine.toml``."""
     pkg = full_copy(tmp_path)
-    shutil.copy(pkg / "data" / "example.toml", tmp_path / "mine.toml")
+    shutil.copy(pkg / "model" / "data" / "example.toml", tmp_path / "mine.toml")
     apply_doc_edits(NEW_PARAMETER, pkg / "derive")
     one_scene_catalog(pkg / "derive", 'SceneSpec(damping="D", friction="coulomb")')
     cli = scratch_cli(tmp_path)
@@ -502,7 +508,7 @@ def test_a_new_parameter_the_pages_commands_run_the_cubic_spring_compiled(tmp_pa
     pkg, cli, _ = regenerated_with_a_new_parameter(tmp_path)
     before = runtime_files(pkg)
     assert CUBIC_LINE in doc_section(NEW_PARAMETER)
-    example = (pkg / "data" / "example.toml").read_text()
+    example = (pkg / "model" / "data" / "example.toml").read_text()
     (tmp_path / "cubic.toml").write_text(K_S3_LINE.sub(CUBIC_LINE, example))
     run = cli("simulate", "--rig", "cubic.toml", "--speed-rpm", "1100", "--csv", "cubic.csv")  # the page's command
     assert run.returncode == 0, run.stderr
@@ -543,7 +549,7 @@ def test_a_new_parameter_keeps_the_shipped_rigs_running_the_papers_law(tmp_path)
     said so, ``--check`` passes, and the quickstart runs the paper's law as before."""
     pkg, cli, said = regenerated_with_a_new_parameter(tmp_path)
     for name in presets.available():
-        path = pkg / "data" / f"{name}.toml"
+        path = pkg / "model" / "data" / f"{name}.toml"
         assert f"updated the shipped rig {path}: added k_s3 = 0.0" in said
         assert rig_values(path)["k_s3"] == 0.0
     check = cli("regenerate", "--check", "--jobs", "1")

@@ -1,4 +1,4 @@
-"""Scenes outside the catalog, derived on first use into the per-user cache (camdyn.ondemand)."""
+"""Scenes outside the catalog, derived on first use into the per-user cache (camdyn.model.ondemand)."""
 from __future__ import annotations
 
 import sys
@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import ondemand
-from camdyn.cli import main
+from camdyn.model import ondemand
+from camdyn.cli.commands import main
 from camdyn.errors import SceneError
-from camdyn.model import Model
-from camdyn.scene import variational_kernels
+from camdyn.model.model import Model
+from camdyn.model.scene import variational_kernels
 
 #: a valid scene that derive/catalog.py does not list (and a small one: quick to derive)
 OPTIONS = dict(contact="point", damping="C", friction="none")
@@ -27,7 +27,7 @@ def user_cache(tmp_path, monkeypatch):
 
 
 def test_the_scene_is_not_in_the_catalog():
-    assert camdyn.derive.vocabulary.SceneSpec(**OPTIONS).slug not in camdyn.Scene.available()
+    assert camdyn.vocabulary.SceneSpec(**OPTIONS).slug not in camdyn.Scene.available()
 
 
 def test_without_sympy_the_error_names_the_derive_extra(user_cache, monkeypatch):

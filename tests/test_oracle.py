@@ -16,7 +16,7 @@ import pytest
 
 import camdyn
 import oracle
-from camdyn.model import Model
+from camdyn.model.model import Model
 from registry import RIG
 
 LINE_16 = RIG.replace(l_lambda=0.016)

@@ -19,16 +19,16 @@ import pytest
 
 import camdyn
 from camdyn import periodic_orbit
-from camdyn.model import Model
-from camdyn.orbits import OrbitOutcome
-from camdyn.section_map import DEFAULT_OPTIONS
+from camdyn.model.model import Model
+from camdyn.orbits.shooting import OrbitOutcome
+from camdyn.orbits.section_map import DEFAULT_OPTIONS
 
 RIG = camdyn.example_rig()
 PRELOADED = RIG.replace(e=0.7 * RIG.r_c, L_us=0.2)  # keeps contact over the oscillating cam's stroke
 SCENE = camdyn.Scene(damping="D", friction="coulomb", motion="oscillating")
 CAM = camdyn.Oscillating(math.pi, 40)
 #: the finite-difference monodromy's entries carry errors ~rtol^(2/3) = 2e-7 at the map's
-#: rtol 1e-10 (camdyn.orbits.SINGULAR_SIGMA): a multiplier below 5 times that is zero to it
+#: rtol 1e-10 (camdyn.orbits.shooting.SINGULAR_SIGMA): a multiplier below 5 times that is zero to it
 FD_ZERO = 1e-6
 
 

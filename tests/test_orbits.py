@@ -2,7 +2,7 @@
 monodromy, Newton's outcomes, and the Floquet multipliers against the simulated dynamics.
 
 The cases, on the example rig with line contact, damping D and Coulomb friction (contact is lost
-near 998 rev/min, camdyn.analysis.contact_loss_speed), found while writing this module:
+near 998 rev/min, camdyn.analysis.statics.contact_loss_speed), found while writing this module:
 
 * 600 rev/min, permanent contact: the orbit slides backward in the viscous phase of damping D
   all round (no switch over a period); multipliers a complex pair of modulus 5.4e-7 (the contact
@@ -19,10 +19,10 @@ import pytest
 
 import camdyn
 from camdyn.errors import ParameterError
-from camdyn.model import Model
-from camdyn.orbits import OrbitOutcome, ShootingSettings, newton, periodic_orbit
-from camdyn.derivatives import finite_differences
-from camdyn.section_map import DEFAULT_OPTIONS, MapFailure, MapValue, StroboscopicMap, derivative_at
+from camdyn.model.model import Model
+from camdyn.orbits.shooting import OrbitOutcome, ShootingSettings, newton, periodic_orbit
+from camdyn.orbits.derivatives import finite_differences
+from camdyn.orbits.section_map import DEFAULT_OPTIONS, MapFailure, MapValue, StroboscopicMap, derivative_at
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -314,7 +314,7 @@ def test_a_flight_orbit_coexists_with_the_contact_orbit_below_the_contact_loss_s
     orbit of large flights (warmed up from the 150 rev/min flight orbit).  Bounds: 'distinct'
     is 0.1 rad apart at the section, half the flight orbit's measured distance from the contact
     orbit (0.21 rad); 'stable' is every |multiplier| < 1 (measured 0 and 0.63)."""
-    from camdyn.tangent import variational
+    from camdyn.orbits.tangent import variational
     rig = camdyn.load_rig("reference-experiment")
     scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
     assert 125.0 < camdyn.contact_loss_speed(rig)

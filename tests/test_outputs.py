@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import files, metadata
-from camdyn.cli import main
-from camdyn.rig import PARAMETERS
+from camdyn.io import files, metadata
+from camdyn.cli.commands import main
+from camdyn.model.rig import PARAMETERS
 
 xr = pytest.importorskip("xarray")
 QUICK = ["--speed-rpm", "1100", "--revolutions", "1", "--sample-rate-Hz", "4000"]

@@ -1,4 +1,4 @@
-"""camdyn.plots: each figure is drawn from real runs, has the axes a reader needs, and saves;
+"""camdyn.io.plots: each figure is drawn from real runs, has the axes a reader needs, and saves;
 matplotlib stays optional."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import plots
+from camdyn.io import plots
 
 matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
@@ -165,7 +165,7 @@ def test_unknown_quantity_is_a_clear_error(impacting):
 
 def test_import_does_not_need_matplotlib_and_calls_say_how_to_install():
     code = ("import sys; sys.modules['matplotlib'] = None; sys.modules['matplotlib.pyplot'] = None\n"
-            "import camdyn.plots as p\n"
+            "import camdyn.io.plots as p\n"
             "try:\n    p.time_history(None)\nexcept ImportError as e:\n    print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert 'pip install "camdyn[plot]"' in out

@@ -1,4 +1,4 @@
-"""Tests of camdyn.rig (the Rig parameter set) and camdyn.errors."""
+"""Tests of camdyn.model.rig (the Rig parameter set) and camdyn.errors."""
 
 import dataclasses
 import importlib
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from camdyn.errors import CamdynError, ParameterError, RigFileError
-from camdyn.rig import PARAMETERS, Rig
+from camdyn.model.rig import PARAMETERS, Rig
 
 DATA = Path(__file__).parent / "data"
 REPO = Path(__file__).resolve().parents[1]
@@ -323,21 +323,21 @@ def test_error_hierarchy_and_pickling():
 
 
 def test_import_does_not_import_sympy():
-    code = "import sys, camdyn.rig; sys.exit(any(m.split('.')[0] == 'sympy' for m in sys.modules))"
+    code = "import sys, camdyn.model.rig; sys.exit(any(m.split('.')[0] == 'sympy' for m in sys.modules))"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
     assert subprocess.run([sys.executable, "-c", code], env=env).returncode == 0
 
 
 def test_shipped_rig_files_state_each_parameters_meaning_and_unit():
     """Issue 14 (R): every parameter line of a shipped TOML rig ends with the meaning and SI unit
-    of camdyn.rig.PARAMETERS (as Rig.to_toml writes them), so a user editing a file sees units."""
+    of camdyn.model.rig.PARAMETERS (as Rig.to_toml writes them), so a user editing a file sees units."""
     import re
     from importlib.resources import files
 
-    from camdyn.rig import PARAMETERS
+    from camdyn.model.rig import PARAMETERS
 
     by_name = {p.name: p for p in PARAMETERS}
-    for path in files("camdyn.data").iterdir():
+    for path in files("camdyn.model.data").iterdir():
         if not path.name.endswith(".toml"):
             continue
         lines = path.read_text(encoding="utf-8").split("[parameters]", 1)[1].splitlines()
@@ -352,7 +352,7 @@ def test_rig_reads_the_one_declaration_in_derive():
     and every constant a generated scene reads is either a rig parameter, an equilibrium
     result, a cam constant or a constant of the laws computed from them."""
     from camdyn import generated
-    from camdyn.derive import parameters as declared
+    from camdyn.vocabulary import parameters as declared
     assert [p.name for p in PARAMETERS] == list(declared.RIG_NAMES)
     for p, row in zip(PARAMETERS, declared.RIG_PARAMETERS):
         assert (p.required, p.rules, p.description) == (row.required, row.rules, row.description)

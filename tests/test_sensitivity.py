@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 
 import camdyn
-from camdyn.cam import RPM
-from camdyn.derive.vocabulary import CONTINUATION_PARAMETERS
-from camdyn.model import Model
+from camdyn.model.cam import RPM
+from camdyn.vocabulary import CONTINUATION_PARAMETERS
+from camdyn.model.model import Model
 
 RIG = camdyn.example_rig()
 SPEED = 1100.0

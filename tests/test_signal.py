@@ -1,21 +1,11 @@
-"""Tests of camdyn.signal."""
+"""Tests of camdyn.analysis.signal."""
 import math
 
 import numpy as np
 import pytest
 
-from camdyn.signal import (
-    frequency_resolution,
-    harmonics,
-    is_uniform,
-    peak_frequency,
-    peak_to_peak,
-    rms,
-    sample_rate,
-    spectrum,
-    whole_periods,
-    noise_floor,
-)
+from camdyn.analysis.signal import (frequency_resolution, harmonics, is_uniform, peak_frequency, peak_to_peak, rms,
+                                    sample_rate, spectrum, whole_periods, noise_floor)
 
 FS = 1000.0  # Hz
 N = 1024

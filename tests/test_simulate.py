@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import analysis, signal
+from camdyn.analysis import statics as analysis, signal
 from registry import METHODS, RIG, SCENES, cam_for, scene_from_slug
 
 FRICTIONLESS = camdyn.Scene(damping="none", friction="none")
@@ -66,7 +66,7 @@ def impacting():
 def test_impacts_alternate_and_switch_on_the_surface(impacting):
     r = impacting
     assert r.ok and r.impacts().size >= 5
-    from camdyn.model import Model
+    from camdyn.model.model import Model
     m = Model(RIG, camdyn.Scene(damping="D", friction="coulomb"), camdyn.ConstantSpeed(1100))
     contact = [s for s in r.switches if s.surface == "gap"]
     for a, b in zip(contact, contact[1:]):
@@ -101,7 +101,7 @@ def test_D_force_is_continuous_at_maximum_compression(impacting):
     """At psi_i_dot = 0 both laws of model D give the same force, so the switch needs no jump."""
     switches = [s for s in impacting.switches if s.surface == "gap_rate"]
     assert switches
-    from camdyn.model import Model
+    from camdyn.model.model import Model
     scene = camdyn.Scene(damping="D", friction="coulomb")
     m = Model(RIG, scene, camdyn.ConstantSpeed(1100))
     for s in switches[:10]:
@@ -212,8 +212,8 @@ def test_misprint_2_damping_power_sign_during_approach(eq, damping, sign):
 
 
 def test_progress_reports_the_share_done_after_each_piece_and_does_not_change_the_run():
-    """A long run is integrated in pieces (camdyn.pieces); progress hears after each one."""
-    from camdyn.pieces import PIECE_PERIODS
+    """A long run is integrated in pieces (camdyn.runs.pieces); progress hears after each one."""
+    from camdyn.runs.pieces import PIECE_PERIODS
     rig, scene = camdyn.example_rig(), camdyn.Scene(damping="D", friction="coulomb")
     revolutions = 2 * PIECE_PERIODS * 2 + 10  # 2 T per kernel period: two whole pieces and a part
     kwargs = dict(speed_rpm=3000, revolutions=revolutions, sample_rate_Hz=50.0, rtol=1e-6, atol=1e-10)
@@ -231,7 +231,7 @@ def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
     import argparse
     import time
 
-    from camdyn import cli
+    from camdyn.cli import commands as cli
     monkeypatch.setattr(cli, "_progress_enabled", lambda args: False)  # as on a terminal
     with cli._busy("simulating", argparse.Namespace(), after=0.05) as share:
         share(0.5)  # before the bar first draws (after 0.05 s), which it then does every 0.5 s
@@ -246,12 +246,12 @@ def test_outputs_are_computed_when_first_read_and_equal_the_kernel_at_the_sample
     import pickle
 
     from camdyn.engine.kernels import compiled_kernels, outputs_on_samples
-    from camdyn.model import Model
+    from camdyn.model.model import Model
 
     r = camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=1100, t_end=0.02, sample_rate_Hz=5_000)
     assert r.ok and r.switches  # impacting: several modes among the samples
     assert "not computed yet" in repr(r.outputs) and "F_n" in r.outputs and len(r.outputs) > 5
-    model = Model(RIG, camdyn.Scene(), camdyn.cam.cam_motion(None, 1100))
+    model = Model(RIG, camdyn.Scene(), camdyn.model.cam.cam_motion(None, 1100))
     mode = np.array([model.kernels.MODES.index(name) for name in r.regime])
     expected = outputs_on_samples(compiled_kernels(model.kernels), True, mode, r.t, r.alpha, r.alpha_dot, model.p,
                                   len(model.kernels.OUTPUTS))

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import sweep as S
+from camdyn.sweep import api as S
 from camdyn.errors import ParameterError
-from camdyn.quasistatic import QuasiStaticOutcome
+from camdyn.runs.quasistatic import QuasiStaticOutcome
 from registry import RIG
 
 RIG16 = RIG.replace(l_lambda=0.016)

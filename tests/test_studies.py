@@ -12,7 +12,7 @@ import pytest
 
 import camdyn
 from camdyn import studies
-from camdyn.analysis import contact_loss_speed, natural_frequency, static_equilibrium
+from camdyn.analysis.statics import contact_loss_speed, natural_frequency, static_equilibrium
 from camdyn.studies import common, reference_rig
 
 pytest.importorskip("matplotlib")
@@ -50,7 +50,7 @@ TARGETS = {  # computed on the shipped presets; tolerance: the paper's rounding 
 @pytest.mark.parametrize("key", TARGETS)
 def test_reference_rig_reproduces_the_reported_number_to_the_papers_rounding(key):
     paper = common.PAPER[key]
-    sigma = camdyn.calibrate.rounding_sigma(paper["value"], paper["digits"])
+    sigma = camdyn.analysis.calibrate.rounding_sigma(paper["value"], paper["digits"])
     assert abs(TARGETS[key]() - paper["value"]) <= sigma * (1 + 1e-9), (key, TARGETS[key](), paper["value"])
 
 
@@ -224,7 +224,7 @@ def _files_under(folder):
 
 
 def test_an_installed_camdyn_writes_to_the_working_folder_never_into_the_package(tmp_path, monkeypatch, capsys):
-    from camdyn.cli import main
+    from camdyn.cli.commands import main
 
     package = Path(camdyn.__file__).resolve().parent
     before = _files_under(package)
@@ -245,4 +245,4 @@ def test_a_checkout_writes_its_docs_and_presets():
     if root is None:
         pytest.skip("camdyn is not running from a source checkout")
     assert common.default_out() == root / "docs"
-    assert common.default_data_dir(root / "docs") == root / "camdyn" / "data"
+    assert common.default_data_dir(root / "docs") == root / "camdyn" / "model" / "data"

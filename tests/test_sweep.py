@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import sweep as S
+from camdyn.sweep import api as S
 from camdyn.errors import CamdynError, ParameterError
-from camdyn.files import write_netcdf
-from camdyn.sweep_store import TITLE, FolderStore
+from camdyn.io.files import write_netcdf
+from camdyn.sweep.store import TITLE, FolderStore
 from registry import RIG
 from sweep_faults import Faulty, InterruptAfter
 
@@ -370,7 +370,7 @@ def test_a_damaged_chunk_is_named_in_one_line_and_runs_again(tmp_path, caplog):
 def test_a_stopping_sweep_says_what_it_saved(caplog):
     """Runs too short to stop (16 revolutions at the least) ran every revolution asked for, though
     their last sample falls a revolution short at one sample per revolution."""
-    caplog.set_level("INFO", logger="camdyn.sweep")
+    caplog.set_level("INFO", logger="camdyn.sweep.api")
     ds = S.bifurcation(RIG, SCENE, [900.0, 1000.0], revolutions=4, transient_revolutions=2, progress=False)
     assert ds["revolutions_run"].values.tolist() == [4.0, 4.0] and (ds["stop_period"] == 0).all()
     assert "stopped once periodic: 0 of the 2 points that ran; 8 of 8 revolutions run, 0 (0 %) saved" in caplog.text

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn import sweep as S
-from camdyn import cli
-from camdyn.cli import main
+from camdyn.sweep import api as S
+from camdyn.cli import commands as cli
+from camdyn.cli.commands import main
 from registry import RIG
 from sweep_faults import Faulty, InterruptAfter, WithDeathSignal
 

@@ -15,11 +15,11 @@ import camdyn
 from camdyn.engine.config import SolverOptions
 from camdyn.engine.driver import integrate
 from camdyn.engine.saltation import saltation_matrix, switch_saltation
-from camdyn.model import Model
-from camdyn.orbits import periodic_orbit
-from camdyn.derivatives import finite_differences
-from camdyn.section_map import StroboscopicMap
-from camdyn.tangent import TangentSettings, tangent, variational
+from camdyn.model.model import Model
+from camdyn.orbits.shooting import periodic_orbit
+from camdyn.orbits.derivatives import finite_differences
+from camdyn.orbits.section_map import StroboscopicMap
+from camdyn.orbits.tangent import TangentSettings, tangent, variational
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -111,7 +111,7 @@ def test_saltation_matrix_against_sympy(orbits):
     from camdyn.derive import fields
     from camdyn.derive import symbols as Sy
     from camdyn.derive.automaton import build
-    from camdyn.derive.vocabulary import SceneSpec
+    from camdyn.vocabulary import SceneSpec
     model = Model(RIG, SCENE, camdyn.ConstantSpeed(1500.0))
     sw = _separation(orbits[1500.0], model)
     spec = SceneSpec(**model.kernels.SCENE)
@@ -200,10 +200,10 @@ def test_damping_b_separation_with_its_unbounded_jacobian_agrees_with_finite_dif
     """Damping B's impact law c = beta_B k_lambda abs(psi_i) acts up to separation, where the 16 mm
     line contact of the reference experiment makes the Jacobian unbounded as psi_i -> 0: the
     segment's integration stalls 7e-15 s short of the switch, and the last END_GAP of it is
-    taken with the Jacobian frozen (camdyn.tangent.END_GAP).  Phi over one revolution with six
+    taken with the Jacobian frozen (camdyn.orbits.tangent.END_GAP).  Phi over one revolution with six
     switches agrees with finite differences of the map to their own error, estimated by the
     spread of two steps (FD steps 0.1 and 0.03 of the default), times 3."""
-    from camdyn.lyapunov import _start
+    from camdyn.orbits.lyapunov import _start
     rig = camdyn.load_rig("reference-experiment")
     model = Model(rig, camdyn.Scene(contact="line", damping="B", friction="coulomb"), camdyn.ConstantSpeed(135.0))
     x, mode = _start(model, 20, None, TIGHT, "compiled")
@@ -218,8 +218,8 @@ def test_damping_b_separation_with_its_unbounded_jacobian_agrees_with_finite_dif
 
 def test_damping_e_impact_law_is_refused_with_the_way_out():
     """Damping E's impact law c = beta_E abs(psi_i)^(1/4) has an unbounded Jacobian at first
-    contact: the tangent dynamics raise, naming finite differences (camdyn.tangent's docstring)."""
-    from camdyn.tangent import TangentFailure
+    contact: the tangent dynamics raise, naming finite differences (camdyn.orbits.tangent's docstring)."""
+    from camdyn.orbits.tangent import TangentFailure
     scene = camdyn.Scene(contact="line", damping="E", friction="coulomb")
     model = Model(RIG, scene, camdyn.ConstantSpeed(1500.0))
     with pytest.raises(TangentFailure, match="finite_differences"):

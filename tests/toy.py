@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import numba
 import numpy as np
 
-from camdyn.derive.vocabulary import OUTPUTS, WITH_RATE_RATE, WITH_RATE_VALUE
+from camdyn.vocabulary import OUTPUTS, WITH_RATE_RATE, WITH_RATE_VALUE
 from camdyn.engine.config import REACH_FACTOR, Settings
 from camdyn.engine.kernels import FILL, RHS, SURFACE, SURFACE_FILL, no_fill
 from camdyn.engine.problem import Kernels, Problem

@@ -12,8 +12,7 @@
 """
 from __future__ import annotations
 
-import importlib
-
+from .._lazy import lazy
 from .config import BACKENDS, METHODS, PI_CONTROL, SCIPY_CONTROL, EventSettings, SolverOptions, StepControl
 
 #: names loaded on first use (PEP 562): the driver imports numba, the settings do not
@@ -22,10 +21,4 @@ _LAZY = {"integrate": ".driver", "Switch": ".switches", "Switches": ".switches",
 __all__ = ["integrate", "SolverOptions", "EventSettings", "StepControl", "PI_CONTROL", "SCIPY_CONTROL", "Switch", "Switches",
            "Trajectory", "BACKENDS", "METHODS"]
 
-
-def __getattr__(name: str):
-    if name not in _LAZY:
-        raise AttributeError(f"module 'camdyn.engine' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
-    globals()[name] = value
-    return value
+__getattr__, __dir__ = lazy(__name__, _LAZY)

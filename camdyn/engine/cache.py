@@ -29,7 +29,7 @@ from pathlib import Path
 ENV = "CAMDYN_CACHE_DIR"
 PACKAGE = Path(__file__).resolve().parent.parent          # camdyn/
 ENGINE = Path(__file__).resolve().parent                   # camdyn/engine/
-#: folders of the user cache root that are not compiled code (camdyn.ondemand's scenes)
+#: folders of the user cache root that are not compiled code (camdyn.model.ondemand's scenes)
 OTHER_FOLDERS = ("scenes",)
 
 

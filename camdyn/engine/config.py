@@ -142,7 +142,7 @@ class SolverOptions:
 
 #: the tolerances of the periodic analyses (the stroboscopic map, shooting, continuation, tangent
 #: dynamics, Lyapunov exponents): their Newton tolerance and finite-difference steps are chosen
-#: from them (camdyn.orbits, camdyn.derivatives); the command line's default for them too
+#: from them (camdyn.orbits.shooting, camdyn.orbits.derivatives); the command line's default for them too
 MAP_OPTIONS = SolverOptions(rtol=1e-10, atol=1e-13)
 
 

@@ -114,7 +114,7 @@ def compiled_kernels(K: ModuleType, outputs: bool = True) -> Kernels:
     ``outputs=False``: the ``outputs`` kernel is a placeholder that is never called, for a loop
     that does not integrate the energy ledger (the only use of outputs inside the loop); the
     scene's outputs, the largest of its kernels, are then compiled only when a result's output
-    quantities are read (:class:`camdyn.result.Outputs`), about a second of a cold start."""
+    quantities are read (:class:`camdyn.runs.result.Outputs`), about a second of a cold start."""
     _check_compilable(K)
     kernels = _compiled(K)
     return kernels._replace(outputs=_compiled_outputs(K)) if outputs else kernels
@@ -127,7 +127,7 @@ def _compiled_jacobian(K: ModuleType):
 
 def compiled_jacobian(K: ModuleType):
     """The generated ``jacobian`` kernel of a scene module as a cfunc (the tangent dynamics',
-    :mod:`camdyn.tangent`; compiled on first use, then from the disk cache)."""
+    :mod:`camdyn.orbits.tangent`; compiled on first use, then from the disk cache)."""
     _check_compilable(K)
     return _compiled_jacobian(K)
 

@@ -19,7 +19,7 @@ _x, _w = np.polynomial.legendre.leggauss(5)
 #: Gauss-Legendre nodes and weights on [0, 1]
 NODES = 0.5 * (_x + 1.0)
 WEIGHTS = 0.5 * _w
-#: flows integrated: P_in, D_c, D_f (camdyn.derive.vocabulary.FLOWS)
+#: flows integrated: P_in, D_c, D_f (camdyn.vocabulary.FLOWS)
 N_FLOWS = 3
 
 

@@ -25,7 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..derive.vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
+from ..vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
@@ -57,7 +57,7 @@ class Start(NamedTuple):
 
 
 #: rows of Samples.y (and so of a Trajectory's y): the state, then, with the energy ledger, the
-#: works of the flows P_in, D_c, D_f (camdyn.derive.vocabulary.FLOWS) in rows WORK..WORK + N_FLOWS
+#: works of the flows P_in, D_c, D_f (camdyn.vocabulary.FLOWS) in rows WORK..WORK + N_FLOWS
 ALPHA, ALPHA_DOT, WORK = STATE_ALPHA, STATE_ALPHA_DOT, len(STATE)
 #: how many rows Samples.y has without and with the ledger
 STATE_ROWS, LEDGER_ROWS = WORK, WORK + N_FLOWS

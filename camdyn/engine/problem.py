@@ -16,7 +16,7 @@ class Kernels(NamedTuple):
     - ``surface(m, s, t, alpha, alpha_dot, p) -> value``
     - ``surface_with_rate(m, s, t, alpha, alpha_dot, p, out)``: surface s's value and its declared
       rate's (RATE_OF_SURFACE[s]), computed together, written to ``out`` as SURFACE_WITH_RATE
-      names them (``out[WITH_RATE_VALUE]``, ``out[WITH_RATE_RATE]``, camdyn.derive.vocabulary)
+      names them (``out[WITH_RATE_VALUE]``, ``out[WITH_RATE_RATE]``, camdyn.vocabulary)
     - ``outputs(m, t, alpha, alpha_dot, p, out)``: the OUTPUTS written to ``out``
     - ``reset(j, t, alpha, alpha_dot, p, out)``: reset j's state written to ``out``
     """

@@ -48,7 +48,7 @@ from __future__ import annotations
 import math
 import numpy as np
 
-from ..derive.vocabulary import STATE_ALPHA, STATE_ALPHA_DOT, WITH_RATE_RATE, WITH_RATE_VALUE
+from ..vocabulary import STATE_ALPHA, STATE_ALPHA_DOT, WITH_RATE_RATE, WITH_RATE_VALUE
 from .jit import allocating, jitable
 from .stepper import dense_eval
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..derive.vocabulary import GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T, STATE_ALPHA, STATE_ALPHA_DOT
+from ..vocabulary import GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T, STATE_ALPHA, STATE_ALPHA_DOT
 
 
 def saltation_matrix(f_before, f_after, gradient) -> np.ndarray:

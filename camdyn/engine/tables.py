@@ -22,7 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..derive.vocabulary import FLOWS
+from ..vocabulary import FLOWS
 
 #: reset index of the identity (no call to a reset kernel)
 IDENTITY = -1

@@ -3,7 +3,7 @@ switches, integrated by the engine's Runge-Kutta pair, compiled (numba).
 
 The system: x' = (alpha_dot, alpha_ddot), Phi' = J Phi with J = [[0, 1], [a_alpha,
 a_alpha_dot]] from the generated ``jacobian``, and the divergence a_alpha_dot integrated
-(:mod:`camdyn.tangent` explains its use).  The step is the loop's (:mod:`.stepper`: its error
+(:mod:`camdyn.orbits.tangent` explains its use).  The step is the loop's (:mod:`.stepper`: its error
 norms, first-step guesses, controller and smallest step, called here), with the stages summed
 over the augmented state's N_AUGMENTED components.  At the segment's start the Jacobian is taken
 LOOK_AHEAD along the motion (the limit from inside the segment: a segment starting on a surface
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..derive.vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
+from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import jitable
 from .stepper import ERR_FLOOR, accepted_factor, blended, first_guess, min_step, rejected_factor, rms, second_guess
@@ -35,7 +35,7 @@ N_AUGMENTED = AUG_DIVERGENCE + 1
 def fill_augmented(ad, add, jac, y, out):
     """out = the augmented field at y, given x' = (ad, add) and the Jacobian's second row ``jac``
     (JACOBIAN order): Phi' = [[0, 1], [a_alpha, a_alpha_dot]] Phi, column by column, and the
-    divergence a_alpha_dot.  Compiled into :func:`augmented_field`; run as Python by camdyn.tangent."""
+    divergence a_alpha_dot.  Compiled into :func:`augmented_field`; run as Python by camdyn.orbits.tangent."""
     j0, j1 = jac[JAC_D_ALPHA], jac[JAC_D_ALPHA_DOT]
     out[AUG_ALPHA], out[AUG_ALPHA_DOT] = ad, add
     for k in range(2):

@@ -16,7 +16,7 @@ From Python::
     out.numbers, out.figures, out.markdown
 
 Studies: reference-rig (identify the reference rig; writes the presets reference*.toml into the
-checkout's camdyn/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
+checkout's camdyn/model/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
 """
 from __future__ import annotations
 
@@ -56,7 +56,7 @@ def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, w
     ``out`` is the folder of the report (default: the checkout's ``docs/`` when camdyn runs
     from a source checkout, else ``./camdyn-reproduction``); figures go to ``<out>/img``.
     ``data_dir`` is where ``reference-rig`` writes the presets (default: the checkout's
-    ``camdyn/data``, else ``<out>/rigs``).  Nothing is written inside an installed package.
+    ``camdyn/model/data``, else ``<out>/rigs``).  Nothing is written inside an installed package.
     """
     if name not in STUDIES:
         import difflib

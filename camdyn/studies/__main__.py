@@ -17,7 +17,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default=None, help="folder of reproduction.md and img/ (default: the checkout's "
                                                     "docs/ in a source checkout, else ./camdyn-reproduction)")
     parser.add_argument("--data-dir", default=None, help="where reference-rig writes the presets (default: the "
-                                                         "checkout's camdyn/data, else <out>/rigs)")
+                                                         "checkout's camdyn/model/data, else <out>/rigs)")
     parser.add_argument("--no-docs", action="store_true", help="do not update the report")
     parser.add_argument("--json", action="store_true", help="print the study's numbers as JSON on stdout "
                                                             "(always on for 'numbers')")

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 
-from camdyn.analysis import contact_loss_speed
+from camdyn.analysis.statics import contact_loss_speed
 
 from .common import Context, StudyOutput, chaos_by_lyapunov, fmt, impact_run, md_table, parallel_map
 
@@ -74,7 +74,7 @@ def geometries(grid: dict) -> list[dict]:
 
 def _fit(g: dict):
     from .reference_rig import experiment_variant, identify
-    from camdyn.presets import load_rig
+    from camdyn.model.presets import load_rig
     # start from the shipped preset, scaled to the lever: the frequencies fix I_Pb / chi*^2 and w_b / chi*
     ref, exp = load_rig("reference"), load_rig("reference-experiment")
     s = g["chi0"] / ref.chi0

@@ -77,10 +77,10 @@ def default_out() -> Path:
 
 
 def default_data_dir(out: Path) -> Path:
-    """Where ``reference-rig`` writes the rig presets when not told: the checkout's ``camdyn/data``
+    """Where ``reference-rig`` writes the rig presets when not told: the checkout's ``camdyn/model/data``
     (they are shipped from there), else ``<out>/rigs`` -- never inside an installed package."""
     root = checkout_root()
-    return root / "camdyn" / "data" if root is not None else Path(out) / "rigs"
+    return root / "camdyn" / "model" / "data" if root is not None else Path(out) / "rigs"
 
 
 @dataclass
@@ -128,7 +128,7 @@ def experiment_rig() -> camdyn.Rig:
 
 
 def _preset(name: str) -> camdyn.Rig:
-    from camdyn.presets import available, load_rig
+    from camdyn.model.presets import available, load_rig
     if name not in available():
         raise CamdynError(f"the preset {name!r} does not exist yet: run 'python -m camdyn.studies reference-rig'")
     return load_rig(name)
@@ -210,7 +210,7 @@ def rel(a, b) -> float | None:
 REPORT_HEADER = """# The paper's results, reproduced
 
 Sundar, Dreyer & Singh, *J. Sound Vib.* 332 (2013) 4280–4295, reproduced with camdyn on the
-reference rig (`camdyn/data/reference.toml`, Sections 6–8 settings) and its experiment variant
+reference rig (`camdyn/model/data/reference.toml`, Sections 6–8 settings) and its experiment variant
 (`reference-experiment.toml`, Sections 4–5); see [reference-rig.md](reference-rig.md) for how
 that rig was identified. Each section below is written by one command,
 `python -m camdyn.studies <name>`, and says what the paper states beside what camdyn computes.
@@ -338,14 +338,14 @@ CONFIDENCE_SE = 3.0
 
 
 def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revolutions: int, batches: int) -> dict:
-    """The largest Lyapunov exponent (camdyn.lyapunov) of the impacting rig's run from the
+    """The largest Lyapunov exponent (camdyn.orbits.lyapunov) of the impacting rig's run from the
     static equilibrium, over ``revolutions`` after ``transient`` (the window of
     :func:`impact_run`'s class), and the verdict it gives: *chaotic* where it is positive by CONFIDENCE_SE standard errors,
     *regular* where it is negative by as many, else *undecided*; *n/a* where the tangent
     dynamics cannot be integrated (damping C and E: their impact law's Jacobian is unbounded at
-    first contact, camdyn.tangent), with the reason."""
-    from camdyn.lyapunov import LyapunovSettings, lyapunov_exponents
-    from camdyn.tangent import TangentFailure
+    first contact, camdyn.orbits.tangent), with the reason."""
+    from camdyn.orbits.lyapunov import LyapunovSettings, lyapunov_exponents
+    from camdyn.orbits.tangent import TangentFailure
 
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
     settings = LyapunovSettings(revolutions=revolutions, transient=transient, batches=batches)

@@ -103,7 +103,7 @@ def run(ctx: Context) -> StudyOutput:
         "A run is *periodic (Pn)* when its Poincaré section (α_r once per cam revolution) repeats with period "
         "n ≤ 8 to 0.2 % of its peak-to-peak, else *aperiodic* (chaotic or a long transient). "
         f"Chaos is judged by the largest Lyapunov exponent λ1 of the same window (tangent dynamics with "
-        f"saltation matrices, `camdyn.lyapunov`, renormalised every revolution, from the static equilibrium "
+        f"saltation matrices, `camdyn.orbits.lyapunov`, renormalised every revolution, from the static equilibrium "
         f"after the same {s['transient']} transient revolutions; ± the standard error of {s['batches']} batch "
         f"means): *chaotic* where λ1 > {CONFIDENCE_SE:g} standard errors, *regular* where λ1 < −{CONFIDENCE_SE:g} "
         "standard errors, else *undecided*. *n/a*: no exponent, where the tangent integration cannot pass an "

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from camdyn.signal import spectrum
+from camdyn.analysis.signal import spectrum
 
 from .common import Context, StudyOutput, experiment_rig, figure, fmt, md_table, save, simulate
 

@@ -13,8 +13,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 import camdyn
-from camdyn.analysis import energy_balance_peak, static_equilibrium
-from camdyn.plots import EVENT_MARKERS, stability_runs
+from camdyn.analysis.statics import energy_balance_peak, static_equilibrium
+from camdyn.io.plots import EVENT_MARKERS, stability_runs
 
 from .common import PAPER, Context, StudyOutput, experiment_rig, figure, fmt, impact_run, md_table, parallel_map, save
 
@@ -53,8 +53,8 @@ def branch(leg: BranchLeg, rig=None) -> dict:
     """A leg continued (damping D, line contact, Coulomb, phase 0) with each orbit's alpha_rp:
     the peak-to-peak of alpha_r over one orbit, run by camdyn.simulate from the orbit's state
     at the section at SAMPLE_RATE_HZ.  JSON-able: lambda, stable, alpha_rp, max_gap, events."""
-    from camdyn.continuation import continue_orbit, events_table
-    from camdyn.tangent import variational
+    from camdyn.orbits.continuation import continue_orbit, events_table
+    from camdyn.orbits.tangent import variational
 
     rig = rig or experiment_rig()
     scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
@@ -129,7 +129,7 @@ def _jump(runs: list[dict], flight: dict) -> tuple[float, float] | None:
 
 def _branch_text(legs: list[dict], runs: list[dict], rig) -> str:
     """What the continued branches say about the jump of alpha_rp (the report's paragraph)."""
-    from camdyn.analysis import compliance_shift, contact_loss_speed
+    from camdyn.analysis.statics import compliance_shift, contact_loss_speed
 
     def events(b, kind):
         return [e["speed_rpm"] for e in b["events"] if e["kind"] == kind]
@@ -141,7 +141,7 @@ def _branch_text(legs: list[dict], runs: list[dict], rig) -> str:
         parts.append(f"the {b['name']} orbit from {b['lambda'][0]:.0f} rev/min ({found or 'no event'}; its branch "
                      f"ends at {last:.2f} rev/min, `{b['end']}`)")
     text = ("**Branches** (`camdyn.continue_orbit` in the cam speed, period 1, phase 0; the contact orbit with "
-            "the variational Jacobian, `camdyn.tangent.variational`, because its contact deflection is below "
+            "the variational Jacobian, `camdyn.orbits.tangent.variational`, because its contact deflection is below "
             "any finite-difference step): " + "; ".join(parts) + ".")
     contact = next((b for b in legs if b["name"] == "contact"), None)
     flight = next((b for b in legs if b["name"] == "flight"), None)
@@ -156,7 +156,7 @@ def _branch_text(legs: list[dict], runs: list[dict], rig) -> str:
         text += (f" The contact orbit grazes (its largest gap reaches 0) at "
                  f"{', '.join(f'{v:.4f}' for v in events(contact, 'grazing')) or '-'} rev/min; the "
                  f"inverse-kinematics contact-loss speed (Fig. 9) is {loss:.4f} rev/min and the compliance shift "
-                 f"`camdyn.analysis.compliance_shift` predicts {shift:.1e} of it.")
+                 f"`camdyn.analysis.statics.compliance_shift` predicts {shift:.1e} of it.")
     return text
 
 

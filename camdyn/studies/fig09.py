@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 import camdyn
-from camdyn.analysis import contact_loss_speed
+from camdyn.analysis.statics import contact_loss_speed
 
-from .common import (Context, StudyOutput, experiment_rig, figure, fmt, md_table, parallel_map,
-                     reference_rig, save, simulate)
+from .common import (Context, StudyOutput, experiment_rig, figure, fmt, md_table, parallel_map, reference_rig, save,
+                     simulate)
 
 NAME, TITLE = "fig9", "Fig. 9: sliding contact and impacting regimes in the k_s–Ω_c plane"
 

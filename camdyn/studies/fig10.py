@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 import camdyn
-from camdyn.analysis import natural_frequency
-from camdyn.signal import peak_frequency, spectrum
+from camdyn.analysis.statics import natural_frequency
+from camdyn.analysis.signal import peak_frequency, spectrum
 
 from .common import PAPER, Context, StudyOutput, figure, fmt, md_table, reference_rig, rel, save, simulate
 

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 import camdyn
-from camdyn.analysis import contact_loss_speed
+from camdyn.analysis.statics import contact_loss_speed
 
 from .common import Context, StudyOutput, figure, fmt, md_table, reference_rig, save, simulate
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 import camdyn
-from camdyn.signal import peak_frequency, spectrum
+from camdyn.analysis.signal import peak_frequency, spectrum
 
 from .common import Context, StudyOutput, figure, fmt, md_table, reference_rig, save, simulate
 
@@ -20,7 +20,7 @@ MODELS = [("nonlinear", "non-linear", "tab:blue"), ("linear_paper", "linear, Eqs
 def instantaneous_frequency(rig, scene, cam, result) -> np.ndarray:
     """sqrt(-d alpha_ddot / d alpha) / 2 pi (Hz) along the run: the stiffness the follower sees
     as the cam turns (the contact point moves along the follower); NaN where no kernel applies."""
-    from camdyn.model import Model
+    from camdyn.model.model import Model
     model = Model(rig, scene, cam)
     out = np.full(result.t.size, np.nan)
     for name in set(result.regime.tolist()):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 import camdyn
-from camdyn.analysis import contact_loss_speed, natural_frequency, static_equilibrium
+from camdyn.analysis.statics import contact_loss_speed, natural_frequency, static_equilibrium
 
 from .common import PAPER, Context, StudyOutput, experiment_rig, fmt, md_table, recorded_numbers, reference_rig, rel
 

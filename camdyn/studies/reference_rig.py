@@ -2,7 +2,7 @@
 
 The paper prints none of its rig's geometry or inertia (they are those of Alzate et al.
 2007, not available here), but it prints results that constrain them. This study fits the
-unconstrained-by-report parameters with :func:`camdyn.calibrate.calibrate`, fixes the rest
+unconstrained-by-report parameters with :func:`camdyn.analysis.calibrate.calibrate`, fixes the rest
 by stated assumptions, and writes the presets ``reference`` (Sections 6-8 settings) and
 ``reference-experiment`` (Sections 4-5 settings) with the provenance table
 ``docs/reference-rig.md``.
@@ -12,10 +12,10 @@ from __future__ import annotations
 import math
 
 import camdyn
-from camdyn import calibrate as cal
-from camdyn.analysis import contact_loss_speed, static_equilibrium
-from camdyn.cam import ConstantSpeed
-from camdyn.rig import NEUTRAL
+from camdyn.analysis import calibrate as cal
+from camdyn.analysis.statics import contact_loss_speed, static_equilibrium
+from camdyn.model.cam import ConstantSpeed
+from camdyn.model.rig import NEUTRAL
 
 from .common import PAPER, Context, StudyOutput, default_data_dir, fmt, md_table, recorded_numbers
 
@@ -139,7 +139,7 @@ def starting_rig(start: dict[str, float], geometry: dict[str, float] | None = No
     values.update(geo)
     values.update(I_Pb=start["I_Pb"], w_b=start["w_b"], L_us=start["L_us"], alpha0=start["alpha0"],
                   theta0=theta0_for(start["alpha0"]) + offset, e=0.1 * values["r_c"])
-    return camdyn.Rig(**{**NEUTRAL, **values})  # a model edit's new constants: the paper's law (camdyn.rig.NEUTRAL)
+    return camdyn.Rig(**{**NEUTRAL, **values})  # a model edit's new constants: the paper's law (camdyn.model.rig.NEUTRAL)
 
 
 def identify(start: dict[str, float] | None = None, geometry: dict[str, float] | None = None) -> cal.Calibration:
@@ -184,7 +184,7 @@ def _provenance(result: cal.Calibration, exp_rig: camdyn.Rig) -> list[list[str]]
         "alpha0": "alpha_rp saturating at 1.36 rad as alpha reaches 90 degrees: alpha* = pi/2 - 1.36",
     }
     rows = []
-    for p in camdyn.rig.PARAMETERS:
+    for p in camdyn.model.rig.PARAMETERS:
         v = getattr(ref, p.name)
         if v is None:
             continue
@@ -195,7 +195,7 @@ def _provenance(result: cal.Calibration, exp_rig: camdyn.Rig) -> list[list[str]]
         elif p.name in ASSUMED:
             status, why = "assumed", ASSUMED[p.name][1]
         elif p.name in NEUTRAL:
-            status, why = "the paper's law", "a model edit's constant at its neutral value (derive/parameters.py)"
+            status, why = "the paper's law", "a model edit's constant at its neutral value (camdyn/vocabulary/parameters.py)"
         else:
             status, why = "reported", REPORTED[p.name][1]
         value = f"{v:.6g}"
@@ -234,7 +234,7 @@ def document(result: cal.Calibration, exp_rig: camdyn.Rig, chaos_scan: dict | No
         "Sundar, Dreyer & Singh (2013) run their model on the rig of Alzate et al. (*Nonlinear Dynamics* 50, "
         "2007), but print none of its geometry or inertia (r_c, e, w_b, χ0, α0, Θ0, d_x, d_y, L_us, the "
         "experiment's k_s, I_Pb). They do print results that constrain them. camdyn's reference rig is a "
-        "physically plausible rig that reproduces those results, identified with `camdyn.calibrate` (weighted "
+        "physically plausible rig that reproduces those results, identified with `camdyn.analysis.calibrate` (weighted "
         "least squares, each target weighted by the paper's rounding: half a unit of its last printed digit). "
         "It is *a* rig consistent with the paper, not the paper's rig: the parameters marked *assumed* below "
         "are not determined by anything the paper prints.",
@@ -326,7 +326,7 @@ def document(result: cal.Calibration, exp_rig: camdyn.Rig, chaos_scan: dict | No
         "## Regenerate",
         "",
         "```bash",
-        "python -m camdyn.studies reference-rig   # refits and rewrites camdyn/data/reference*.toml and this page",
+        "python -m camdyn.studies reference-rig   # refits and rewrites camdyn/model/data/reference*.toml and this page",
         "```",
         "",
         "The fit itself:",
@@ -343,7 +343,7 @@ def run(ctx: Context) -> StudyOutput:
     start = None
     if ctx.fast:
         try:  # start from the shipped preset: a few evaluations only
-            from camdyn.presets import load_rig
+            from camdyn.model.presets import load_rig
             shipped = load_rig("reference")
             exp = load_rig("reference-experiment")
             start = {"I_Pb": shipped.I_Pb, "w_b": shipped.w_b, "L_us": shipped.L_us, "alpha0": shipped.alpha0,

@@ -1,0 +1,101 @@
+"""Named rigs shipped with camdyn (TOML files in camdyn/model/data).
+
+A model edit that adds a parameter with a neutral value (``neutral=`` in
+``camdyn.vocabulary.parameters``: the value that gives the paper's law back) would leave every shipped
+rig without it, and the scenes that read it would refuse them. ``camdyn regenerate`` writes that
+value into the shipped files that lack it (:func:`add_neutral_values`) and says which;
+``camdyn regenerate --check`` fails while one lacks it (:func:`lacking_neutral_values`). A rig file
+of your own is never changed: the scenes refuse it with a message that names the value.
+"""
+from __future__ import annotations
+
+import re
+from importlib import resources
+from pathlib import Path
+
+from .. import __version__
+from ..errors import ParameterError, RigFileError
+from .rig import NEUTRAL, PARAMETERS, Rig, tomllib
+
+_BY_NAME = {p.name: p for p in PARAMETERS}
+_TABLE = re.compile(r"^\s*\[")          # a TOML table header
+_KEY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=")
+
+
+def available() -> list[str]:
+    """The names of the shipped rigs (the TOML files of camdyn/model/data)."""
+    return sorted(p.name[:-5] for p in resources.files("camdyn.model.data").iterdir() if p.name.endswith(".toml"))
+
+
+def load_rig(name: str) -> Rig:
+    """A shipped rig by name (see :func:`available`), or a TOML file path."""
+    if name in available():
+        with resources.as_file(resources.files("camdyn.model.data") / f"{name}.toml") as path:
+            rig = Rig.from_toml(path)
+        return rig.replace(origin=f"camdyn preset {name!r} (camdyn {__version__})")
+    if str(name).endswith(".toml"):
+        return Rig.from_toml(name)
+    raise ParameterError("name", name, f"one of {available()} or a path to a .toml rig file")
+
+
+def example_rig() -> Rig:
+    """The illustrative rig of the README (not the paper's identified rig)."""
+    return load_rig("example")
+
+
+def preset_files() -> list[Path]:
+    """The shipped rig files, as files on disk (the package's data folder)."""
+    folder = Path(str(resources.files("camdyn.model.data")))
+    return [folder / f"{name}.toml" for name in available()]
+
+
+def _parameter_lines(lines: list[str]) -> dict[str, int]:
+    """Parameter name -> line index, for the keys of the [parameters] table of a rig file."""
+    found, inside = {}, False
+    for i, line in enumerate(lines):
+        if _TABLE.match(line):
+            inside = line.strip() == "[parameters]"
+        elif inside and _KEY.match(line):
+            found[_KEY.match(line).group(1)] = i
+    return found
+
+
+def lacking_neutral_values() -> dict[Path, list[str]]:
+    """The shipped rig files that do not give a parameter declared with a neutral value, and those
+    parameters (empty when every file gives them all)."""
+    lacking = {}
+    for path in preset_files():
+        given = _parameter_lines(path.read_text(encoding="utf-8").splitlines())
+        names = [n for n in NEUTRAL if n not in given]
+        if names:
+            lacking[path] = names
+    return lacking
+
+
+def _with_line(lines: list[str], name: str) -> list[str]:
+    """``lines`` with the neutral value of ``name`` added to the [parameters] table: after the
+    parameter declared just before it that the file gives (the order of camdyn.model.rig.PARAMETERS,
+    the order Rig.to_toml writes), else first in the table."""
+    given = _parameter_lines(lines)
+    order = [p.name for p in PARAMETERS]
+    before = [given[n] for n in order[:order.index(name)] if n in given]
+    at = max(before) + 1 if before else next(i for i, line in enumerate(lines) if line.strip() == "[parameters]") + 1
+    return lines[:at] + [_BY_NAME[name].toml_line(NEUTRAL[name])] + lines[at:]
+
+
+def add_neutral_values() -> dict[Path, list[str]]:
+    """Write the neutral value of each parameter declared with one into the shipped rig files
+    that lack it; return the files changed and the parameters added to each."""
+    lacking = lacking_neutral_values()
+    for path, names in lacking.items():
+        text = path.read_text(encoding="utf-8")
+        lines = text.splitlines()
+        for name in names:
+            lines = _with_line(lines, name)
+        new = "\n".join(lines) + ("\n" if text.endswith("\n") else "")
+        given = tomllib.loads(new).get("parameters", {})
+        if any(given.get(n) != NEUTRAL[n] for n in names):  # the line landed outside [parameters]
+            raise RigFileError(str(path), f"could not add {', '.join(names)} to its [parameters] table; add "
+                               + ", ".join(f"'{n} = {NEUTRAL[n]!r}'" for n in names) + " by hand")
+        path.write_text(new, encoding="utf-8")
+    return lacking

@@ -1,0 +1,141 @@
+"""Lyapunov exponents of a hybrid trajectory, from its tangent dynamics (Benettin et al. 1980).
+
+Along a run, the tangent vectors of the state x = (alpha, alpha_dot) evolve by the variational
+equation between switches and jump by the saltation matrices at them (:mod:`camdyn.orbits.tangent`).
+Every cam period T the basis Q of two tangent vectors is propagated, Phi Q = Q' R (QR
+re-orthonormalisation), and log abs(R_ii) is the stretching of the i-th direction over that
+revolution; the exponents are their sums over the revolutions divided by the time.  Within a
+revolution the basis is re-orthonormalised as well, after every switch and every stretch of
+contact that could contract it by e^100 (``tangent(..., renormalise=True)``: a stiff contact's
+damping contracts Phi by more than the range of a double in one revolution), and R is the
+product of those factors:
+
+    lambda_i = sum_k log abs(R_ii^(k)) / (N T)   (1/s),  lambda_1 >= lambda_2.
+
+lambda_1 is the largest exponent (the first column of Q is a single tangent vector
+renormalised every period, Benettin's algorithm); lambda_1 + lambda_2 = log abs(det Phi) / (N T),
+the time mean of the field's divergence d(alpha_ddot)/d(alpha_dot) plus the switches' log abs(det S)
+divided by the time (Liouville).  A stick entry (a Filippov sliding mode) has det S = 0: the
+second exponent is then -inf.
+
+The run starts after ``transient`` revolutions from ``y0`` (default the static equilibrium).
+Each revolution is integrated in the kernels' periodic time (they are periodic in t with 2 T,
+:mod:`camdyn.runs.pieces`), so a long run does not lose accuracy to the rounding of large t.  The
+estimate's uncertainty: the revolutions are grouped in batches; the standard error of the
+batch means (:attr:`LyapunovExponents.standard_error`) assumes the batches are independent.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.cam import CamMotion, periodic_cam
+from ..engine.config import SolverOptions
+from ..errors import ParameterError
+from ..model.model import Model
+from ..model.rig import Rig
+from ..model.scene import Scene
+from .section_map import DEFAULT_OPTIONS, MapFailure, warm_up
+from .tangent import TangentSettings, tangent
+
+__all__ = ["lyapunov_exponents", "spectrum", "LyapunovExponents", "LyapunovSettings"]
+
+
+@dataclass(frozen=True)
+class LyapunovSettings:
+    """How long: ``revolutions`` measured after ``transient`` discarded, in ``batches`` batches
+    (for the standard error; ``revolutions`` must be a multiple of it)."""
+
+    revolutions: int = 200
+    transient: int = 50
+    batches: int = 10
+
+    def __post_init__(self):
+        checks = (("revolutions", 1), ("transient", 0), ("batches", 2))
+        for name, low in checks:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise ParameterError(name, value, f"an integer >= {low}")
+        if self.revolutions % self.batches:
+            raise ParameterError("revolutions", self.revolutions, f"a multiple of batches = {self.batches}")
+
+
+@dataclass(frozen=True)
+class LyapunovExponents:
+    """The Lyapunov spectrum of a run.
+
+    ``exponents``: (lambda_1, lambda_2) in 1/s, largest first; ``standard_error``: the batch
+    means' standard error of each (1/s; nan for an infinite exponent); ``per_revolution``:
+    the exponents times T (nats per cam revolution); ``revolutions``: N measured;
+    ``transient``: revolutions discarded before; ``period``: T (s); ``divergence_mean``: the
+    time mean of d(alpha_ddot)/d(alpha_dot) over the measured run (1/s); ``saltation_rate``:
+    sum of log abs(det S) over its switches divided by its time (1/s); ``switches``: how many."""
+
+    exponents: np.ndarray
+    standard_error: np.ndarray
+    revolutions: int
+    transient: int
+    period: float
+    divergence_mean: float
+    saltation_rate: float
+    switches: int
+
+    @property
+    def largest(self) -> float:
+        return float(self.exponents[0])
+
+    @property
+    def per_revolution(self) -> np.ndarray:
+        return self.exponents * self.period
+
+
+def _start(model: Model, transient: int, y0, options, backend):
+    """The state and mode after ``transient`` revolutions from y0 (None: the equilibrium)."""
+    if transient == 0:
+        return (model.static_state() if y0 is None else np.asarray(y0, dtype=float)), None
+    t_end = transient * model.period
+    try:
+        tr = warm_up(model, t_end, y0, np.array([t_end]), options, backend)
+    except MapFailure as failure:
+        raise ParameterError("transient", transient, f"a run that succeeds ({failure})") from None
+    return tr.y[:2, -1].copy(), int(tr.end_mode)
+
+
+def spectrum(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=None,
+             options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled",
+             tangent_settings: TangentSettings = TangentSettings()) -> LyapunovExponents:
+    """The Lyapunov spectrum of ``model``'s run (see the module docstring)."""
+    T = model.period
+    if not (math.isfinite(T) and T > 0):
+        raise ParameterError("cam", None, "a periodic cam motion (a nonzero speed, or a period)",
+                             problem=f"{model.cam!r} has no period")
+    x, mode = _start(model, settings.transient, y0, options, backend)
+    Q = np.eye(2)
+    logs = np.empty((settings.revolutions, 2))
+    divergence, log_det, switches = 0.0, 0.0, 0
+    for k in range(settings.revolutions):
+        t0 = ((settings.transient + k) % 2) * T        # the kernels' period is 2 T
+        r = tangent(model, (t0, t0 + T), x, Q, mode, options, backend, tangent_settings, renormalise=True)
+        Q, logs[k] = r.phi, r.log_growth   # Q R_k with log abs(diag R_k) = log_growth: Q is orthonormal
+        x, mode = r.state, r.end_mode
+        divergence, log_det, switches = divergence + r.divergence, log_det + r.log_det_saltation, switches + r.switches
+    time = settings.revolutions * T
+    exponents = logs.sum(axis=0) / time
+    batch = logs.reshape(settings.batches, -1, 2).sum(axis=1) / (time / settings.batches)
+    with np.errstate(invalid="ignore"):
+        se = batch.std(axis=0, ddof=1) / math.sqrt(settings.batches)
+    return LyapunovExponents(exponents, np.where(np.isfinite(exponents), se, np.nan), settings.revolutions,
+                             settings.transient, T, divergence / time, log_det / time, switches)
+
+
+def lyapunov_exponents(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, speed_rpm: float | None = None,
+                       settings: LyapunovSettings = LyapunovSettings(), y0=None,
+                       options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled") -> LyapunovExponents:
+    """The Lyapunov exponents (1/s) of the run of ``scene`` on ``rig`` driven by ``cam`` (or at
+    ``speed_rpm``), after ``settings.transient`` revolutions from ``y0`` (default the static
+    equilibrium), over ``settings.revolutions`` (see the module docstring)."""
+    if not isinstance(settings, LyapunovSettings):
+        raise ParameterError("settings", settings, "a camdyn.orbits.lyapunov.LyapunovSettings")
+    return spectrum(Model(rig, scene, periodic_cam(cam, speed_rpm)), settings, y0, options, backend)

@@ -1,0 +1,130 @@
+"""The result of a simulation: time histories, regimes, switches, outcome."""
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine.switches import Switches
+from ..outcome import Outcome
+
+
+class Outputs(Mapping):
+    """A run's output quantities by name, computed on first use, all at once.
+
+    The names are known at once; the values come from ``compute()`` (a dict of arrays) the
+    first time one is read.  A run whose outputs nobody reads never compiles the scene's
+    ``outputs`` kernel: about a second of a cold start (docs/performance.md, Start-up).
+    Pickled (a sweep's worker) or copied, it is the plain dict of its values."""
+
+    def __init__(self, names, compute: Callable[[], dict]):
+        self._names = tuple(names)
+        self._compute = compute
+        self._values: dict | None = None
+
+    def _all(self) -> dict:
+        if self._values is None:
+            values = self._compute()
+            self._values = {name: values[name] for name in self._names}
+            self._compute = None  # let go of the model and the samples it held
+        return self._values
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._names:
+            raise KeyError(name)
+        return self._all()[name]
+
+    def __contains__(self, name) -> bool:
+        return name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __reduce__(self):
+        return dict, (self._all(),)
+
+    def __repr__(self) -> str:
+        state = "computed" if self._values is not None else "not computed yet"
+        return f"Outputs({', '.join(self._names)}; {state})"
+
+
+@dataclass
+class Result:
+    """Time histories of one run (SI units), sampled uniformly at ``t``.
+
+    Arrays: t, alpha, alpha_dot, Theta, alpha_i (rigid-contact angle, Eq. 29),
+    alpha_r = alpha - alpha_i (residual response, Section 4), psi_i, psi_j,
+    psi_i_dot, F_s, F_n, F_f, v_r, N_x, energy, P_in, D_c, D_f, and ``regime``
+    (the name of the regime active at each sample).  ``switches`` lists every
+    regime switch (:class:`~camdyn.engine.switches.Switches`: each a ``Switch``, the times as
+    ``switches.t``); ``outcome`` says how the run ended (check ``result.ok``).
+    """
+
+    t: np.ndarray
+    alpha: np.ndarray
+    alpha_dot: np.ndarray
+    Theta: np.ndarray
+    regime: np.ndarray
+    outputs: Mapping[str, np.ndarray]    # a dict, or Outputs (computed when first read)
+    switches: Switches
+    outcome: Outcome
+    stats: dict
+    period: float
+    scene: str
+    alpha_star: float
+    meta: dict = field(default_factory=dict)
+
+    def __getattr__(self, name):
+        outputs = self.__dict__.get("outputs", {})
+        if name in outputs:
+            return outputs[name]
+        raise AttributeError(f"Result has no attribute {name!r}")
+
+    @property
+    def ok(self) -> bool:
+        return self.outcome.ok
+
+    @property
+    def alpha_r(self) -> np.ndarray:
+        return self.alpha - self.outputs["alpha_i"]
+
+    @property
+    def in_contact(self) -> np.ndarray:
+        """Whether the follower touches the cam at each sample (the generated CONTACT_OF_MODE)."""
+        contact = self.meta["contact"]
+        return np.array([contact[name] for name in self.regime], dtype=bool)
+
+    def impacts(self) -> np.ndarray:
+        """Times at which contact starts (a switch from a free mode to a contact mode)."""
+        before, after = self._contact_across_switches()
+        return self.switches.t[~before & after]
+
+    def separations(self) -> np.ndarray:
+        """Times at which contact ends."""
+        before, after = self._contact_across_switches()
+        return self.switches.t[before & ~after]
+
+    def _contact_across_switches(self) -> tuple[np.ndarray, np.ndarray]:
+        """Whether the follower touches the cam before and after each switch (CONTACT_OF_MODE)."""
+        sw = self.switches
+        contact = np.array([self.meta["contact"][name] for name in sw.modes], dtype=bool)
+        return contact[sw.before], contact[sw.after]
+
+    def after(self, t0: float) -> "Result":
+        """The samples at t >= t0 (e.g. to drop a transient)."""
+        keep = self.t >= t0
+        return Result(self.t[keep], self.alpha[keep], self.alpha_dot[keep], self.Theta[keep],
+                      self.regime[keep], {k: v[keep] for k, v in self.outputs.items()},
+                      self.switches[self.switches.t >= t0], self.outcome, self.stats,
+                      self.period, self.scene, self.alpha_star, self.meta)
+
+    def summary(self) -> str:
+        lines = [f"scene {self.scene}: {self.outcome.name} ({self.outcome.message})",
+                 f"  t = {self.t[0]:.6g} .. {self.t[-1]:.6g} s, {self.t.size} samples" if self.t.size else "  no samples",
+                 f"  {len(self.switches)} regime switches, {self.impacts().size} impacts, "
+                 f"{self.stats.get('steps', 0)} steps, {self.stats.get('nfev', 0)} RHS evaluations"]
+        return "\n".join(lines)

@@ -139,10 +139,27 @@ def warm_start(model: Model, revolutions: float, phase: float, y0=None,
     t_eval = t_end - T + T * np.arange(SCALE_SAMPLES + 1) / SCALE_SAMPLES
     t_eval[-1] = t_end                       # the section itself, not t_end - T + T rounded
     tr = warm_up(model, t_end, y0, t_eval, options, backend)
-    a, ad = tr.y[0], tr.y[1]
-    scale = np.array([np.max(np.abs(a - model.equilibrium.alpha)), np.max(np.abs(ad))])
-    tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])   # a motion at rest: rad, rad/s
-    return tr.y[:2, -1].copy(), int(tr.end_mode), np.maximum(scale, tiny)
+    return tr.y[:2, -1].copy(), int(tr.end_mode), motion_scale(model, tr.y[0], tr.y[1])
+
+
+def quasi_static_warm_start(model: Model, phase: float):
+    """The warm start of ``periodic_orbit(..., start="quasistatic")``: the quasi-static contact
+    orbit's state and mode at the section time ``phase`` (:func:`camdyn.runs.quasistatic.section_state`)
+    and the size of the motion over one revolution of it; MapFailure where the orbit does not exist."""
+    orbit = quasistatic.orbit_at(model, phase + model.period * np.arange(SCALE_SAMPLES) / SCALE_SAMPLES)
+    if not orbit.ok:
+        raise MapFailure(f"no quasi-static warm start: {orbit.message}")
+    x0, mode = quasistatic.section_state(model, phase)
+    return x0, mode, motion_scale(model, orbit.alpha, orbit.alpha_dot)
+
+
+def motion_scale(model: Model, alpha: np.ndarray, alpha_dot: np.ndarray) -> np.ndarray:
+    """The size of a motion, per state component: ``max |alpha - alpha*|`` (rad) and ``max
+    |alpha_dot|`` (rad/s) over its samples, at least 1e-12 of each's unit (a motion at rest):
+    the scale of shooting's residual and of the finite-difference steps."""
+    scale = np.array([np.max(np.abs(alpha - model.equilibrium.alpha)), np.max(np.abs(alpha_dot))])
+    tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])
+    return np.maximum(scale, tiny)
 
 
 def _residual(F: np.ndarray, scale: np.ndarray) -> float:
@@ -263,7 +280,7 @@ def periodic_orbit(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, spee
         raise ParameterError("start", start, "'run' (a warm-up run) or 'quasistatic' (the quasi-static contact orbit)")
     try:
         if start == "quasistatic":
-            x0, mode, scale = quasistatic.warm_start(model, phase)
+            x0, mode, scale = quasi_static_warm_start(model, phase)
         else:
             x0, mode, scale = warm_start(model, warmup_revolutions, phase, y0, options, backend)
     except MapFailure as failure:

@@ -28,7 +28,6 @@ _EXPORTS = {
     'simulate': '.simulation',
     'solve_at': '.quasistatic',
     'solver_options': '.simulation',
-    'warm_start': '.quasistatic',
 }
 
 __getattr__, __dir__ = lazy(__name__, _EXPORTS)

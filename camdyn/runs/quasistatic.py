@@ -175,22 +175,5 @@ def section_state(model: Model, phase: float) -> tuple[np.ndarray, int]:
     return np.array([alpha, (ahead - behind) / (2 * h)]), m
 
 
-def warm_start(model: Model, phase: float):
-    """The quasi-static warm start of :func:`camdyn.periodic_orbit` (``start="quasistatic"``):
-    the state and mode at the section time ``phase`` (:func:`section_state`) and the size of the
-    motion over one revolution of the orbit (the residual's scale, as
-    :func:`camdyn.orbits.shooting.warm_start` gives it); MapFailure where the orbit does not exist."""
-    from ..orbits.section_map import MapFailure
-
-    T = model.period
-    orbit = orbit_at(model, phase + T * np.arange(64) / 64)
-    if not orbit.ok:
-        raise MapFailure(f"no quasi-static warm start: {orbit.message}")
-    x0, mode = section_state(model, phase)
-    scale = np.array([np.max(np.abs(orbit.alpha - model.equilibrium.alpha)), np.max(np.abs(orbit.alpha_dot))])
-    tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])   # a motion at rest: rad, rad/s
-    return x0, mode, np.maximum(scale, tiny)
-
-
 __all__ = ["quasi_static_orbit", "QuasiStaticOrbit", "QuasiStaticOutcome", "orbit_at", "solve_at",
-           "rigid_kinematics", "contact_mode", "section_state", "warm_start"]
+           "rigid_kinematics", "contact_mode", "section_state"]

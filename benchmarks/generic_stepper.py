@@ -35,9 +35,10 @@ def scalar_run(rhs, p, m, t, y0, y1, t_end, method, cfg):
     h = S.initial_step(rhs, p, m, t, y0, y1, K[0, 1], t_end, method, cfg)
     err_prev, n, steps = S.ERR_FLOOR, method.n_stages, 0
     while t < t_end:
-        status, t, y0, y1, h, _, _, err_prev = S.accepted_step(rhs, p, m, t, y0, y1, h, t_end, method, K, cfg, err_prev)
-        if status != S.ACCEPTED:
+        r = S.accepted_step(rhs, p, m, t, y0, y1, h, t_end, method, K, cfg, err_prev)
+        if r.status != S.ACCEPTED:
             break
+        t, y0, y1, h, err_prev = r.t, r.y0, r.y1, r.h_next, r.err
         steps += 1
         K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
     return t, y0, y1, steps

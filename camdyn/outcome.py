@@ -29,7 +29,7 @@ class Outcome(ActionableOutcome):
     ANGLE_LIMIT = ("the follower angle approached 90 degrees, where tan(alpha) and sec(alpha) of "
                    "Eq. 11 blow up; the follower has left the cam for good")
     #: the scene option follower="quasistatic" (camdyn.runs.quasistatic), never the engine's loop (whose
-    #: codes, camdyn.engine.loop.OUTCOMES, are the members above, in order): the samples stop before it
+    #: codes index camdyn.engine.loop.OUTCOMES, the members above): the samples stop before it
     CONTACT_TENSILE = ("the quasi-static contact force F_n would turn tensile (<= 0): the follower leaves the "
                        "cam there (result.stats['where'] says when and at which cam angle) and the quasi-static "
                        "orbit does not exist; use the full model (follower='dynamic')")

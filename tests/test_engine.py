@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import camdyn
-from camdyn.engine import cache, loop
+from camdyn.engine import loop
 from camdyn.engine.config import SolverOptions, settings as loop_settings
 from camdyn.engine.loop import SUCCESS, Samples, Start, run_compiled, run_interpreted
 from camdyn.engine.tableau import DOP853, arrays
@@ -301,10 +301,12 @@ def test_settings_carry_the_rules_constants_by_name():
     cfg = loop_settings(SolverOptions(rtol=1e-7, atol=1e-11), contact_frequency=1e4)
     assert (cfg.rtol, cfg.atol, cfg.contact_step) == (1e-7, 1e-11, 0.1 / 1e4)
     assert cfg._fields[:3] == ("rtol", "atol", "max_step")
-    # the loop's codes are camdyn.Outcome's members in order; the members after them come only
-    # from the quasi-static follower (no integration), which the loop never returns
-    quasi_static = ("CONTACT_TENSILE", "NO_QUASI_STATIC")
-    assert loop.OUTCOMES + quasi_static == tuple(o.name for o in camdyn.Outcome)
+    # the loop's codes are indices of camdyn.Outcome members; the members it never returns come
+    # only from the quasi-static follower (no integration)
+    quasi_static = (camdyn.Outcome.CONTACT_TENSILE, camdyn.Outcome.NO_QUASI_STATIC)
+    assert set(loop.OUTCOMES) | set(quasi_static) == set(camdyn.Outcome)
+    assert [loop.OUTCOMES[code] for code in (loop.SUCCESS, loop.CHATTER, loop.ANGLE_LIMIT)] == \
+        [camdyn.Outcome.SUCCESS, camdyn.Outcome.CHATTER, camdyn.Outcome.ANGLE_LIMIT]
 
 
 def test_a_run_that_will_compile_the_loop_says_so_once(monkeypatch):
@@ -321,7 +323,7 @@ def test_a_run_that_will_compile_the_loop_says_so_once(monkeypatch):
     index = loop._run_compiled._cache._cache_file  # numba's index of the loop in the cache
     monkeypatch.setattr(index, "_load_index", lambda: {})  # as for an empty cache or another checkout ...
     monkeypatch.setattr(driver, "loop_loaded", lambda: False)  # ... and a fresh process
-    assert not cache.loop_cached()
+    assert not loop.loop_cached()
     with pytest.warns(camdyn.CompileNotice, match="compiles its integration loop.*filterwarnings"):
         camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, t_end=1e-4)
 

@@ -50,9 +50,9 @@ def _adaptive(prob, method, cfg, t0, t_end, y0, y1, times):
     h = stepper.initial_step(prob.kernels.rhs, prob.p, 0, t0, y0, y1, K[0, 1], t_end, method, cfg)
     t, n, nfev, err = t0, 0, 2, stepper.ERR_FLOOR
     while t < t_end:
-        status, t, y0, y1, h, f, _, err = stepper.accepted_step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K,
-                                                       cfg, err)
-        nfev += f
+        r = stepper.accepted_step(prob.kernels.rhs, prob.p, 0, t, y0, y1, h, t_end, method, K, cfg, err)
+        t, y0, y1, h, err = r.t, r.y0, r.y1, r.h_next, r.err
+        nfev += r.nfev
         times[n] = t
         n += 1
         K[0, 0], K[0, 1] = K[method.n_stages, 0], K[method.n_stages, 1]

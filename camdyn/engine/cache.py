@@ -157,15 +157,3 @@ def install() -> bool:
     if not any(getattr(c, "__name__", "") == locator.__name__ for c in classes):
         classes.insert(0, locator)
     return True
-
-
-def loop_cached() -> bool:
-    """Whether the compiled loop of this camdyn, engine and source file is in the cache: numba's
-    index for ``camdyn.engine.loop``'s entry point exists and matches the file (numba keys it by
-    the file's path and time stamp, so another checkout of the same engine does not count)."""
-    from .loop import _run_compiled
-
-    try:
-        return bool(_run_compiled._cache._cache_file._load_index())
-    except (AttributeError, OSError):  # numba's internals moved: any index of the loop
-        return any((cache_dir() / "numba").rglob("loop.run-*.nbi"))

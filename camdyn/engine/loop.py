@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ..outcome import Outcome
 from ..vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import allocating, jitable
@@ -35,9 +36,10 @@ from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coeffici
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
 
-#: outcome codes of run(), by position: names of camdyn.Outcome members
-OUTCOMES = ("SUCCESS", "STEP_FAILED", "MAX_EVENTS", "CHATTER", "NONFINITE", "ANGLE_LIMIT")
-SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = range(6)
+#: the camdyn.Outcome members run() can end with; its outcome code is the member's index here
+OUTCOMES = (Outcome.SUCCESS, Outcome.STEP_FAILED, Outcome.MAX_EVENTS, Outcome.CHATTER, Outcome.NONFINITE,
+            Outcome.ANGLE_LIMIT)
+SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = (OUTCOMES.index(o) for o in OUTCOMES)
 #: one switch: when, which transition (row of Tables), the modes before and after, the state after
 SWITCH = np.dtype([("t", np.float64), ("transition", np.int64), ("before", np.int64), ("after", np.int64),
                    ("alpha", np.float64), ("alpha_dot", np.float64)])
@@ -203,11 +205,11 @@ def run(prob, method, cfg, start, samples):
         watched = n_watched > 0
         have_start = False
         while t < t_end:
-            status, t_new, n0, n1, h_next, f, rej, err_prev = accepted_step(rhs, p, m, t, y0, y1, h_abs, t_end, method,
-                                                                            K, cfg, err_prev)
-            nfev += f
-            rejected += rej
-            if status != ACCEPTED:
+            r = accepted_step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg, err_prev)
+            t_new, n0, n1, h_next, err_prev = r.t, r.y0, r.y1, r.h_next, r.err
+            nfev += r.nfev
+            rejected += r.rejected
+            if r.status != ACCEPTED:
                 outcome = STEP_FAILED
                 break
             steps += 1
@@ -271,9 +273,16 @@ def run(prob, method, cfg, start, samples):
             if abs(y0) > cfg.angle_limit:
                 outcome = ANGLE_LIMIT
                 break
-    # a plain tuple: numba boxes a NamedTuple by calling its Python __new__, and a Ctrl-C pending
-    # when the loop returns makes that call fail, which numba's boxing does not check (a crash)
+    # a plain tuple, in the order of RAW_FIELDS: numba boxes a NamedTuple by calling its Python
+    # __new__, and a Ctrl-C pending when the loop returns makes that call fail, which numba's
+    # boxing does not check (a crash)
     return outcome, i_sample, sw, n_sw, nfev, steps, rejected, m, t, y0, y1
+
+
+#: run()'s plain tuple, field by field: Run's fields with the switch buffer and its count (SW_*
+#: rows) in place of ``switches``
+RAW_FIELDS = ("outcome", "n_samples", "switch_buffer", "n_switches", "nfev", "steps", "rejected", "mode", "t", "alpha",
+              "alpha_dot")
 
 
 #: run's own body compiled as the entry point, not a function calling it: numba optimizes and
@@ -296,6 +305,16 @@ _ENTRIES: dict = {}
 def loop_loaded() -> bool:
     """Whether the compiled loop is in memory (compiled or loaded from the cache already)."""
     return bool(_ENTRIES) or bool(_run_compiled.signatures)
+
+
+def loop_cached() -> bool:
+    """Whether the compiled loop of this camdyn, engine and source file is in the cache: numba's
+    index for this module's entry point exists and matches the file (numba keys it by the file's
+    path and time stamp, so another checkout of the same engine does not count)."""
+    try:
+        return bool(_run_compiled._cache._cache_file._load_index())
+    except (AttributeError, OSError):  # numba's internals moved: any index of the loop
+        return any((cache.cache_dir() / "numba").rglob("loop.run-*.nbi"))
 
 
 def _layout(value):
@@ -331,6 +350,7 @@ def run_interpreted(prob, method, cfg, start, samples) -> Run:
 
 
 def _finish(raw: tuple) -> Run:
-    """The :class:`Run` of :func:`run`'s tuple (switches as SWITCH records)."""
-    outcome, n_samples, sw, n_sw, *rest = raw
-    return Run(outcome, n_samples, _switch_records(sw, n_sw), *rest)
+    """The :class:`Run` of :func:`run`'s tuple (RAW_FIELDS; switches as SWITCH records)."""
+    fields = dict(zip(RAW_FIELDS, raw))
+    switches = _switch_records(fields.pop("switch_buffer"), fields.pop("n_switches"))
+    return Run(switches=switches, **fields)

@@ -30,6 +30,7 @@ times smaller, instead of poisoning the step size with NaN.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from .jit import jitable
 
@@ -44,6 +45,19 @@ ERR_FLOOR = 1e-4
 
 #: accepted_step() status codes
 ACCEPTED, TOO_SMALL = 0, 1
+
+
+class StepResult(NamedTuple):
+    """What :func:`accepted_step` returns (a named tuple: numba builds it as a plain struct)."""
+
+    status: int          # ACCEPTED, or TOO_SMALL (the step size fell below min_step; nothing changed)
+    t: float             # the step's end
+    y0: float            # the state there
+    y1: float
+    h_next: float        # the next step's size
+    nfev: int            # RHS evaluations spent, rejected attempts included
+    rejected: int        # rejected attempts
+    err: float           # the accepted attempt's error for the next step (at least ERR_FLOOR)
 
 
 @jitable
@@ -185,9 +199,8 @@ def accepted_step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev
     """One accepted step from (t, y) towards t_bound, K[0] = f(t, y) on entry; ``err_prev``: the
     previous accepted step's error (ERR_FLOOR at a run's start), read by the PI controller.
 
-    Returns (status, t_new, y_new0, y_new1, h_abs_next, rhs_evaluations, rejections, err), err
-    the accepted step's error for the next step (at least ERR_FLOOR); K then holds the accepted
-    attempt's stages with f(t_new, y_new) in row n_stages.
+    Returns a :class:`StepResult`; K then holds the accepted attempt's stages with f(t_new,
+    y_new) in row n_stages.
     """
     exponent = method.exponent
     smallest = min_step(t)
@@ -199,7 +212,7 @@ def accepted_step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev
     rejected = 0
     while True:
         if h_abs < smallest:
-            return TOO_SMALL, t, y0, y1, h_abs, nfev, rejected, err_prev
+            return StepResult(TOO_SMALL, t, y0, y1, h_abs, nfev, rejected, err_prev)
         t_new = t + h_abs
         if t_new - t_bound > 0:
             t_new = t_bound
@@ -210,7 +223,7 @@ def accepted_step(rhs, p, m, t, y0, y1, h_abs, t_bound, method, K, cfg, err_prev
         err = error_norm(K, h, y0, y1, n0, n1, cfg.rtol, cfg.atol, method)
         if err < 1.0:
             factor = accepted_factor(err, err_prev, rejected, exponent, cfg.control_a, cfg.control_b)
-            return ACCEPTED, t_new, n0, n1, h_abs * factor, nfev, rejected, max(err, ERR_FLOOR)
+            return StepResult(ACCEPTED, t_new, n0, n1, h_abs * factor, nfev, rejected, max(err, ERR_FLOOR))
         h_abs *= rejected_factor(err, exponent)
         rejected += 1
 

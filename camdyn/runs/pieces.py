@@ -20,10 +20,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..engine.config import SolverOptions
-from ..engine.driver import Trajectory
-from ..engine.switches import Switches
-from ..engine.loop import LEDGER_ROWS, STATE_ROWS, WORK
+from ..engine import SolverOptions
+from ..engine import Trajectory
 from ..model.model import Model
 from ..outcome import Outcome
 
@@ -72,7 +70,7 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
         tr = integrate(model, (phase, local_end), y, local, opts, mode=mode)
         kept = min(tr.t.size, own.size)
         shift = start - phase
-        parts.append(_absolute(tr, own[:kept], kept, shift, work))
+        parts.append(tr.piece(own[:kept], kept, shift, work))
         budget -= len(tr.switches)
         if progress is not None:
             progress((end - t0) / (t_end - t0))
@@ -80,31 +78,19 @@ def integrate_in_pieces(integrate: Callable, model: Model, t_span: tuple[float, 
             return _joined(parts, stopped=True)
         if tr.outcome is not Outcome.SUCCESS or tr.t.size < local.size or budget <= 0:
             break
-        y = tr.y[:STATE_ROWS, -1].copy()
+        y = tr.end_state()
         if options.ledger:
-            work = work + tr.y[WORK:LEDGER_ROWS, -1]
+            work = work + tr.works[:, -1]
         mode = tr.end_mode
         start, i = end, hi
     return _joined(parts)
 
 
-def _absolute(tr: Trajectory, t: np.ndarray, kept: int, shift: float, work: np.ndarray) -> Trajectory:
-    """A piece's trajectory in absolute time: its own samples only, switches shifted, works offset."""
-    y = tr.y[:, :kept].copy()
-    if y.shape[0] == LEDGER_ROWS:
-        y[WORK:LEDGER_ROWS] += work[:, None]
-    return dataclasses.replace(tr, t=t.copy(), y=y, mode=tr.mode[:kept], switches=tr.switches.shifted(shift))
-
-
 def _joined(parts: list[Trajectory], stopped: bool = False) -> Trajectory:
-    last = parts[-1]
     stats = {}
     for p in parts:
         for name, value in p.stats.items():
             stats[name] = stats.get(name, 0) + value if isinstance(value, (int, float)) else value
     stats["pieces"] = len(parts)
     stats["stopped"] = stopped
-    return dataclasses.replace(last, t=np.concatenate([p.t for p in parts]),
-                               y=np.concatenate([p.y for p in parts], axis=1),
-                               mode=np.concatenate([p.mode for p in parts]),
-                               switches=Switches.joined([p.switches for p in parts]), stats=stats)
+    return Trajectory.joined(parts, stats)

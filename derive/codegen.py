@@ -35,7 +35,7 @@ from . import trig
 from .automaton import Automaton
 from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
-from camdyn.vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, SceneSpec
+from camdyn.vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSITION, SceneSpec
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
@@ -454,9 +454,15 @@ def _automaton_code(A: Automaton) -> list[str]:
               "#: surface's value crosses zero upward (+1: from < 0 to >= 0) or downward (-1), for the first",
               "#: target whose conditions hold",
               "TRANSITIONS = ("]
-    lines += [f"    ({mode[tr.source]}, {surf[tr.surface]}, {tr.direction:+d}, {targets(tr.targets)}, "
-              f"{constant_name('RESET', tr.reset)})," for tr in A.transitions]
+    lines += ["    (" + ", ".join(_transition_cells(tr, mode, surf, targets)) + ")," for tr in A.transitions]
     return lines + [")"]
+
+
+def _transition_cells(tr, mode: dict, surf: dict, targets) -> list[str]:
+    """One TRANSITIONS row's cells, in the vocabulary's TRANSITION order."""
+    cells = {"source": mode[tr.source], "surface": surf[tr.surface], "direction": f"{tr.direction:+d}",
+             "targets": targets(tr.targets), "reset": constant_name("RESET", tr.reset)}
+    return [cells[column] for column in TRANSITION]
 
 
 def module_name(spec: SceneSpec) -> str:

@@ -152,7 +152,7 @@ class Settings(NamedTuple):
     rtol: float
     atol: float
     max_step: float
-    control_a: float        # the step-size controller's coefficients (stepper.CONTROLS)
+    control_a: float        # the step-size controller's coefficients (StepControl.a, .b)
     control_b: float
     xtol: float
     interior_points: int
@@ -173,6 +173,8 @@ def settings(options: SolverOptions, contact_frequency: float) -> Settings:
     ev = options.events
     step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
     a, b = options.step_control.a, options.step_control.b
-    return Settings(float(options.rtol), float(options.atol), float(options.max_step), a, b, float(ev.xtol),
-                    int(ev.interior_points), float(ev.reach_factor), int(ev.max_events), ANGLE_LIMIT,
-                    CHATTER_SWITCHES, CHATTER_WINDOW, step, CROSSING_RETRIES, LOOK_AHEAD, bool(options.ledger))
+    return Settings(rtol=float(options.rtol), atol=float(options.atol), max_step=float(options.max_step),
+                    control_a=a, control_b=b, xtol=float(ev.xtol), interior_points=int(ev.interior_points),
+                    reach_factor=float(ev.reach_factor), max_events=int(ev.max_events), angle_limit=ANGLE_LIMIT,
+                    chatter_switches=CHATTER_SWITCHES, chatter_window=CHATTER_WINDOW, contact_step=step,
+                    crossing_retries=CROSSING_RETRIES, look_ahead=LOOK_AHEAD, ledger=bool(options.ledger))

@@ -22,7 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..vocabulary import FLOWS
+from ..vocabulary import FLOWS, TRANSITION_DIRECTION as DIRECTION, TRANSITION_RESET as RESET
+from ..vocabulary import TRANSITION_SOURCE as SOURCE, TRANSITION_SURFACE as SURFACE, TRANSITION_TARGETS as TARGETS
 
 #: reset index of the identity (no call to a reset kernel)
 IDENTITY = -1
@@ -65,9 +66,9 @@ def _module_tables(K: ModuleType) -> Tables:
 def _tables(K) -> Tables:
     transitions = transition_rows(K)
     n_modes = len(K.MODES)
-    watch_start = np.searchsorted([tr[0] for tr in transitions], np.arange(n_modes + 1), side="left")
+    watch_start = np.searchsorted([tr[SOURCE] for tr in transitions], np.arange(n_modes + 1), side="left")
     target_start, target_mode, condition_start, condition_surface, condition_sign = [0], [], [0], [], []
-    for candidates in [tr[3] for tr in transitions] + [K.INITIAL]:
+    for candidates in [tr[TARGETS] for tr in transitions] + [K.INITIAL]:
         for mode, conditions in candidates:
             target_mode.append(mode)
             for surface, sign in conditions:
@@ -75,9 +76,10 @@ def _tables(K) -> Tables:
                 condition_sign.append(sign)
             condition_start.append(len(condition_surface))
         target_start.append(len(target_mode))
-    resets = [IDENTITY if K.RESETS[tr[4]] == "identity" else tr[4] for tr in transitions]
+    resets = [IDENTITY if K.RESETS[tr[RESET]] == "identity" else tr[RESET] for tr in transitions]
     sampled_start, sampled = sampled_surfaces(K, transitions, watch_start)
-    parts = [K.CONTACT_OF_MODE, watch_start, [tr[1] for tr in transitions], [tr[2] for tr in transitions], resets,
+    parts = [K.CONTACT_OF_MODE, watch_start, [tr[SURFACE] for tr in transitions], [tr[DIRECTION] for tr in transitions],
+             resets,
              target_start, target_mode, condition_start, condition_surface, condition_sign, K.RATE_OF_SURFACE,
              [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled]
     starts = np.cumsum([0] + [len(part) for part in parts])[:-1]
@@ -92,7 +94,7 @@ def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tu
     called again (compressed rows: mode m's are ``sampled[sampled_start[m]:sampled_start[m + 1]]``)."""
     start, sampled = [0], []
     for m in range(len(K.MODES)):
-        watched = [tr[1] for tr in transitions[watch_start[m]:watch_start[m + 1]]]
+        watched = [tr[SURFACE] for tr in transitions[watch_start[m]:watch_start[m + 1]]]
         covered = {K.RATE_OF_SURFACE[s] for s in watched} - {-1}
         mine: list[int] = []
         for s in watched:
@@ -105,11 +107,11 @@ def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tu
 
 def transition_rows(K: ModuleType) -> list[tuple]:
     """The module's transitions in the order of :class:`Tables` (to name a switch's surface)."""
-    return sorted(K.TRANSITIONS, key=lambda tr: tr[0])
+    return sorted(K.TRANSITIONS, key=lambda tr: tr[SOURCE])
 
 
 @lru_cache(maxsize=None)
 def transition_surfaces(K: ModuleType) -> tuple[str, ...]:
     """The name of the surface each transition crosses, by the transition's index (a switch
     record's ``transition``), once per scene module."""
-    return tuple(K.SURFACES[row[1]] for row in transition_rows(K))
+    return tuple(K.SURFACES[row[SURFACE]] for row in transition_rows(K))

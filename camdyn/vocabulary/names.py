@@ -23,6 +23,13 @@ def mode_name(contact: bool, phase: str | None = None, slip: str | None = None) 
     return name
 
 
+#: the columns of a scene module's TRANSITIONS rows, in order (derive writes them, the engine
+#: reads them by these indices): the source mode, the surface crossed, the direction (+1 upward,
+#: -1 downward), the candidate targets ((mode, conditions), ...), the reset
+TRANSITION = ("source", "surface", "direction", "targets", "reset")
+TRANSITION_SOURCE, TRANSITION_SURFACE, TRANSITION_DIRECTION, TRANSITION_TARGETS, TRANSITION_RESET = \
+    range(len(TRANSITION))
+
 #: Switching surfaces: name -> (unit, meaning).  A surface's value is a function of the state
 #: (t, alpha, alpha_dot) under a mode's laws; its sign selects modes (see derive.automaton).
 SURFACES: dict[str, tuple[str, str]] = {

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ._lazy import lazy
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 _EXPORTS = {
     "Rig": "camdyn.model.rig",

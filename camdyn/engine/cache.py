@@ -58,7 +58,7 @@ def source_hash(folder: Path, salt: str = "") -> str:
 @lru_cache(maxsize=None)
 def engine_key() -> str:
     """camdyn's version and a hash of the engine's sources: the name of the current cache."""
-    from .. import __version__
+    from .._version import __version__
     return f"{__version__}-{source_hash(ENGINE)}"
 
 

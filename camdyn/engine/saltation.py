@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..vocabulary import GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T, STATE_ALPHA, STATE_ALPHA_DOT
+from .tables import transition_surface_indices
 
 
 def saltation_matrix(f_before, f_after, gradient) -> np.ndarray:
@@ -50,3 +51,11 @@ def switch_saltation(model, before: int, after: int, surface: int, t: float, x) 
     f_before = (ad, model.rhs(before, t, a, ad))
     f_after = (ad, model.rhs(after, t, a, ad))
     return saltation_matrix(f_before, f_after, model.surface_gradient(before, surface, t, a, ad))
+
+
+def record_saltation(model, record) -> tuple[np.ndarray, int]:
+    """The saltation matrix of one of a run's switches (a record of
+    :attr:`camdyn.engine.Switches.records`) and the index of the surface it crossed."""
+    surface = transition_surface_indices(model.kernels)[int(record["transition"])]
+    x = (float(record["alpha"]), float(record["alpha_dot"]))
+    return switch_saltation(model, int(record["before"]), int(record["after"]), surface, float(record["t"]), x), surface

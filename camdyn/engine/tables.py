@@ -111,7 +111,13 @@ def transition_rows(K: ModuleType) -> list[tuple]:
 
 
 @lru_cache(maxsize=None)
+def transition_surface_indices(K: ModuleType) -> tuple[int, ...]:
+    """The surface (an index into SURFACES) of each transition, in the loop's transition order
+    (a switch record's ``transition``)."""
+    return tuple(int(row[SURFACE]) for row in transition_rows(K))
+
+
 def transition_surfaces(K: ModuleType) -> tuple[str, ...]:
     """The name of the surface each transition crosses, by the transition's index (a switch
     record's ``transition``), once per scene module."""
-    return tuple(K.SURFACES[row[SURFACE]] for row in transition_rows(K))
+    return tuple(K.SURFACES[s] for s in transition_surface_indices(K))

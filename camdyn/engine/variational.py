@@ -11,13 +11,18 @@ may start on a kink of the law).
 """
 from __future__ import annotations
 
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from scipy.integrate import solve_ivp
 
 from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
+from .config import LOOK_AHEAD
 from .jit import jitable
+from .kernels import compiled_jacobian, compiled_kernels
+from .tableau import method_of
 from .stepper import ERR_FLOOR, accepted_factor, blended, first_guess, min_step, rejected_factor, rms, second_guess
 
 cache.install()
@@ -125,3 +130,72 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
         t, y = t_new, y_new
         K[0] = K[n]
     return y, True
+
+
+class Augmented(NamedTuple):
+    """The augmented state, by name: x = (alpha, alpha_dot), Phi (2 x 2) and the integral of the
+    field's divergence d(alpha_ddot)/d(alpha_dot)."""
+
+    x: np.ndarray
+    phi: np.ndarray
+    divergence: float
+
+    def packed(self) -> np.ndarray:
+        """The rows of :func:`integrate_segment`'s y (AUG_* indices)."""
+        return np.concatenate([self.x, self.phi.ravel(), [self.divergence]])
+
+    @staticmethod
+    def unpacked(y: np.ndarray) -> "Augmented":
+        return Augmented(y[[AUG_ALPHA, AUG_ALPHA_DOT]], y[AUG_PHI].reshape(2, 2), float(y[AUG_DIVERGENCE]))
+
+    def finite(self) -> bool:
+        return bool(np.all(np.isfinite(self.x)) and np.all(np.isfinite(self.phi)) and np.isfinite(self.divergence))
+
+
+def augmented_flow(model, m: int, t0: float, t1: float, start: Augmented, rtol: float, atol: float, control,
+                   compiled: bool) -> tuple[Augmented, bool, str]:
+    """The augmented state at t1 from ``start`` at t0 in mode m of ``model``: (state, ok, why not).
+    ``atol`` scales with the size of Phi at the start for its entries; ``compiled``: by
+    :func:`integrate_segment` with ``control`` (a StepControl), else by SciPy's DOP853 over the
+    Python kernels."""
+    y0 = start.packed()
+    tol = atol * np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(start.phi)))), [1.0]])
+    if compiled:
+        K = model.kernels
+        y, ok = integrate_segment(compiled_kernels(K, outputs=False).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
+                                  rtol, tol, method_of("DOP853"), LOOK_AHEAD, control)
+        return Augmented.unpacked(y), bool(ok), "the step size fell below the spacing of t"
+    sol = solve_ivp(_python_field(model, m, t0), (t0, t1), y0, method="DOP853", rtol=rtol, atol=tol)
+    return Augmented.unpacked(sol.y[:, -1]), bool(sol.success), sol.message
+
+
+def frozen_step(model, m: int, t: float, a: Augmented, gap: float) -> Augmented:
+    """``a`` carried over ``gap`` seconds with the Jacobian frozen at (t, a.x): one Euler step of
+    Phi and the divergence, x kept (the engine's recorded state restarts it after)."""
+    jac = np.array(model.jacobian(m, t, float(a.x[0]), float(a.x[1])))
+    y = a.packed()
+    slope = np.empty(N_AUGMENTED)
+    fill_augmented(0.0, 0.0, jac, y, slope)
+    y[AUG_PHI] += gap * slope[AUG_PHI]
+    y[AUG_DIVERGENCE] += gap * slope[AUG_DIVERGENCE]
+    return Augmented.unpacked(y)
+
+
+def _python_field(model, m: int, t_start: float):
+    """The augmented field in mode m for SciPy (the Python kernels).  At the segment's start the
+    Jacobian is its limit from inside the segment, taken LOOK_AHEAD along the motion as the
+    rules do: a segment that starts on a surface may start on a kink of the law (the impact
+    damping's abs(psi_i) at first contact, whose generated derivative is 0 at psi_i = 0), and a
+    first stage with the kink's value would stall the step-size control."""
+    def f(t, y):
+        a, ad = y[AUG_ALPHA], y[AUG_ALPHA_DOT]
+        add = model.rhs(m, t, a, ad)
+        if t == t_start:
+            d = LOOK_AHEAD
+            jac = np.array(model.jacobian(m, t + d, a + d * ad, ad + d * add))
+        else:
+            jac = np.array(model.jacobian(m, t, a, ad))
+        out = np.empty(N_AUGMENTED)
+        fill_augmented(ad, add, jac, y, out)
+        return out
+    return f

@@ -190,7 +190,7 @@ def run_attributes(result, rig=None, *, rig_source: str | None = None,
     camdyn.ParameterError
         If no rig is given and ``result.meta`` does not hold one.
     """
-    from .. import __version__
+    from .._version import __version__
     from ..errors import ParameterError
     from ..model.rig import Rig
 

@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 from .cam import CamMotion, ConstantSpeed
 from ..vocabulary.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
 from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
-from ..engine.config import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
+from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
 from .scene import Scene, variational_kernels
@@ -206,7 +206,7 @@ class Model:
         """The output quantities (rows in the order of ``OUTPUTS``: ``OUT_<NAME>``) at samples of
         a run (its modes, times and states), by the compiled outputs kernel or, with backend
         "python", the generated Python one."""
-        from ..engine.kernels import compiled_kernels, outputs_on_samples, python_kernels
+        from ..engine import compiled_kernels, outputs_on_samples, python_kernels
         K = self.kernels
         compiled = backend == "compiled"
         kern = compiled_kernels(K) if compiled else python_kernels(K, self.cam if self.scene.motion == "user" else None)

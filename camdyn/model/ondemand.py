@@ -29,7 +29,7 @@ from pathlib import Path
 from types import ModuleType
 
 from ..vocabulary import SceneSpec
-from ..engine.cache import remove_folders, source_hash, user_cache_root
+from ..engine import remove_folders, source_hash, user_cache_root
 from ..errors import CompileNotice, SceneError
 
 SCENES_FOLDER = "scenes"

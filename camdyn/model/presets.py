@@ -13,7 +13,7 @@ import re
 from importlib import resources
 from pathlib import Path
 
-from .. import __version__
+from .._version import __version__
 from ..errors import ParameterError, RigFileError
 from .rig import NEUTRAL, PARAMETERS, Rig, tomllib
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.cam import CamMotion, periodic_cam
-from ..engine.config import SolverOptions
+from ..engine import SolverOptions
 from ..errors import ParameterError
 from ..model.model import Model
 from ..model.rig import Rig

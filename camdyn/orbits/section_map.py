@@ -29,12 +29,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..engine.config import LOOK_AHEAD, MAP_OPTIONS, SolverOptions
-from ..engine.driver import Trajectory, integrate
-from ..engine.kernels import python_kernels
-from ..engine.problem import Problem
-from ..engine.rules import across, initial_mode
-from ..engine.tables import tables
+from ..engine import MAP_OPTIONS, Domain, SolverOptions, Trajectory, integrate
 from ..errors import CamdynError, ParameterError
 from ..model.model import Model
 from ..runs.pieces import integrate_in_pieces
@@ -120,8 +115,7 @@ class StroboscopicMap:
         self.model, self.periods, self.phase = model, int(periods), float(phase)
         self.mode = None if mode is None else int(mode)
         self.options, self.backend = options, backend
-        K = model.kernels
-        self._rules = Problem(python_kernels(K), tables(K), np.ascontiguousarray(model.p, dtype=float))
+        self._domain = Domain(model)
 
     @property
     def t_span(self) -> tuple[float, float]:
@@ -133,13 +127,11 @@ class StroboscopicMap:
         the automaton's initial rule's choice."""
         t0, (a, ad) = self.phase, map(float, x)
         if self.mode is None:
-            return int(initial_mode(self._rules, t0, a, ad, LOOK_AHEAD))
-        tab = self._rules.tables
-        for w in range(tab.data[tab.watch_start + self.mode], tab.data[tab.watch_start + self.mode + 1]):
-            if across(self._rules, self.mode, w, t0, a, ad):
-                surface = self.model.kernels.SURFACES[tab.data[tab.surface + w]]
-                raise MapFailure(f"the state {tuple(map(float, x))} is across surface {surface!r} of mode "
-                                 f"{self.model.kernels.MODES[self.mode]!r} at the section: outside the mode's domain")
+            return self._domain.initial_mode(t0, a, ad)
+        s = self._domain.surface_crossed(self.mode, t0, a, ad)
+        if s >= 0:
+            raise MapFailure(f"the state {tuple(map(float, x))} is across surface {self._domain.surfaces[s]!r} of "
+                             f"mode {self._domain.modes[self.mode]!r} at the section: outside the mode's domain")
         return self.mode
 
     def evaluate(self, x) -> MapValue:

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..runs import quasistatic
 from ..model.cam import CamMotion, periodic_cam
-from ..engine.config import SolverOptions
+from ..engine import SolverOptions
 from ..errors import ParameterError
 from ..model.model import Model
 from ..outcome import ActionableOutcome

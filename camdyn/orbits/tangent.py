@@ -31,18 +31,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATE_ALPHA, STATE_ALPHA_DOT
-from ..engine.config import LOOK_AHEAD, SCIPY_CONTROL, SolverOptions, StepControl, step_control
-from ..engine.driver import integrate
-from ..engine.kernels import compiled_jacobian, compiled_kernels
-from ..engine.loop import ALPHA, ALPHA_DOT
-from ..engine.saltation import switch_saltation
-from ..engine.tableau import method_of
-from ..engine.tables import transition_rows
-from ..engine.variational import (AUG_ALPHA, AUG_ALPHA_DOT, AUG_DIVERGENCE, AUG_PHI, N_AUGMENTED, fill_augmented,
-                                  integrate_segment)
+from ..engine import (SCIPY_CONTROL, Augmented, SolverOptions, StepControl, augmented_flow, frozen_step, integrate,
+                      record_saltation, step_control)
+from ..vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from ..errors import CamdynError, ParameterError
 from ..model.model import Model
 from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue, StroboscopicMap
@@ -113,78 +105,39 @@ class TangentResult:
     log_growth: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
 
-def _augmented(model: Model, m: int, t_start: float):
-    """The field of (x, Phi, integral of the divergence) in mode m.  At the segment's start the
-    Jacobian is its limit from inside the segment, taken LOOK_AHEAD along the motion as the
-    engine's rules do: a segment that starts on a surface may start on a kink of the law (the
-    impact damping's abs(psi_i) at first contact, whose generated derivative is 0 at psi_i = 0),
-    and a first stage with the kink's value would stall the step-size control."""
-    p, K = model.p, model.kernels
-    extra = model._extra
-    jac = np.empty(2)
-
-    def f(t, y):
-        a, ad = y[AUG_ALPHA], y[AUG_ALPHA_DOT]
-        add = K.rhs(m, t, a, ad, p, *extra(t))
-        if t == t_start:
-            d = LOOK_AHEAD
-            K.jacobian(m, t + d, a + d * ad, ad + d * add, p, *extra(t + d), jac)
-        else:
-            K.jacobian(m, t, a, ad, p, *extra(t), jac)
-        out = np.empty(N_AUGMENTED)
-        fill_augmented(ad, add, jac, y, out)
-        return out
-    return f
-
-
 def _segment(model: Model, m: int, t0: float, t1: float, x, phi, settings: TangentSettings, compiled: bool):
-    """(x, Phi, integral of the divergence) at t1 from (x, Phi) at t0 in mode m: compiled
-    (:mod:`camdyn.engine.variational`) or by SciPy's DOP853 over the Python kernels."""
-    y0 = np.concatenate([x, phi.ravel(), [0.0]])
+    """(x, Phi, integral of the divergence) at t1 from (x, Phi) at t0 in mode m
+    (:func:`camdyn.engine.augmented_flow`, compiled or by SciPy over the Python kernels)."""
     if t1 <= t0:
         return np.asarray(x, dtype=float), phi, 0.0
-    atol = settings.atol * np.concatenate([[1.0, 1.0], np.full(4, max(1.0, np.max(np.abs(phi)))), [1.0]])
-    y, ok, message = _integrate(model, m, t0, t1, y0, settings, atol, compiled)
+    start = Augmented(np.asarray(x, dtype=float), np.asarray(phi, dtype=float), 0.0)
+    a, ok, message = _flow_to(model, m, t0, t1, start, settings, compiled)
     if not ok and t1 - t0 > 2 * END_GAP:          # an unbounded Jacobian at the segment's end
-        y, ok, message = _short_of_end(model, m, t0, t1, y0, settings, atol, compiled, END_GAP)
+        a, ok, message = _short_of_end(model, m, t0, t1, start, settings, compiled, END_GAP)
         if ok:
-            fine, ok, message = _short_of_end(model, m, t0, t1, y0, settings, atol, compiled, END_GAP / 100)
-            change = np.max(np.abs(y[AUG_PHI] - fine[AUG_PHI])) / max(np.max(np.abs(fine[AUG_PHI])), np.finfo(float).tiny)
+            fine, ok, message = _short_of_end(model, m, t0, t1, start, settings, compiled, END_GAP / 100)
+            change = np.max(np.abs(a.phi - fine.phi)) / max(np.max(np.abs(fine.phi)), np.finfo(float).tiny)
             if ok and not change <= END_GAP_CHANGE:
                 ok, message = False, (f"Phi with the Jacobian frozen over the last {END_GAP:g} s and the last "
                                       f"{END_GAP / 100:g} s differs by {change:.1e}: a singularity that matters")
-    if not ok or not np.all(np.isfinite(y)):
+    if not ok or not a.finite():
         raise TangentFailure(f"the tangent integration in mode {model.kernels.MODES[m]!r} from t = {t0:g} s "
                              f"failed: {message} (an unbounded Jacobian, e.g. damping C or E's impact law at "
                              "first contact: use camdyn.orbits.derivatives.finite_differences)")
-    return y[[AUG_ALPHA, AUG_ALPHA_DOT]], y[AUG_PHI].reshape(2, 2), float(y[AUG_DIVERGENCE])
+    return a.x, a.phi, a.divergence
 
 
-def _short_of_end(model: Model, m: int, t0: float, t1: float, y0, settings, atol, compiled: bool, gap: float):
+def _flow_to(model: Model, m: int, t0: float, t1: float, start: Augmented, settings: TangentSettings, compiled: bool):
+    return augmented_flow(model, m, t0, t1, start, settings.rtol, settings.atol, settings.step_control, compiled)
+
+
+def _short_of_end(model: Model, m: int, t0: float, t1: float, start: Augmented, settings, compiled: bool, gap: float):
     """The augmented system to ``gap`` before t1, then Phi and the divergence over the gap with
-    the Jacobian frozen there (one Euler step; x stays: the engine's state restarts it at t1)."""
-    y, ok, message = _integrate(model, m, t0, t1 - gap, y0, settings, atol, compiled)
+    the Jacobian frozen there (:func:`camdyn.engine.frozen_step`)."""
+    a, ok, message = _flow_to(model, m, t0, t1 - gap, start, settings, compiled)
     if not ok:
-        return y, ok, message
-    t, jac = t1 - gap, np.empty(2)
-    model.kernels.jacobian(m, t, float(y[AUG_ALPHA]), float(y[AUG_ALPHA_DOT]), model.p, *model._extra(t), jac)
-    slope = np.empty(N_AUGMENTED)
-    fill_augmented(0.0, 0.0, jac, y, slope)          # one Euler step of Phi and the divergence
-    out = y.copy()
-    out[AUG_PHI] += gap * slope[AUG_PHI]
-    out[AUG_DIVERGENCE] += gap * slope[AUG_DIVERGENCE]
-    return out, True, message
-
-
-def _integrate(model: Model, m: int, t0: float, t1: float, y0, settings: TangentSettings, atol, compiled: bool):
-    """The augmented system from t0 to t1: (y, ok, message)."""
-    if compiled:
-        K = model.kernels
-        y, ok = integrate_segment(compiled_kernels(K, outputs=False).rhs, compiled_jacobian(K), model.p, m, t0, t1, y0,
-                                  settings.rtol, atol, method_of("DOP853"), LOOK_AHEAD, settings.step_control)
-        return y, ok, "the step size fell below the spacing of t"
-    sol = solve_ivp(_augmented(model, m, t0), (t0, t1), y0, method="DOP853", rtol=settings.rtol, atol=atol)
-    return sol.y[:, -1], sol.success, sol.message
+        return a, ok, message
+    return frozen_step(model, m, t1 - gap, a, gap), True, message
 
 
 #: with renormalisation, a segment is integrated in pieces over which Phi grows or shrinks by at
@@ -197,9 +150,8 @@ RENORMALISE_NATS = 100.0
 def _piece_end(model: Model, m: int, t: float, x, t1: float) -> float:
     """The end of the next piece of a segment to t1: its rate bound is abs(a_alpha_dot) (the
     divergence) plus sqrt(a_alpha) where the stiffness term repels (Eqs. 21-22 at the start)."""
-    jac = np.empty(2)
-    model.kernels.jacobian(m, t, float(x[STATE_ALPHA]), float(x[STATE_ALPHA_DOT]), model.p, *model._extra(t), jac)
-    rate = abs(jac[JAC_D_ALPHA_DOT]) + math.sqrt(max(jac[JAC_D_ALPHA], 0.0))
+    d_alpha, d_alpha_dot = model.jacobian(m, t, float(x[STATE_ALPHA]), float(x[STATE_ALPHA_DOT]))
+    rate = abs(d_alpha_dot) + math.sqrt(max(d_alpha, 0.0))
     if not math.isfinite(rate) or rate <= 0.0:
         return t1
     return min(t1, t + RENORMALISE_NATS / rate)
@@ -241,23 +193,21 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     tr = integrate(model, (t0, t1), x, np.array([t1]), options, mode=mode, backend=backend)
     if not tr.outcome.ok or tr.t.size != 1:
         raise TangentFailure(f"the run from {tuple(map(float, x))} failed: {tr.outcome.message}", tr.outcome)
-    K = model.kernels
     compiled = backend == "compiled"
     phi = np.eye(2) if phi0 is None else np.array(phi0, dtype=float).reshape(2, 2)
-    records, surface_of = tr.switches.records, [row[1] for row in transition_rows(K)]
+    records = tr.switches.records
     m = int(records["before"][0]) if len(records) else tr.end_mode
     t, divergence, log_det = t0, 0.0, 0.0
     growth = np.zeros(2) if renormalise else None
     for sw in records:
-        t_sw, before, after = float(sw["t"]), int(sw["before"]), int(sw["after"])
+        t_sw, after = float(sw["t"]), int(sw["after"])
         _, phi, d, growth = _flow(model, m, t, t_sw, x, phi, settings, compiled, growth)
         divergence += d
         x = np.array([sw["alpha"], sw["alpha_dot"]], dtype=float)
-        surface = surface_of[int(sw["transition"])]
-        S = switch_saltation(model, before, after, surface, t_sw, x)
+        S, surface = record_saltation(model, sw)
         if not np.all(np.isfinite(S)):
-            raise TangentFailure(f"the switch at t = {t_sw:g} s across {K.SURFACES[surface]!r} grazes it (the "
-                                 "field is tangent to the surface): no saltation matrix")
+            raise TangentFailure(f"the switch at t = {t_sw:g} s across {model.kernels.SURFACES[surface]!r} grazes it "
+                                 "(the field is tangent to the surface): no saltation matrix")
         phi = S @ phi
         if renormalise:
             phi, growth = _orthonormalised(phi, growth)
@@ -265,7 +215,7 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
         log_det += math.log(det) if det > 0 else -math.inf
         t, m = t_sw, after
     flow_x, phi, d, growth = _flow(model, m, t, t1, x, phi, settings, compiled, growth)
-    return TangentResult(tr.y[[ALPHA, ALPHA_DOT], -1], phi, int(tr.end_mode), len(records), divergence + d, log_det,
+    return TangentResult(tr.end_state(), phi, int(tr.end_mode), len(records), divergence + d, log_det,
                          flow_x, np.zeros(2) if growth is None else growth)
 
 

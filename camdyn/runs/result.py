@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..engine.switches import Switches
+from ..engine import Switches
 from ..outcome import Outcome
 
 

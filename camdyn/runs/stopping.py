@@ -27,9 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.driver import Trajectory
-from ..engine.loop import ALPHA
-from ..engine.switches import Switches
+from ..engine import Switches, Trajectory
 from ..errors import ParameterError
 
 #: outputs that accumulate over a run (the energy ledger's works): extended by their increment
@@ -169,7 +167,7 @@ class Watch:
 
     def __call__(self, piece: Trajectory) -> bool:
         first = (-self.seen) % self.per_revolution
-        self.alpha.extend(piece.y[ALPHA, first::self.per_revolution].tolist())
+        self.alpha.extend(piece.alpha[first::self.per_revolution].tolist())
         self.modes.extend(piece.mode[first::self.per_revolution].tolist())
         self.seen += piece.t.size
         self.period = self.stop.period_of(np.asarray(self.alpha), np.asarray(self.modes), self.rtol, self.atol)

@@ -47,7 +47,7 @@ except ImportError:  # not POSIX (Windows): sweep folders are not locked (Folder
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..errors import CamdynError
 from ..model.rig import PARAMETERS
 from .spec import ALL_CODES, NOT_RUN, OWN, ChunkResult, SweepSpec

@@ -20,11 +20,11 @@ the correlation method; the median over about 100 values of c).
 from __future__ import annotations
 
 import math
-from numbers import Integral
 
 import numpy as np
 
 from ..errors import ParameterError
+from .._checks import integer, is_integer, real
 
 #: the shortest series the test accepts: n_cut = N/10 must leave a few tens of lags
 MIN_LENGTH = 100
@@ -53,7 +53,7 @@ def _series(phi) -> np.ndarray:
 def _generator(rng) -> np.random.Generator:
     if isinstance(rng, np.random.Generator):
         return rng
-    if rng is None or (isinstance(rng, Integral) and not isinstance(rng, bool) and rng >= 0):
+    if rng is None or (is_integer(rng) and rng >= 0):
         return np.random.default_rng(rng)
     raise ParameterError("rng", rng, "a numpy.random.Generator, a seed (integer >= 0) or None")
 
@@ -110,10 +110,8 @@ def zero_one_test(series, *, n_c: int = 100, rng=None, resolution: float = 0.0) 
         At finite N it approaches its limit slowly: see tests/test_chaos01.py for measured values.
     """
     phi = _series(series)
-    if isinstance(n_c, bool) or not isinstance(n_c, Integral) or not 1 <= n_c <= 10_000:
-        raise ParameterError("n_c", n_c, "an integer, 1 <= n_c <= 10000")
-    if isinstance(resolution, bool) or not isinstance(resolution, (int, float)) or not 0 <= resolution < math.inf:
-        raise ParameterError("resolution", resolution, "a finite number >= 0, in the series' unit")
+    integer("n_c", n_c, "an integer, 1 <= n_c <= 10000", lambda n: 1 <= n <= 10_000)
+    real("resolution", resolution, "a finite number >= 0, in the series' unit", lambda v: 0 <= v < math.inf)
     cs = _generator(rng).uniform(*C_RANGE, size=int(n_c))
     if np.ptp(phi) <= resolution:
         return 0.0

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import is_integer
+
 __all__ = [
     "rms",
     "peak_to_peak",
@@ -115,7 +117,7 @@ def spectrum(t, x, *, window: str = "hann", detrend: str | None = "mean", pad_to
         raise ValueError(f"detrend must be one of {_DETRENDS}, got {detrend!r}")
     w = _window(window, n)
     nfft = n if pad_to is None else pad_to
-    if isinstance(nfft, bool) or not isinstance(nfft, (int, np.integer)) or nfft < n:
+    if not (is_integer(nfft) and nfft >= n):
         raise ValueError(f"pad_to must be an integer >= len(x) = {n}, got {pad_to!r}")
 
     amplitude = np.abs(np.fft.rfft(w * x, nfft)) * (2.0 / w.sum())

@@ -15,6 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
+from .._checks import integer, real
 from .tableau import TABLEAUS
 
 _EPS = float(np.finfo(float).eps)
@@ -102,15 +103,11 @@ class EventSettings:
     reach_factor: float = REACH_FACTOR
 
     def __post_init__(self) -> None:
-        if isinstance(self.xtol, bool) or not isinstance(self.xtol, (int, float)) or not (4 * _EPS <= self.xtol < 1):
-            raise ParameterError("xtol", self.xtol, f"4*eps = {4 * _EPS:.3g} <= xtol < 1")
+        real("xtol", self.xtol, f"4*eps = {4 * _EPS:.3g} <= xtol < 1", lambda v: 4 * _EPS <= v < 1)
         for name, low in (("interior_points", 0), ("max_events", 1)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ParameterError(name, value, f"an integer >= {low}")
-        factor = self.reach_factor
-        if isinstance(factor, bool) or not isinstance(factor, (int, float)) or not factor >= 1:
-            raise ParameterError("reach_factor", factor, "a number >= 1 (math.inf: interior samples in every step)")
+            integer(name, getattr(self, name), f"an integer >= {low}", lambda n: n >= low)
+        real("reach_factor", self.reach_factor, "a number >= 1 (math.inf: interior samples in every step)",
+             lambda v: v >= 1)
 
 
 @dataclass(frozen=True)
@@ -129,12 +126,9 @@ class SolverOptions:
         if self.method not in METHODS:
             raise ParameterError("method", self.method, f"one of {METHODS} (explicit Runge-Kutta pairs with "
                                  "dense output; implicit methods do not pay on this model: docs/performance.md)")
-        if isinstance(self.rtol, bool) or not (isinstance(self.rtol, (int, float)) and 1e-14 <= self.rtol <= 1e-2):
-            raise ParameterError("rtol", self.rtol, "1e-14 <= rtol <= 1e-2")
-        if isinstance(self.atol, bool) or not (isinstance(self.atol, (int, float)) and 0 < self.atol <= 1e-2):
-            raise ParameterError("atol", self.atol, "0 < atol <= 1e-2")
-        if isinstance(self.max_step, bool) or not (isinstance(self.max_step, (int, float)) and self.max_step > 0):
-            raise ParameterError("max_step", self.max_step, "max_step > 0 (s)")
+        real("rtol", self.rtol, "1e-14 <= rtol <= 1e-2", lambda v: 1e-14 <= v <= 1e-2)
+        real("atol", self.atol, "0 < atol <= 1e-2", lambda v: 0 < v <= 1e-2)
+        real("max_step", self.max_step, "max_step > 0 (s)", lambda v: v > 0)
         if not isinstance(self.events, EventSettings):
             raise ParameterError("events", self.events, "an EventSettings")
         object.__setattr__(self, "step_control", step_control(self.step_control))

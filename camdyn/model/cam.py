@@ -10,18 +10,15 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-import numpy as np
 
 from ..errors import ParameterError
+from .._checks import finite
 
 RPM = 2 * math.pi / 60  # rad/s per rev/min
 
 
 def _finite(name: str, value, valid: str = "a finite number") -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(value):
-        raise ParameterError(name, value, valid)
-    return float(value)
+    return finite(name, value, valid)
 
 
 @dataclass(frozen=True)

@@ -39,7 +39,6 @@ import math
 import os
 import sys
 from dataclasses import dataclass
-from numbers import Real
 from pathlib import Path
 from typing import Any, Collection, Mapping
 
@@ -49,6 +48,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from ..vocabulary.parameters import RIG_PARAMETERS, RigParameter, Rule
+from .._checks import is_real
 from ..errors import ParameterError, RigFileError
 
 __all__ = ["PARAMETERS", "NEUTRAL", "Parameter", "Rule", "Rig"]
@@ -111,7 +111,7 @@ class Parameter:
                 raise ParameterError(self.name, None, "required", reason=self.meaning)
             return None
         x = math.nan
-        if isinstance(value, Real) and not isinstance(value, bool):
+        if is_real(value):
             try:
                 x = float(value)
             except OverflowError:  # an int beyond the float range

@@ -28,6 +28,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
+from .._checks import flag, real
 from .section_map import MapDerivative, MapFailure, MapValue, StroboscopicMap, derivative_at
 from .tangent import Variational
 
@@ -159,8 +160,7 @@ class FiniteDifferences:
         scale = np.asarray(scale, dtype=float)
         if scale.shape != (2,) or not np.all(np.isfinite(scale)) or not np.all(scale > 0):
             raise ParameterError("scale", scale, "two positive numbers (rad, rad/s)")
-        if isinstance(step_factor, bool) or not isinstance(step_factor, (int, float)) or not 0 < step_factor < 1e6:
-            raise ParameterError("step_factor", step_factor, "0 < step_factor < 1e6")
+        real("step_factor", step_factor, "0 < step_factor < 1e6", lambda v: 0 < v < 1e6)
         self.section_map, self.scale, self.step_factor, self.fallback = section_map, scale, float(step_factor), fallback
 
     def __call__(self, x) -> tuple[np.ndarray, np.ndarray]:
@@ -216,6 +216,5 @@ def finite_differences(section_map: StroboscopicMap, scale, step_factor: float =
     """The Jacobian provider by central differences of ``section_map`` (:class:`FiniteDifferences`),
     falling back to the variational provider where a column cannot be resolved (``fallback=False``:
     the derivative is reported unresolved instead)."""
-    if not isinstance(fallback, bool):
-        raise ParameterError("fallback", fallback, "True or False")
+    flag("fallback", fallback)
     return FiniteDifferences(section_map, scale, step_factor, _variational_fallback if fallback else None)

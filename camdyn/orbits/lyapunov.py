@@ -34,6 +34,7 @@ import numpy as np
 from ..model.cam import CamMotion, periodic_cam
 from ..engine import SolverOptions
 from ..errors import ParameterError
+from .._checks import integer
 from ..model.model import Model
 from ..model.rig import Rig
 from ..model.scene import Scene
@@ -55,9 +56,7 @@ class LyapunovSettings:
     def __post_init__(self):
         checks = (("revolutions", 1), ("transient", 0), ("batches", 2))
         for name, low in checks:
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise ParameterError(name, value, f"an integer >= {low}")
+            integer(name, getattr(self, name), f"an integer >= {low}", lambda n: n >= low)
         if self.revolutions % self.batches:
             raise ParameterError("revolutions", self.revolutions, f"a multiple of batches = {self.batches}")
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..engine import MAP_OPTIONS, Domain, SolverOptions, Trajectory, integrate
 from ..errors import CamdynError, ParameterError
+from .._checks import integer, real
 from ..model.model import Model
 from ..runs.pieces import integrate_in_pieces
 
@@ -102,14 +103,11 @@ class StroboscopicMap:
         if not (math.isfinite(T) and T > 0):
             raise ParameterError("model", None, "a periodic cam motion (a nonzero speed, or a period)",
                                  problem=f"{model.cam!r} has no period")
-        if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or not 1 <= periods <= MAX_PERIODS:
-            raise ParameterError("periods", periods, f"an integer, 1 <= periods <= {MAX_PERIODS}")
-        if isinstance(phase, bool) or not isinstance(phase, (int, float)) or not 0.0 <= phase < T:
-            raise ParameterError("phase", phase, f"0 <= phase < T = {T:.6g} s")
+        integer("periods", periods, f"an integer, 1 <= periods <= {MAX_PERIODS}", lambda n: 1 <= n <= MAX_PERIODS)
+        real("phase", phase, f"0 <= phase < T = {T:.6g} s", lambda v: 0.0 <= v < T)
         modes = model.kernels.MODES
-        if mode is not None and (isinstance(mode, bool) or not isinstance(mode, (int, np.integer))
-                                 or not 0 <= mode < len(modes)):
-            raise ParameterError("mode", mode, f"None or an index into the scene's MODES {modes}")
+        if mode is not None:
+            integer("mode", mode, f"None or an index into the scene's MODES {modes}", lambda n: 0 <= n < len(modes))
         if not isinstance(options, SolverOptions):
             raise ParameterError("options", options, "a camdyn.engine.SolverOptions")
         self.model, self.periods, self.phase = model, int(periods), float(phase)

@@ -29,6 +29,7 @@ from ..runs import quasistatic
 from ..model.cam import CamMotion, periodic_cam
 from ..engine import SolverOptions
 from ..errors import ParameterError
+from .._checks import integer, real
 from ..model.model import Model
 from ..outcome import ActionableOutcome
 from ..model.rig import Rig
@@ -119,11 +120,9 @@ class ShootingSettings:
     max_iterations: int = 20
 
     def __post_init__(self):
-        if isinstance(self.tol, bool) or not isinstance(self.tol, (int, float)) or not 0 < self.tol < 1:
-            raise ParameterError("tol", self.tol, "0 < tol < 1 (scaled residual)")
-        if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int) \
-                or not 1 <= self.max_iterations <= 1000:
-            raise ParameterError("max_iterations", self.max_iterations, "an integer, 1 <= max_iterations <= 1000")
+        real("tol", self.tol, "0 < tol < 1 (scaled residual)", lambda v: 0 < v < 1)
+        integer("max_iterations", self.max_iterations, "an integer, 1 <= max_iterations <= 1000",
+                lambda n: 1 <= n <= 1000)
 
 
 def warm_start(model: Model, revolutions: float, phase: float, y0=None,
@@ -133,8 +132,7 @@ def warm_start(model: Model, revolutions: float, phase: float, y0=None,
     size of the motion over its last revolution (``max |alpha - alpha*|`` and ``max |alpha_dot|``:
     the residual's scale)."""
     T = model.period
-    if isinstance(revolutions, bool) or not isinstance(revolutions, (int, np.integer)) or revolutions < 1:
-        raise ParameterError("warmup_revolutions", revolutions, "an integer >= 1")
+    integer("warmup_revolutions", revolutions, "an integer >= 1", lambda n: n >= 1)
     t_end = phase + revolutions * T
     t_eval = t_end - T + T * np.arange(SCALE_SAMPLES + 1) / SCALE_SAMPLES
     t_eval[-1] = t_end                       # the section itself, not t_end - T + T rounded

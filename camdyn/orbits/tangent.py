@@ -35,7 +35,8 @@ import numpy as np
 from ..engine import (SCIPY_CONTROL, Augmented, SolverOptions, StepControl, augmented_flow, frozen_step, integrate,
                       record_saltation, step_control)
 from ..vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
-from ..errors import CamdynError, ParameterError
+from ..errors import CamdynError
+from .._checks import real
 from ..model.model import Model
 from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue, StroboscopicMap
 
@@ -76,9 +77,7 @@ class TangentSettings:
 
     def __post_init__(self):
         for name in ("rtol", "atol"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value < 1:
-                raise ParameterError(name, value, "0 < value < 1")
+            real(name, getattr(self, name), "0 < value < 1", lambda v: 0 < v < 1)
         object.__setattr__(self, "step_control", step_control(self.step_control))
 
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..engine import Switches, Trajectory
 from ..errors import ParameterError
+from .._checks import integer, is_real
 
 #: outputs that accumulate over a run (the energy ledger's works): extended by their increment
 ACCUMULATED = ("work_in", "dissipated_contact", "dissipated_friction")
@@ -62,16 +63,14 @@ class StopWhenPeriodic:
 
     def __post_init__(self):
         for name, least in (("max_period", 1), ("check_every", 2)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
-                raise ParameterError(name, value, f"an integer >= {least}")
+            integer(name, getattr(self, name), f"an integer >= {least}", lambda n: n >= least)
         if self.check_every % 2:
             raise ParameterError("check_every", self.check_every, "an even number of revolutions (whole kernel "
                                  "periods 2 T)")
         r = self.revolutions
-        if isinstance(r, bool) or not isinstance(r, (int, np.integer)) or r < 2 * self.max_period:
-            raise ParameterError("revolutions", r, f"an integer >= 2 max_period ({2 * self.max_period})")
-        if isinstance(self.tol, bool) or not isinstance(self.tol, (int, float)) or not 1 <= self.tol <= 1e6:
+        integer("revolutions", r, f"an integer >= 2 max_period ({2 * self.max_period})",
+                lambda n: n >= 2 * self.max_period)
+        if not (is_real(self.tol) and 1 <= self.tol <= 1e6):
             raise ParameterError("tol", self.tol, "1 <= tol <= 1e6 (times the solver's tolerance rtol abs(alpha) + atol: "
                                  "below 1 the check would ask for more than the solver gives)")
 

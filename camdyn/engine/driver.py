@@ -26,7 +26,8 @@ from .tableau import method_of
 from .tables import tables, transition_surfaces
 
 #: "compiled": the loop and the kernels compiled by numba (built-in cam motions);
-#: "python": the same loop run by Python (any cam motion, e.g. a user's callables; ~100x slower)
+#: "python": the same loop run by Python (any cam motion, e.g. a user's callables; slow:
+#: docs/design-notes.md, *The python backend*)
 
 
 @dataclass

@@ -178,8 +178,8 @@ def fill_outputs(outputs, modes, t, alpha, alpha_dot, p, out):
     row = np.empty(out.shape[0])
     for i in range(t.shape[0]):
         outputs(modes[i], t[i], alpha[i], alpha_dot[i], p, row)
-        for k in range(row.shape[0]):  # element by element: a slice assignment compiles numba's
-            out[k, i] = row[k]         # shape-error formatting (seconds of the cold start)
+        for k in range(row.shape[0]):  # element by element (docs/design-notes.md, *Element-by-element
+            out[k, i] = row[k]         # copies in compiled code*)
     return out
 
 

@@ -92,8 +92,8 @@ def _record(sw, n, t, w, before, after, a, ad):
     """Append a switch as column n of sw (rows SW_*), doubling the buffer when full; returns it."""
     if n == sw.shape[1]:
         bigger = np.empty((sw.shape[0], 2 * n))
-        for r in range(sw.shape[0]):  # element by element: a slice assignment compiles numba's
-            for k in range(n):        # shape-error message formatting, seconds of the cold start
+        for r in range(sw.shape[0]):  # element by element (docs/design-notes.md, *Element-by-element
+            for k in range(n):        # copies in compiled code*)
                 bigger[r, k] = sw[r, k]
         sw = bigger
     sw[SW_T, n], sw[SW_TRANSITION, n], sw[SW_BEFORE, n], sw[SW_AFTER, n] = t, w, before, after
@@ -296,9 +296,9 @@ _run_compiled = njit(cache=True, error_model="numpy")(run)
 
 
 #: the compiled loop's machine-code entry per layout of its arguments (:func:`_layout`), found by
-#: the dispatcher on the first call with that layout: numba's dispatcher types every argument on
-#: every call, and typing the named tuples of cfuncs and arrays costs 0.1-0.6 ms, more than a
-#: short run (a stroboscopic map's, a stopping sweep's piece of 4 revolutions) takes to integrate
+#: the dispatcher on the first call with that layout and called directly after it: numba's
+#: dispatcher types every argument on every call, which costs a short run more than its
+#: integration (docs/design-notes.md, *Typing the loop's arguments on every call*)
 _ENTRIES: dict = {}
 
 

@@ -61,7 +61,7 @@ class Switches(Sequence):
 
     def __iter__(self):
         r = self.records
-        columns = zip(*(r[name].tolist() for name in SWITCH.names))   # by column: ~1 us a field otherwise
+        columns = zip(*(r[name].tolist() for name in SWITCH.names))   # by column (docs/design-notes.md)
         for t, w, b, a, x, v in columns:
             yield Switch(t, self.surfaces[w], self.modes[b], self.modes[a], x, v)
 

@@ -9,9 +9,7 @@ is the candidate row after the last transition.  Nothing is found by name at run
 
 All the tables are one integer array, ``data``, and each field of :class:`Tables` is where its
 table starts in it: table ``surface``'s entry w is ``tab.data[tab.surface + w]``.  One array,
-not twelve: reference-counted compiled code pays an atomic count per array for every call that
-passes the tables (measured on the sliding benchmark, benchmarks/floor.py: ~0.2 us per call;
-the engine's helpers no longer count references, :mod:`camdyn.engine.jit`).
+not twelve (docs/design-notes.md, *One integer array for the automaton's tables*).
 """
 from __future__ import annotations
 

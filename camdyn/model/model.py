@@ -109,7 +109,7 @@ def _check_cam(scene: Scene, cam) -> None:
 def _worst_reach(rig: Rig, kernels: ModuleType) -> tuple[float, float]:
     """(Theta, margin) of the least reach margin |PG_c| - (r_c + w_b/2) over a turn of the cam
     (the generated ``reach``, 721 angles): a property of the rig alone, kept for the last rigs
-    seen, so that a sweep in the speed does not redo it for every point (1.6 ms each)."""
+    seen, so that a sweep in the speed does not redo it for every point (docs/design-notes.md)."""
     thetas = rig.theta0 + np.linspace(0, 2 * math.pi, 721)
     p = static_parameters(rig, kernels)
     margins = [kernels.reach(th, p) for th in thetas]

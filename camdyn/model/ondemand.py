@@ -33,8 +33,8 @@ from ..engine import remove_folders, source_hash, user_cache_root
 from ..errors import CompileNotice, SceneError
 
 SCENES_FOLDER = "scenes"
-#: how long one scene's derivation may take before it is stopped (s); a scene takes 10-40 s
-#: on one core (the largest catalogued scene: about 30 s on a loaded 2-core machine)
+#: how long one scene's derivation may take before it is stopped (s; docs/design-notes.md,
+#: *Deriving a scene on first use*)
 DERIVE_TIMEOUT = 600.0
 
 

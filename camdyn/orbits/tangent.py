@@ -42,11 +42,10 @@ from .section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue, S
 
 __all__ = ["tangent", "variational", "Variational", "TangentResult", "TangentSettings", "TangentFailure"]
 
-#: a segment whose integration fails on an unbounded Jacobian at its end (damping B's impact law,
-#: c = beta k_lambda abs(psi_i), as psi_i -> 0 at separation: the step size fell to 7e-15 s short
-#: of it) is integrated to END_GAP (s) before its end and the Jacobian frozen over the rest: an
-#: integrable singularity's share of Phi over it vanishes with END_GAP (the engine locates the
-#: switch itself to ~1e-12 s); checked against finite differences in tests/test_tangent.py
+#: a segment whose integration fails on an unbounded Jacobian at its end (damping B's impact law
+#: as psi_i -> 0 at separation) is integrated to END_GAP (s) before its end and the Jacobian
+#: frozen over the rest: an integrable singularity's share of Phi over it vanishes with END_GAP
+#: (docs/design-notes.md, *The tangent integration's end gap*; tests/test_tangent.py)
 END_GAP = 1e-9
 #: ... unless Phi changes by more than this (relative) when the gap shrinks 100-fold: damping C's
 #: abs(psi_i)^(1/4) law, whose singular share of Phi is ~gap^(1/4), is refused (the tests' bound

@@ -4,9 +4,8 @@ The generated kernels see time only through the cam motion and are periodic in t
 P = 2 T (T the cam's period; the half-angle forms carry Omega t / 2, whose sines change sign
 over one T, in products that do not).  At large t the rounding of t itself perturbs every
 stage time by ~1e-16 t, which the stiff contact turns into state errors above a tight
-tolerance: the step size collapses and the cost grows with t (measured while writing
-tests/test_chaos.py: the same 300 revolutions at rtol 1e-11 took 8.2e3 steps from t = 0 and
-7.0e6 from t = 20000 T).  Here a run longer than PIECE_PERIODS * P is integrated in pieces of
+tolerance: the step size collapses and the cost grows with t (docs/design-notes.md, *Long
+runs in pieces*).  Here a run longer than PIECE_PERIODS * P is integrated in pieces of
 that length, each in a local time tau = phase + (t - piece start), with phase = t0 mod P, so
 tau stays below about PIECE_PERIODS * P and the cam phase, hence the motion, is the same.
 Each piece starts in the regime the previous one ended in; the samples, switches and (with

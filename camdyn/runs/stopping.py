@@ -45,11 +45,8 @@ class StopWhenPeriodic:
 
     Why a multiple of the solver's tolerance, and why 10: a converged run's section still
     scatters from revolution to revolution, and two runs with other steps differ, at the level
-    of the solver's error (measured on ``example_rig(l_lambda=0.016)``, damping D, Coulomb, rtol
-    1e-7, atol 1e-11: up to 7e-9 rad = 1.2 rtol abs(alpha) when impacting, up to 3.4e-12 rad = 0.34
-    atol in permanent contact, where alpha at the section is 1e-8 rad and atol dominates); below
-    that scatter the check would never hold, and a size of the motion alone cannot say where
-    that is (relative to abs(alpha) at the section, the permanent-contact scatter is 1e-4).  A
+    of the solver's error (docs/design-notes.md, *The stop threshold's factor 10*); below that
+    scatter the check would never hold, and a size of the motion alone cannot say where it is.  A
     stopped run's section values differ from the full run's by at most about
     ``tol (rtol abs(alpha) + atol) / (1 - abs(mu))`` (mu the orbit's largest Floquet multiplier per period:
     the transient still left) plus the full run's own scatter.  ``revolutions`` >= 2

@@ -163,6 +163,32 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
     return c0, c1, UNUSABLE
 
 
+@jitable
+def _crossed(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, on_surface, work):
+    """The first transition whose surface the step [t, t_new] crosses, and when: (w, t_cross); w
+    NONFINITE for a non-finite value, -1 for none (t_cross = t_new).  A step that starts on a
+    surface (``on_surface``) and leaves it at once is a crossing at its start."""
+    w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
+    if w == NONFINITE or w >= 0:
+        return w, t_cross
+    if on_surface:
+        w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
+        return w, (t if w >= 0 else t_new)
+    return w, t_new
+
+
+@jitable
+def _crossing_state(prob, method, m, w, t, t_new, y0, y1, n0, n1, h, Q, t_cross, K, may_retry):
+    """The state at transition w's crossing at t_cross in the step [t, t_new] (the step's end or
+    start as they are, else :func:`_restart_state`): (c0, c1, verdict, RHS evaluations)."""
+    if t_cross == t_new:
+        return n0, n1, ACROSS, 0
+    if t_cross == t:
+        return y0, y1, ACROSS, 0
+    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry)
+    return c0, c1, verdict, method.n_stages
+
+
 @allocating
 def _buffers(method, tab):
     """The loop's work arrays: the stages K, the interpolant Q, first_crossing's work, the
@@ -226,15 +252,10 @@ def run(prob, method, cfg, start, samples):
                 if not (screen and clear_of_surfaces(prob, m, t, t_new, n0, n1, K[n, 1], cfg, have_start, work)):
                     if not interpolant:
                         nfev += dense_coefficients(rhs, p, m, t, y0, y1, h, method, K, Q)
-                    w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
+                    w, t_cross = _crossed(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, on_surface, work)
                     if w == NONFINITE:
                         outcome = NONFINITE_STATE
                         break
-                    if w < 0:
-                        t_cross = t_new
-                        if on_surface:
-                            w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
-                            t_cross = t if w >= 0 else t_new
                 have_start = True
             if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
                 i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)
@@ -242,19 +263,14 @@ def run(prob, method, cfg, start, samples):
                 _account(prob, m, t, h, y0, y1, Q, t_cross, buf, ledger_work)
             h_last = h
             if w >= 0:
-                if t_cross == t_new:
-                    c0, c1 = n0, n1
-                elif t_cross == t:
-                    c0, c1 = y0, y1
-                else:
-                    c0, c1, verdict = _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K,
+                c0, c1, verdict, f = _crossing_state(prob, method, m, w, t, t_new, y0, y1, n0, n1, h, Q, t_cross, K,
                                                      retries < cfg.crossing_retries)
-                    nfev += n
-                    if verdict == NOT_YET:  # on in this mode from there
-                        t, y0, y1, h_abs = t_cross, c0, c1, h
-                        K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
-                        have_start, retries = False, retries + 1
-                        continue
+                nfev += f
+                if verdict == NOT_YET:  # on in this mode from there
+                    t, y0, y1, h_abs = t_cross, c0, c1, h
+                    K[0, 0], K[0, 1] = K[n, 0], K[n, 1]
+                    have_start, retries = False, retries + 1
+                    continue
                 retries = 0
                 m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
                 capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1

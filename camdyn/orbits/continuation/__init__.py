@@ -76,8 +76,7 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
+from ..._checks import finite, integer, real
 from ...engine.config import SolverOptions
 from ...errors import ParameterError
 from ...model.rig import PARAMETERS, Rig
@@ -110,9 +109,8 @@ def _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction
     names = [p.name for p in PARAMETERS]
     if parameter != SPEED and parameter not in names:
         raise ParameterError("parameter", parameter, f"'{SPEED}' or a rig parameter ({', '.join(names)})")
-    for name, v in (("start", start), ("end", end)):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not math.isfinite(v):
-            raise ParameterError(name, v, "a finite real number")
+    finite("start", start)
+    finite("end", end)
     if start == end:
         raise ParameterError("end", end, f"a value other than start ({start})")
     if parameter == SPEED:
@@ -120,14 +118,11 @@ def _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction
             raise ParameterError("speed_rpm", speed_rpm, "None when the speed itself is continued")
         if not start * end > 0:
             raise ParameterError("end", end, "a speed of the same sign as start, and neither zero (rev/min)")
-    elif isinstance(speed_rpm, bool) or not isinstance(speed_rpm, (int, float)) or not speed_rpm != 0 \
-            or not math.isfinite(speed_rpm):
-        raise ParameterError("speed_rpm", speed_rpm, f"a nonzero cam speed (rev/min) to continue {parameter} at")
-    if isinstance(periods, bool) or not isinstance(periods, int) or not 1 <= periods <= 50:
-        raise ParameterError("periods", periods, "an integer, 1 <= periods <= 50")
-    if isinstance(phase_fraction, bool) or not isinstance(phase_fraction, (int, float)) \
-            or not 0 <= phase_fraction < 1:
-        raise ParameterError("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)")
+    else:
+        real("speed_rpm", speed_rpm, f"a nonzero cam speed (rev/min) to continue {parameter} at",
+             lambda v: v != 0 and math.isfinite(v))
+    integer("periods", periods, "an integer, 1 <= periods <= 50", lambda n: 1 <= n <= 50)
+    real("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)", lambda v: 0 <= v < 1)
     if not isinstance(settings, ContinuationSettings):
         raise ParameterError("settings", settings, "a camdyn.orbits.continuation.ContinuationSettings")
 

@@ -10,6 +10,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..._checks import integer, real
 from ...engine.config import SolverOptions
 from ...errors import ParameterError
 from ...model.cam import ConstantSpeed
@@ -68,16 +69,14 @@ class ContinuationSettings:
 
     def __post_init__(self):
         for name in ("step", "min_step", "max_step", "locate_tol"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= 1:
-                raise ParameterError(name, v, "0 < value <= 1 (scaled arclength: the parameter range is 1)")
+            real(name, getattr(self, name), "0 < value <= 1 (scaled arclength: the parameter range is 1)",
+                 lambda v: 0 < v <= 1)
         if not self.min_step <= self.step <= self.max_step:
             raise ParameterError("step", self.step, f"min_step ({self.min_step}) <= step <= max_step ({self.max_step})")
         ShootingSettings(self.tol, self.max_corrector)          # checks tol and max_corrector
         for name, lo in (("max_points", 2), ("easy_iterations", 1), ("switch_depth", 0)):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= 100_000:
-                raise ParameterError(name, v, f"an integer, {lo} <= {name} <= 100000")
+            integer(name, getattr(self, name), f"an integer, {lo} <= {name} <= 100000",
+                    lambda n, lo=lo: lo <= n <= 100_000)
 
 
 @dataclass(frozen=True)

@@ -54,8 +54,8 @@ with its test function and locator in one table, :data:`.events.KINDS`):
   crawls in from the flat side; but on the contact side (gap < 0) it is smooth, the contact
   orbit continuing through the event: the trials aim at the root of the secant through the
   two latest contact-side trials, short of it while it still moves and then just past it, so
-  that the bracket closes from both sides (:func:`.events.grazing_location`: 7 trials where bisection
-  took 14 on the leg up from 0.8 x the contact-loss speed of ``benchmarks/sweep_stop.py``).
+  that the bracket closes from both sides (:func:`.events.grazing_location`; its trials against
+  bisection's are measured in docs/continuation.md).
   A trial needs the gap alone: its orbit is corrected without derivatives (6 runs less each),
   which only the two bracketing points get.
 

@@ -152,7 +152,7 @@ def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
     corner at the event (the contact's deflection before it, the flight's height after), so
     secant trials across the bracket crawl in from the flat side, while on the contact side
     (gap < 0) it is smooth, the contact orbit continuing through the event.  A trial needs the
-    gap alone: it is a corrected orbit without derivatives (2 n + 2 runs less by finite
+    gap alone: it is a corrected orbit without derivatives (6 runs less by finite
     differences); the two points returned get theirs (after: None when a run fails there, as
     for a failed step; before: p then, the bracket's start, the location lost for that rare case)."""
     tol = leg.settings.locate_tol

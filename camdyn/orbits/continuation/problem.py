@@ -124,7 +124,7 @@ class Leg:
     The unknowns are z = (x / s, lambda / span) (:data:`Z_STATE`, :data:`Z_LAMBDA`): built by
     :meth:`z`, split by :meth:`split`, a direction along lambda alone by :meth:`along`."""
 
-    problem: object          # a Problem, or what a test gives in its place (its span, section_map, ...)
+    problem: Problem         # (or anything with its span, parameter, options, section_map and jacobian)
     periods: int
     scale: np.ndarray
     settings: ContinuationSettings

@@ -203,13 +203,13 @@ def test_any_jacobian_provider_plugs_in(pd_branch):
 @pytest.fixture(scope="module")
 def impacting_start():
     """A first point whose finite differences resolve at their first pair of steps (the example
-    rig at 1650 rev/min, one impact per revolution), its problem and scale."""
-    from camdyn.orbits import continuation as C
-    problem = C.Problem(RIG, SCENE, "speed_rpm", 1650.0, 1700.0)
-    first, scale = C._start(problem, 20, ContinuationSettings())
-    assert first is not None, scale
+    rig at 1650 rev/min, one impact per revolution), and its leg (problem, period, scale, settings)."""
+    from camdyn.orbits.continuation import Problem, follow
+    started = follow.start(Problem(RIG, SCENE, "speed_rpm", 1650.0, 1700.0), 20, ContinuationSettings())
+    assert not isinstance(started, str), started
+    first, leg = started
     assert first.derivation.provider == "finite_differences" and first.resolved
-    return problem, first, scale
+    return leg, first
 
 
 def _counting(monkeypatch):
@@ -220,36 +220,37 @@ def _counting(monkeypatch):
     return runs
 
 
-def _first_pair(problem, p, scale) -> bool:
+def _first_pair(leg, p) -> bool:
     """Whether each of p's three differences (alpha, alpha_dot, lambda) was taken at its second
     step, the first pair that can agree: 2 x 2 runs each."""
-    first = np.append(finite_difference_steps(p.x, scale, problem.options.rtol),
+    problem = leg.problem
+    first = np.append(finite_difference_steps(p.x, leg.scale, problem.options.rtol),
                       problem.options.rtol ** (1 / 3) * max(abs(p.lam), problem.span))
     return np.allclose(p.derivation.steps, first / SHRINK, rtol=1e-12)
 
 
 def test_a_converged_point_runs_its_orbit_once(impacting_start, monkeypatch):
     """A step's orbit is run once: the corrector's last run gives the point's largest gap and
-    the map's value to the provider, which does not run it again (camdyn.orbits.continuation._orbit_run).
+    the map's value to the provider, which does not run it again (camdyn.orbits.continuation.corrector.orbit_run).
     So a step that converges in k chord iterations costs k + 1 runs, and its derivatives 12 where
     each of the 3 differences (2 columns, lambda) resolves at its first pair of steps (h and
     h / 4, 2 runs each: camdyn.orbits.derivatives); the first point 1 + 12."""
-    from camdyn.orbits import continuation as C
-    problem, first, scale = impacting_start
+    from camdyn.orbits.continuation import corrector as C
+    leg, first = impacting_start
     evaluations = []
-    real_evaluate = C._evaluate
-    monkeypatch.setattr(C, "_evaluate", lambda *a: evaluations.append(1) or real_evaluate(*a))
+    real_evaluate = C.evaluate
+    monkeypatch.setattr(C, "evaluate", lambda *a: evaluations.append(1) or real_evaluate(*a))
     runs = _counting(monkeypatch)
-    q = C._step(problem, first, 1e-3, 1, scale, ContinuationSettings())
+    q = C.step(leg, first, 1e-3)
     assert q is not None and len(evaluations) == 1          # a chord step, derivatives at the point only
-    assert q.derivation.provider == "finite_differences" and q.resolved and _first_pair(problem, q, scale)
+    assert q.derivation.provider == "finite_differences" and q.resolved and _first_pair(leg, q)
     assert len(runs) == q.iterations + 1 + 12
     # the gap comes from the corrector's run: the same as a run of its own (the samples' end is P_n(x))
-    again = C._orbit_run(problem, q.lam, q.x, first.mode, 1)
-    assert C._gap(again)[0] == q.max_gap and np.array_equal(C._gap(again)[1], q.alpha_revolutions)
+    again = C.orbit_run(leg, q.lam, q.x, first.mode)
+    assert C.gap(again)[0] == q.max_gap and np.array_equal(C.gap(again)[1], q.alpha_revolutions)
     del runs[:]
-    p = C._first_point(problem, first.lam, first.x, first.mode, 1, scale, 1.0)
-    assert _first_pair(problem, p, scale) and len(runs) == 1 + 12
+    p = C.first_point(leg, first.lam, first.x, first.mode, 1.0)
+    assert _first_pair(leg, p) and len(runs) == 1 + 12
 
 
 def test_a_rig_parameter_is_continued_at_a_fixed_speed():
@@ -327,6 +328,36 @@ def test_bad_settings_name_the_setting(kwargs, name):
     assert exc.value.name == name
 
 
+def test_the_unknowns_are_laid_out_in_one_place():
+    """z = (x / scale, lambda / span): Leg.z builds it in the order of camdyn.vocabulary.STATE with
+    lambda last, Leg.split inverts it (to the two roundings of a division and a product: 2 ulp),
+    and Leg.along points along lambda alone."""
+    from camdyn.orbits.continuation.problem import Z_LAMBDA, Z_SIZE, Leg, Problem
+    problem = Problem(RIG, SCENE, "speed_rpm", 1650.0, 1850.0)
+    leg = Leg(problem, 1, np.array([0.02, 30.0]), ContinuationSettings())
+    x = np.array([0.013, -7.5])
+    z = leg.z(1700.0, x)
+    assert z.shape == (Z_SIZE,) == (len(camdyn.vocabulary.STATE) + 1,)
+    assert z[camdyn.vocabulary.STATE_ALPHA] == 0.013 / 0.02 and z[Z_LAMBDA] == 1700.0 / 200.0
+    lam, back = leg.split(z)
+    assert lam == pytest.approx(1700.0, rel=4.5e-16) and back == pytest.approx(x, rel=4.5e-16)
+    assert np.array_equal(leg.along(-1.0), np.eye(Z_SIZE)[Z_LAMBDA] * -1.0)
+    assert leg.doubled().periods == 2 and leg.doubled().scale is leg.scale
+
+
+def test_the_event_table_names_every_kind_once():
+    """Every kind of the table (camdyn.orbits.continuation.events.KINDS) with a test function has a
+    locator; ``unless`` names a kind that has a test function; only the period doubling switches
+    branches; EVENTS (the Dataset's event_kinds) is the table's order."""
+    from camdyn.orbits.continuation import events as E
+    assert EVENTS == tuple(k.name for k in E.KINDS) and len(set(EVENTS)) == len(EVENTS)
+    names = {k.name for k in E.DETECTED}
+    assert all(k.locate is not None for k in E.DETECTED)
+    assert all(k.unless in names for k in E.KINDS if k.unless is not None)
+    assert [k.name for k in E.KINDS if k.switch_branch] == ["period_doubling"]
+    assert [k.name for k in E.KINDS if k.test is None] == ["multiplier_jump"]
+
+
 @pytest.mark.parametrize("f_lo, f_hi, expected", [
     (-1.0, 3.0, 0.325),                 # the secant root: 0.2 + 0.5 / 4
     (-1e-12, 2e-8, 0.2005),             # the root at lo + 2.5e-5: kept tol / 2 inside
@@ -334,11 +365,11 @@ def test_bad_settings_name_the_setting(kwargs, name):
     (-2.0, float("nan"), 0.45),         # hi has no value (a failed step): the midpoint
     (1.0, 1.0, 0.45)])                  # no slope: the midpoint
 def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f_hi, expected):
-    """The secant trial of the event location (camdyn.orbits.continuation._trial) stays tol/2 inside
+    """The secant trial of the event location (camdyn.orbits.continuation.events.trial) stays tol/2 inside
     [lo, hi] = [0.2, 0.7] (tol = 1e-3), so every trial shrinks the bracket by at least that and
     the location ends; the midpoint when an end has no value."""
-    from camdyn.orbits.continuation import _trial
-    assert _trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)
+    from camdyn.orbits.continuation.events import trial
+    assert trial(0.2, 0.7, f_lo, f_hi, 1e-3) == pytest.approx(expected, rel=1e-12)
 
 
 @pytest.mark.parametrize("lo, hi, contact, far, expected", [
@@ -353,11 +384,11 @@ def test_each_location_trial_is_inside_the_bracket_by_half_the_tolerance(f_lo, f
     (0.2, 0.7, [(0.7, -1.0), (0.5, -0.5)], -1.0, 0.3 - 2.5e-4),          # contact side at hi: past root 0.3 toward lo
 ])
 def test_each_grazing_trial_aims_from_the_contact_side(lo, hi, contact, far, expected):
-    """camdyn.orbits.continuation._grazing_trial (tol = 1e-3): past the contact-side secant's root by
+    """camdyn.orbits.continuation.events.grazing_trial (tol = 1e-3): past the contact-side secant's root by
     tol / 4 (GRAZING_PAST), short of it by its change while that exceeds tol / 4, never nearer
     the far end than 0.75 tol nor the contact end than tol / 4; the midpoint otherwise."""
-    from camdyn.orbits.continuation import _grazing_trial
-    assert _grazing_trial(lo, hi, contact, far, 1e-3) == pytest.approx(expected, rel=1e-12)
+    from camdyn.orbits.continuation.events import grazing_trial
+    assert grazing_trial(lo, hi, contact, far, 1e-3) == pytest.approx(expected, rel=1e-12)
 
 
 @pytest.fixture(scope="module")
@@ -365,13 +396,13 @@ def grazing_step():
     """Two orbits of the benchmark rig's contact branch (line contact 16 mm, section at T/2) on
     either side of its grazing at 0.999998 x the contact-loss speed L: p at 0.995 L in permanent
     contact, q 0.6 of the range 0.995-1.005 L on, at 1.001 L, in flight."""
-    from camdyn.orbits import continuation as C
+    from camdyn.orbits.continuation import Problem, corrector, follow
     loss = camdyn.contact_loss_speed(RIG.replace(l_lambda=0.016))
-    problem = C.Problem(RIG.replace(l_lambda=0.016), SCENE, "speed_rpm", 0.995 * loss, 1.005 * loss, phase_fraction=0.5)
-    p, scale = C._start(problem, 20, ContinuationSettings())
-    q = C._step(problem, p, 0.6, 1, scale, ContinuationSettings())
+    problem = Problem(RIG.replace(l_lambda=0.016), SCENE, "speed_rpm", 0.995 * loss, 1.005 * loss, phase_fraction=0.5)
+    p, leg = follow.start(problem, 20, ContinuationSettings())
+    q = corrector.step(leg, p, 0.6)
     assert p.max_gap < 0 < q.max_gap
-    return problem, p, q, scale
+    return leg, p, q
 
 
 def test_grazing_is_located_where_bisection_locates_it_in_fewer_trials(grazing_step, monkeypatch):
@@ -379,17 +410,17 @@ def test_grazing_is_located_where_bisection_locates_it_in_fewer_trials(grazing_s
     trial), between the same two orbits: both brackets hold the grazing within locate_tol of
     arclength, so their points agree to twice that; measured 8 trials against 20, and the
     located orbits 1.0e-7 of the range apart."""
-    from camdyn.orbits import continuation as C
-    problem, p, q, scale = grazing_step
-    settings = ContinuationSettings()
+    from camdyn.orbits.continuation import events as C
+    leg, p, q = grazing_step
+    problem, settings = leg.problem, leg.settings
     trials = []
-    corrected = C._corrected
-    monkeypatch.setattr(C, "_corrected", lambda *a: trials.append(a[2]) or corrected(*a))
-    located = C._locate(problem, p, q, 0.6, "grazing", 1, scale, settings)
+    corrected = C.corrected
+    monkeypatch.setattr(C, "corrected", lambda *a: trials.append(a[2]) or corrected(*a))
+    located = C.locate(leg, C.KIND["grazing"], p, q, 0.6)
     secant = len(trials)
-    monkeypatch.setattr(C, "_grazing_trial", lambda lo, hi, *_: 0.5 * (lo + hi))
+    monkeypatch.setattr(C, "grazing_trial", lambda lo, hi, *_: 0.5 * (lo + hi))
     del trials[:]
-    bisected = C._locate(problem, p, q, 0.6, "grazing", 1, scale, settings)
+    bisected = C.locate(leg, C.KIND["grazing"], p, q, 0.6)
     assert len(trials) == 20                   # log2(0.6 / locate_tol) = 19.2: the bracket halved 20 times
     assert secant <= len(trials) // 2
     tol = settings.locate_tol * problem.span   # in lambda: |d lambda / ds| <= the range (the tangent is a unit vector)
@@ -441,16 +472,17 @@ class _AnalyticProblem:
 
 def _continued(f, start, end, monkeypatch):
     """Follow the fixed point x = 0 of f from start to end: the branch and its events."""
-    from camdyn.orbits import continuation as C
+    from camdyn.orbits.continuation import Branch, corrector, follow
+    from camdyn.orbits.continuation.problem import Leg
 
-    def run(problem, lam, x, mode, periods):          # P_n(x) alone: no engine run to sample
-        return C._Run(None, problem.section_map(lam, mode).evaluate(x), None, np.zeros(0))
-    monkeypatch.setattr(C, "_orbit_run", run)
-    monkeypatch.setattr(C, "_gap", lambda run: (-1.0, np.zeros(1), 0))
-    problem, scale, settings = _AnalyticProblem(f, start, end), np.ones(2), ContinuationSettings()
-    first = C._first_point(problem, start, np.zeros(2), 0, 1, scale, 1.0)
-    branch, events = C.Branch(1), []
-    C._follow(problem, branch, 0, first, scale, settings, events)
+    def run(leg, lam, x, mode):          # P_n(x) alone: no engine run to sample
+        return corrector.Run(None, leg.section_map(lam, mode).evaluate(x), None, np.zeros(0))
+    monkeypatch.setattr(corrector, "orbit_run", run)
+    monkeypatch.setattr(corrector, "gap", lambda run: (-1.0, np.zeros(1), 0))
+    leg = Leg(_AnalyticProblem(f, start, end), 1, np.ones(2), ContinuationSettings())
+    first = corrector.first_point(leg, start, np.zeros(2), 0, 1.0)
+    branch, events = Branch(1), []
+    follow.follow(leg, branch, 0, first, events)
     return branch, [e[0] for e in events]
 
 

@@ -1,0 +1,284 @@
+"""The events along a branch, in one table (:data:`KINDS`): each kind's test function, whose
+sign change between two points marks it, the distance of the multipliers from its critical
+value, and how it is located in arclength (the secant trials with the Illinois rule, or the
+grazing trials from the contact side); their detection between two points and location."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from ..shooting import sorted_multipliers
+from .corrector import completed, corrected, gap, step
+from .problem import N_STATE, Z_LAMBDA, Event, Leg, Point
+
+#: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value,
+#: and the multipliers on both sides of the bracket differ by less: a bracket of locate_tol puts
+#: them within ~``|d mu / ds| locate_tol`` (~1e-5) of each other, unless they jump
+CRITICAL = 1e-2
+#: an event's location stops after this many trials (each shrinks the bracket)
+MAX_BISECTIONS = 40
+#: a grazing's trial aims this fraction of locate_tol past the root extrapolated from the contact
+#: side, and no nearer the far end of the bracket than the rest of locate_tol: with the root known
+#: to within this fraction of locate_tol (the secant's error shrinks superlinearly on the smooth
+#: contact side), one trial lands past the event and the next, a locate_tol from it, before it:
+#: the bracket closes from both sides in two trials (:func:`grazing_trial`)
+GRAZING_PAST = 0.25
+
+
+class Kind(NamedTuple):
+    """An event kind: its name; its test function at a point (None: a kind only named after a
+    location, ``multiplier_jump``); the distance of each multiplier from the kind's critical
+    value (None: not an event of the multipliers, always smooth); its locator, ``(leg, kind, p,
+    q, ds) -> (before, after)``; and the kind whose sign change at the same step masks it
+    (``unless``: the +1 multiplier of a fold is no branch point); ``switch_branch``: whether the
+    branch of period 2 n T is switched to there (:mod:`.switching`)."""
+
+    name: str
+    test: Callable[[Point], float] | None
+    distance: Callable[[np.ndarray], np.ndarray] | None
+    locate: Callable | None
+    unless: str | None = None
+    switch_branch: bool = False
+
+
+class Found(NamedTuple):
+    """A located event, the orbit it is at, and the points p and q of the step it lies in."""
+
+    event: Event
+    at: Point
+    p: Point
+    q: Point
+
+
+# --- the test functions (a 2 x 2 monodromy M: det(M -+ I) = det M -+ tr M + 1) ----------------------
+def _det_trace(p: Point) -> tuple[float, float]:
+    M = p.jacobian
+    return float(np.linalg.det(M)), float(np.trace(M))
+
+
+def _fold(p: Point) -> float:
+    """The lambda-component of the tangent: it changes sign where the branch turns back."""
+    return float(p.tangent[Z_LAMBDA])
+
+
+def _branch_point(p: Point) -> float:
+    det, tr = _det_trace(p)
+    return det - tr + 1.0
+
+
+def _period_doubling(p: Point) -> float:
+    det, tr = _det_trace(p)
+    return det + tr + 1.0
+
+
+def _neimark_sacker(p: Point) -> float:
+    """det M - 1 (``|mu|^2 = det M``) where the multipliers are a complex pair; NaN elsewhere."""
+    det, tr = _det_trace(p)
+    return det - 1.0 if tr * tr - 4.0 * det < 0 else math.nan
+
+
+def _grazing(p: Point) -> float:
+    return p.max_gap
+
+
+def tests(p: Point) -> dict[str, float]:
+    """The test functions at a point, by kind.  Where the point's derivatives are unresolved they
+    come from the differences across the first step (:mod:`camdyn.orbits.derivatives`): a sign
+    change next to such a point is located but named a ``multiplier_jump``, never a bifurcation
+    (:func:`smooth`)."""
+    return {kind.name: kind.test(p) for kind in DETECTED}
+
+
+def _changed(a: float, b: float) -> bool:
+    return math.isfinite(a) and math.isfinite(b) and a * b < 0
+
+
+# --- location ----------------------------------------------------------------------------------------
+@dataclass
+class Bracket:
+    """An event's bracket [lo, hi] in arclength from p: the test function's values at its ends
+    (their signs: p's at lo), the orbits there (after: None while hi is q's step or a failed
+    one), and ``kept``: how many trials in a row kept hi (> 0) or lo (< 0), for the Illinois rule."""
+
+    lo: float
+    hi: float
+    f_lo: float
+    f_hi: float
+    before: object
+    after: object = None
+    kept: int = 0
+
+    def narrow(self, s: float, f: float, orbit) -> None:
+        """Move the end on the side of the trial at s (f there; NaN, a failed step: past the
+        event, the map is not smooth beyond a grazing) to it, halving the value kept at the
+        other end when it was kept before (the Illinois rule)."""
+        if math.isfinite(f) and math.copysign(1.0, f) == math.copysign(1.0, self.f_lo):
+            self.lo, self.f_lo, self.before = s, f, orbit
+            self.f_hi, self.kept = (self.f_hi / 2.0, self.kept + 1) if self.kept > 0 else (self.f_hi, 1)
+        else:
+            self.hi, self.f_hi, self.after = s, f, orbit
+            self.f_lo, self.kept = (self.f_lo / 2.0, self.kept - 1) if self.kept < 0 else (self.f_lo, -1)
+
+
+def locate(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
+    """The sign change of ``kind``'s test function between p and q (``ds`` apart in arclength),
+    bracketed in arclength from p to ``locate_tol`` by the kind's locator: the points on both
+    sides of the event (after: None when the far end is a failure)."""
+    return kind.locate(leg, kind, p, q, ds)
+
+
+def secant_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
+    """The location of a smooth test function f: the next trial is the secant root of the
+    bracket, with the Illinois rule (the value kept at an end twice in a row is halved, so that
+    both ends close in: superlinear for a smooth f) and kept ``locate_tol`` / 2 inside it; the
+    midpoint where an end has no value."""
+    tol = leg.settings.locate_tol
+    bracket = Bracket(0.0, ds, kind.test(p), kind.test(q), p)
+    for _ in range(MAX_BISECTIONS):
+        if bracket.hi - bracket.lo <= tol:
+            break
+        s = trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, tol)
+        r = step(leg, p, s)
+        bracket.narrow(s, math.nan if r is None else kind.test(r), r)
+    return bracket.before, bracket.after
+
+
+def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
+    """The grazing between p and q bracketed as :func:`secant_location` does, the trials aimed
+    from the contact side (:func:`grazing_trial`): its test function, the largest gap, has a
+    corner at the event (the contact's deflection before it, the flight's height after), so
+    secant trials across the bracket crawl in from the flat side, while on the contact side
+    (gap < 0) it is smooth, the contact orbit continuing through the event.  A trial needs the
+    gap alone: it is a corrected orbit without derivatives (6 runs less by finite
+    differences); the two points returned get theirs (after: None when a run fails there, as
+    for a failed step; before: p then, the bracket's start, the location lost for that rare case)."""
+    tol = leg.settings.locate_tol
+    bracket = Bracket(0.0, ds, kind.test(p), kind.test(q), p)
+    contact = [(0.0, p.max_gap) if p.max_gap < 0 else (ds, q.max_gap)]
+    far = 1.0 if p.max_gap < 0 else -1.0
+    for _ in range(MAX_BISECTIONS):
+        if bracket.hi - bracket.lo <= tol:
+            break
+        s = grazing_trial(bracket.lo, bracket.hi, contact[-3:], far, tol)
+        r = corrected(leg, p, s)
+        f = math.nan if r is None else gap(r.run)[0]
+        if f < 0:
+            contact.append((s, f))
+        bracket.narrow(s, f, r)
+    before = bracket.before if bracket.before is p else completed(leg, p, bracket.before)
+    after = None if bracket.after is None else completed(leg, p, bracket.after)
+    return before or p, after
+
+
+def grazing_trial(lo: float, hi: float, contact: list, far: float, tol: float) -> float:
+    """The next trial of a grazing's location in [lo, hi], from the latest contact-side points
+    ``contact`` (arclength, largest gap < 0; ``far``: +1 when the far side is hi, -1 when lo).
+
+    The root of the secant through the last two is the estimate; its change from the estimate
+    of the two before bounds its error (the secant's error shrinks superlinearly).  The trial
+    is that much short of it, to land on the contact side and improve it (halfway to it when
+    that is past the contact end), and once it has settled (a change below GRAZING_PAST tol)
+    GRAZING_PAST tol past it, to land on the far side.  It stays GRAZING_PAST tol from the
+    contact end and (1 - GRAZING_PAST) tol from the far end, so that every trial shrinks the
+    bracket by as much and one landing on the contact side next to the far end closes it.  The
+    midpoint with one contact-side point, or an estimate outside (lo, hi)."""
+    root = _secant_root(contact[-2:])
+    if not lo < root < hi:
+        return 0.5 * (lo + hi)
+    change = abs(root - _secant_root(contact[-3:-1])) if len(contact) > 2 else 0.0
+    short = change if change > GRAZING_PAST * tol else 0.0      # NaN (a flat secant before): not short
+    near = lo if far > 0 else hi                                # the contact end
+    u = (root - near) * far                                     # the estimate's distance from it
+    aim = u + GRAZING_PAST * tol - short
+    aim = aim if aim > 0 else 0.5 * u
+    return near + far * min(max(aim, GRAZING_PAST * tol), hi - lo - (1.0 - GRAZING_PAST) * tol)
+
+
+def _secant_root(points: list) -> float:
+    """The root of the line through two points (s, f); NaN with fewer, or a flat line."""
+    if len(points) < 2 or points[0][1] == points[1][1]:
+        return math.nan
+    (s0, f0), (s1, f1) = points
+    return s1 - f1 * (s1 - s0) / (f1 - f0)
+
+
+def trial(lo: float, hi: float, f_lo: float, f_hi: float, tol: float) -> float:
+    """The secant root of f over [lo, hi] (the midpoint when an end has no finite value), kept
+    tol / 2 inside the bracket so that each trial shrinks it by at least that."""
+    if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or f_lo == f_hi:
+        return 0.5 * (lo + hi)
+    s = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+    return min(max(s, lo + 0.5 * tol), hi - 0.5 * tol)
+
+
+# --- detection ---------------------------------------------------------------------------------------
+def detect(leg: Leg, p: Point, q: Point, ds: float, where: tuple[int, int]) -> list[Found]:
+    """The events between consecutive points p and q (ds apart), located; ``where``: (branch, index of p)."""
+    f0, f1 = tests(p), tests(q)
+    found = []
+    for kind in DETECTED:
+        if not _changed(f0[kind.name], f1[kind.name]):
+            continue
+        if kind.unless is not None and _changed(f0[kind.unless], f1[kind.unless]):
+            continue
+        before, after = locate(leg, kind, p, q, ds)
+        e = after or before
+        mu = sorted_multipliers(e.jacobian) if e.resolved else np.full(N_STATE, np.nan, dtype=complex)
+        named = kind.name if smooth(kind, before, after) else MULTIPLIER_JUMP.name
+        event = Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap)
+        found.append(Found(event, e, p, q))
+    return found
+
+
+def smooth(kind: Kind, before: Point, after: Point | None) -> bool:
+    """Whether an event of the multipliers is a bifurcation: at the located orbit the kind's
+    critical multiplier (+1, -1, modulus 1) is within CRITICAL, and the multipliers on both
+    sides of the bracket (``locate_tol`` apart) differ by less than CRITICAL (they do not jump).
+    A kind not of the multipliers (grazing) is always one."""
+    if kind.distance is None:
+        return True
+    e = after or before
+    if not (e.resolved and before.resolved):
+        return False                        # the switches change within a difference step: not smooth
+    mu = sorted_multipliers(e.jacobian)
+    jump = 0.0 if after is None else float(np.max(np.abs(mu - sorted_multipliers(before.jacobian))))
+    return float(np.min(kind.distance(mu))) < CRITICAL and jump < CRITICAL
+
+
+def _from_one(mu: np.ndarray) -> np.ndarray:
+    return np.abs(mu - 1.0)
+
+
+def _from_minus_one(mu: np.ndarray) -> np.ndarray:
+    return np.abs(mu + 1.0)
+
+
+def _from_unit_circle(mu: np.ndarray) -> np.ndarray:
+    return np.abs(np.abs(mu) - 1.0)
+
+
+#: the event table, in the order the test functions are evaluated: ``fold`` (a multiplier
+#: through +1, the branch turning back), ``branch_point`` (through +1 while the branch does not
+#: turn: a crossing of branches), ``period_doubling`` (a real multiplier through -1),
+#: ``neimark_sacker`` (a complex pair through the unit circle), ``grazing`` (the orbit's largest
+#: gap through 0); ``multiplier_jump``: a test function of the multipliers changed sign but the
+#: located orbit's multipliers are not critical or jump across the bracket (the map is not smooth
+#: there, e.g. where the orbit meets a new switching surface)
+KINDS = (
+    Kind("fold", _fold, _from_one, secant_location),
+    Kind("branch_point", _branch_point, _from_one, secant_location, unless="fold"),
+    Kind("period_doubling", _period_doubling, _from_minus_one, secant_location, switch_branch=True),
+    Kind("neimark_sacker", _neimark_sacker, _from_unit_circle, secant_location),
+    Kind("grazing", _grazing, None, grazing_location),
+    Kind("multiplier_jump", None, None, None),
+)
+#: the event kinds' names, in the table's order (:data:`camdyn.orbits.continuation.EVENTS`)
+EVENTS = tuple(kind.name for kind in KINDS)
+#: the kinds by name
+KIND = {kind.name: kind for kind in KINDS}
+#: the kinds that have a test function, in the table's order
+DETECTED = tuple(kind for kind in KINDS if kind.test is not None)
+MULTIPLIER_JUMP = KIND["multiplier_jump"]

@@ -167,7 +167,7 @@ def _residual(F: np.ndarray, scale: np.ndarray) -> float:
 def newton_matrix(J: np.ndarray, scale: np.ndarray) -> np.ndarray:
     """dP/dx - I in the variables scaled by the motion's size (x_j / scale_j): the Jacobian of
     the scaled residual (P(x) - x) / scale, which shooting and the continuation's corrector solve."""
-    return (J - np.eye(2)) * scale[None, :] / scale[:, None]
+    return (J - np.eye(J.shape[0])) * scale[None, :] / scale[:, None]
 
 
 def _newton_step(J: np.ndarray, F: np.ndarray, scale: np.ndarray):

@@ -77,7 +77,7 @@ from __future__ import annotations
 import math
 
 from ..._checks import finite, integer, real
-from ...engine.config import SolverOptions
+from ...engine import SolverOptions
 from ...errors import ParameterError
 from ...model.rig import PARAMETERS, Rig
 from ...model.scene import Scene

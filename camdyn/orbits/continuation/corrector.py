@@ -8,9 +8,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ...engine.driver import Trajectory
+from ...engine import Trajectory
 from ...errors import CamdynError
-from ...vocabulary import STATE_ALPHA, STATE_ALPHA_DOT
 from ..derivatives import Column, Unresolved, resolved_difference
 from ..section_map import MapFailure, MapValue, StroboscopicMap, derivative_at
 from ..shooting import newton_matrix
@@ -161,9 +160,9 @@ def gap(run: Run):
     """The largest psi_i over the orbit (m), alpha at the starts of its revolutions, and the end
     mode, from the samples of its run."""
     model, tr = run.section_map.model, run.trajectory
-    psi = model.outputs_at(tr.mode, tr.t, tr.y[STATE_ALPHA], tr.y[STATE_ALPHA_DOT],
+    psi = model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot,
                            run.section_map.backend)[model.kernels.OUT_PSI_I]
-    return refined_max(psi), tr.y[STATE_ALPHA, np.searchsorted(tr.t, run.starts)], int(tr.end_mode)
+    return refined_max(psi), tr.alpha[np.searchsorted(tr.t, run.starts)], int(tr.end_mode)
 
 
 def refined_max(v: np.ndarray) -> float:

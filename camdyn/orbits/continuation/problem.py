@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..._checks import integer, real
-from ...engine.config import SolverOptions
+from ...engine import SolverOptions
 from ...errors import ParameterError
 from ...model.cam import ConstantSpeed
 from ...model.model import Model

@@ -256,14 +256,19 @@ def _check_extras(names: list[str], targets: tuple[Target, ...]) -> None:
                                + suggest(missing[0], names))
 
 
+def _check_not_fitted(k: str, kind: str, role: str, names: list[str]) -> None:
+    """A fixed or tied parameter (``kind``) is a rig parameter and not one of the unknowns."""
+    if k not in BY_NAME:
+        raise CalibrationError(f"{kind} parameter {k!r} is not a rig parameter" + suggest(k, RIG_PARAMS))
+    if k in names:
+        raise CalibrationError(f"{k!r} is both an unknown and {role}: choose one")
+
+
 def _checked_fixed(rig: Rig, fixed: Mapping[str, str] | None, names: list[str]) -> dict[str, str]:
     """Rig parameters with a value, not fitted, each with its assumption in words."""
     fixed = dict(fixed or {})
     for k, why in fixed.items():
-        if k not in BY_NAME:
-            raise CalibrationError(f"fixed parameter {k!r} is not a rig parameter" + suggest(k, RIG_PARAMS))
-        if k in names:
-            raise CalibrationError(f"{k!r} is both an unknown and fixed by assumption: choose one")
+        _check_not_fitted(k, "fixed", "fixed by assumption", names)
         if not isinstance(why, str) or not why.strip():
             raise CalibrationError(f"fixed parameter {k!r}: give the assumption as a non-empty string (why "
                                    "its value is plausible)")
@@ -276,10 +281,7 @@ def _checked_tied(tied: Mapping[str, Callable] | None, names: list[str], fixed: 
     """Rig parameters neither fitted nor fixed, each a callable of the others."""
     tied = dict(tied or {})
     for k, fn in tied.items():
-        if k not in BY_NAME:
-            raise CalibrationError(f"tied parameter {k!r} is not a rig parameter" + suggest(k, RIG_PARAMS))
-        if k in names:
-            raise CalibrationError(f"{k!r} is both an unknown and tied to others: choose one")
+        _check_not_fitted(k, "tied", "tied to others", names)
         if k in fixed:
             raise CalibrationError(f"{k!r} is both fixed and tied: choose one")
         if not callable(fn):

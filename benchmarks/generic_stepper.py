@@ -44,9 +44,9 @@ def scalar_run(rhs, p, m, t, y0, y1, t_end, method, cfg):
     return t, y0, y1, steps
 
 
-def generic(N: int):
-    """The same step over a state array of N components (N a constant of the closure), the sums
-    in the scalar stepper's order (so the bits can match)."""
+def _stages(N: int):
+    """The field and one step's stages over a state array of N components (N a constant of the
+    closure), the sums in the scalar stepper's order (so the bits can match)."""
     @njit
     def field(rhs, p, m, t, y, K, row):
         K[row, 0] = y[1]
@@ -73,7 +73,11 @@ def generic(N: int):
         for i in range(N):
             y_new[i] = y[i] + h * d[i]
         field(rhs, p, m, t + h, y_new, K, n)
+    return field, attempt
 
+
+def _error_norm(N: int):
+    """SciPy's DOP853 error norm over N components."""
     @njit
     def error_norm(K, h, y, y_new, rtol, atol, method):
         coef, n = method.coef, method.n_stages
@@ -90,6 +94,14 @@ def generic(N: int):
             s5 += (a / scale) ** 2
             s3 += (b / scale) ** 2
         return S.blended(s5, s3, h, float(N))
+    return error_norm
+
+
+def generic(N: int):
+    """The engine's step over a state array of N components: accepted step after accepted step
+    in one mode, as :func:`scalar_run`."""
+    field, attempt = _stages(N)
+    error_norm = _error_norm(N)
 
     @njit
     def run(rhs, p, m, t, y0, y1, t_end, method, cfg):

@@ -9,7 +9,7 @@ the diagram by brute force (every point to the end, ``stop=None``) and with conv
 stopping (``camdyn.StopWhenPeriodic()``, the default of ``camdyn.sweep.api.bifurcation``), the
 revolutions each ran and the agreement of their sections; then one permanent-contact orbit shot
 from the quasi-static warm start against the warm-up run.  ``performance.py`` calls
-:func:`measure` and :func:`lines` for its Sweeps section.
+:func:`measure` (perf/timing.py) and :func:`lines` (perf/report.py) for its Sweeps section.
 """
 from __future__ import annotations
 
@@ -28,7 +28,8 @@ from camdyn.sweep import api as S
 
 RIG = camdyn.example_rig().replace(l_lambda=0.016)
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
-RTOL, ATOL = 1e-7, 1e-11          # performance.py's SWEEP_RTOL, atol = 1e-4 rtol
+#: the bifurcation benchmark's tolerances (also performance.py's sweeps and sweep_store.py's: read from here)
+RTOL, ATOL = 1e-7, 1e-11          # atol = 1e-4 rtol
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 #: the issue's goals
 SHOOT_GOAL_S, DIAGRAM_GOAL_S = 0.05, 5.0

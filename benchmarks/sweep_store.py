@@ -3,7 +3,7 @@
     python benchmarks/sweep_store.py overhead      # the 200 x 200 bifurcation sweep, in memory and streamed
     python benchmarks/sweep_store.py memory --points 100000
 
-``overhead``: the bifurcation sweep of docs/performance.md (benchmarks/performance.py's
+``overhead``: the bifurcation sweep of docs/performance.md (benchmarks/perf/timing.py's
 ``sweep_timing``: example rig with a 16 mm line contact, damping D, Coulomb friction, 200 speeds
 from 0.8 to 1.6 x the contact-loss speed, 200 revolutions each, the second half as the Poincare
 section, rtol 1e-7, atol 1e-11, ProcessPoolExecutor(2), compiled backend), timed in memory
@@ -37,10 +37,10 @@ import numpy as np
 
 import camdyn
 from camdyn.sweep import api as S
+from sweep_stop import RTOL as SWEEP_RTOL  # the bifurcation benchmark's tolerance
 
 RIG = camdyn.example_rig()
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
-SWEEP_RTOL = 1e-7  # as benchmarks/performance.py
 
 
 class StoreClock:

@@ -13,7 +13,7 @@ import pytest
 import camdyn
 from camdyn import studies
 from camdyn.analysis.statics import contact_loss_speed, natural_frequency, static_equilibrium
-from camdyn.studies import common, reference_rig
+from camdyn.studies import common, rig_fit
 
 pytest.importorskip("matplotlib")
 
@@ -177,12 +177,47 @@ def test_impact_run_continues_from_its_end_state():
 
 def test_reference_rig_geometry_override_refits_every_printed_number():
     """identify(geometry=...) keeps every printed number within rounding for another assumed geometry."""
-    res = reference_rig.identify(geometry=dict(d_x=0.05, theta0_offset=math.pi))
+    res = rig_fit.identify(geometry=dict(d_x=0.05, theta0_offset=math.pi))
     assert res.all_within
     assert res.rig.d_x == 0.05
-    assert res.rig.theta0 == pytest.approx(reference_rig.theta0_for(res.rig.alpha0) + math.pi)
+    assert res.rig.theta0 == pytest.approx(rig_fit.theta0_for(res.rig.alpha0) + math.pi)
     with pytest.raises(KeyError, match="not one of"):
-        reference_rig.identify(geometry=dict(e=0.1))
+        rig_fit.identify(geometry=dict(e=0.1))
+
+
+def _study_imports() -> dict[str, set[str]]:
+    """module -> the modules of camdyn.studies it imports (at the top or inside a function)."""
+    import ast
+    folder = Path(studies.__file__).parent
+    graph = {}
+    for path in folder.glob("*.py"):
+        names = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                names |= {node.module} if node.module else {a.name for a in node.names}
+        graph[path.stem] = names & {p.stem for p in folder.glob("*.py")}
+    return graph
+
+
+def test_the_studies_import_no_circle():
+    """The reference-rig fit lives in rig_fit, which both reference_rig and chaos_scan import (they
+    imported each other, inside functions)."""
+    graph = _study_imports()
+    assert graph["chaos_scan"] >= {"rig_fit"} and "reference_rig" not in graph["chaos_scan"]
+
+    def on_a_circle(start: str) -> bool:
+        todo, seen = list(graph[start]), set()
+        while todo:
+            module = todo.pop()
+            if module == start:
+                return True
+            if module not in seen:
+                seen.add(module)
+                todo.extend(graph[module])
+        return False
+
+    circles = [m for m in graph if on_a_circle(m)]
+    assert not circles, circles
 
 
 def test_chaos_scan_writes_its_section_to_both_documents(tmp_path):

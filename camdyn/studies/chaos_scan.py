@@ -5,7 +5,7 @@ is only a datum), and nothing the paper prints determines them. Section 4 states
 experiment's motion becomes chaotic (B and D above about 155 rev/min, E earlier, A and C
 still periodic at 155). This study asks whether some assumed geometry reproduces those
 onsets: for every geometry of a grid it refits the other unknowns with
-:func:`camdyn.studies.reference_rig.identify` (so every printed number is reproduced again),
+:func:`camdyn.studies.rig_fit.identify` (so every printed number is reproduced again),
 builds the experiment's variant, and classes the motion (Poincare section once per cam
 revolution) at the speeds that decide the paper's statements (stage 1); the geometries that
 meet most statements, and the shipped geometry, are then run for all five damping models
@@ -21,8 +21,10 @@ import math
 import time
 
 from camdyn.analysis.statics import contact_loss_speed
+from camdyn.model.presets import load_rig
 
 from .common import Context, StudyOutput, chaos_by_lyapunov, fmt, impact_run, md_table, parallel_map
+from .rig_fit import INITIAL, experiment_variant, identify, preset_start, unknowns
 
 NAME, TITLE = "chaos-scan", "Chaos onsets: geometry scan"
 
@@ -73,12 +75,10 @@ def geometries(grid: dict) -> list[dict]:
 
 
 def _fit(g: dict):
-    from .reference_rig import experiment_variant, identify
-    from camdyn.model.presets import load_rig
     # start from the shipped preset, scaled to the lever: the frequencies fix I_Pb / chi*^2 and w_b / chi*
-    ref, exp = load_rig("reference"), load_rig("reference-experiment")
-    s = g["chi0"] / ref.chi0
-    start = {"I_Pb": ref.I_Pb * s * s, "w_b": ref.w_b * s, "L_us": ref.L_us, "alpha0": ref.alpha0, "k_s_exp": exp.k_s}
+    start = preset_start()
+    s = g["chi0"] / load_rig("reference").chi0
+    start.update(I_Pb=start["I_Pb"] * s * s, w_b=start["w_b"] * s)
     geometry = dict(r_c=g["r_c"], chi0=g["chi0"], d_x=g["dx_ratio"] * g["chi0"], theta0_offset=g["theta0_offset"])
     res = identify(start, geometry)
     return res, experiment_variant(res)
@@ -173,7 +173,6 @@ def _geo_text(g: dict) -> str:
 
 def _misfits(st1: list[dict]) -> str:
     """Which geometries do not reproduce the printed numbers, and which fitted unknown sits at a bound."""
-    from .reference_rig import INITIAL, unknowns
     bad = [r for r in st1 if not r["within_rounding"]]
     if not bad:
         return ""

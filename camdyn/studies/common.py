@@ -187,6 +187,20 @@ def save(fig, path: Path) -> Path:
     return path
 
 
+def spectrum_panels(ax, low_title: str, band_title: str) -> None:
+    """Titles, labels, legends and grids of the two spectrum panels (fig10, fig16): the low
+    frequencies (harmonics of the cam) left, the band around the resonance right."""
+    ax[0].set_title(low_title)
+    ax[0].set_xlabel("frequency (Hz)")
+    ax[0].set_ylabel("|α| (rad)")
+    ax[0].legend(fontsize=7)
+    ax[0].grid(alpha=0.3)
+    ax[1].set_title(band_title)
+    ax[1].set_xlabel("frequency (Hz)")
+    ax[1].legend(fontsize=7)
+    ax[1].grid(alpha=0.3)
+
+
 def md_table(header: list[str], rows: list[list[Any]]) -> str:
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]

@@ -63,39 +63,84 @@ def run(ctx: Context) -> StudyOutput:
             f"(up to {s['max_revolutions']} while aperiodic)")
     runs = [r for rs in parallel_map(_job, jobs, ctx.fast) for r in rs]
     by = {(r["damping"], r["speed_rpm"]): r for r in runs}
+    png = _figure(ctx, by, s["speeds"])
+    found = _findings(by, s)
+    numbers = {"first_aperiodic_rpm": found["first_aperiodic"], "first_chaotic_rpm_lyapunov": found["first_chaotic"],
+               "chaos_at_155_lyapunov": found["chaos155"], "first_aperiodic_rpm_upsweep": found["first_aperiodic_up"],
+               "class_at_155": found["at155"], "coexisting_rpm": found["coexisting"],
+               "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r", "end_state")} for r in runs]}
+    return StudyOutput(NAME, TITLE, _markdown(png, rig, s, by, found), numbers, [png])
+
+
+def _first(speeds: list, test) -> float | None:
+    """The least speed that passes ``test`` (None: none does)."""
+    hits = [sp for sp in speeds if test(sp)]
+    return min(hits) if hits else None
+
+
+def _findings(by: dict, s: dict) -> dict:
+    """Per model: the first aperiodic speed from each start, the class and the chaos verdict at
+    155 rev/min, the first chaotic speed (by lambda_1), whether lambda_1 judged any run, the speeds
+    where the two starts end on different motions, and the runs continued past s["revolutions"]."""
     speeds = s["speeds"]
+    return {
+        "first_aperiodic": {d: _first(speeds, lambda sp: by[d, sp]["class"] == "aperiodic") for d in MODELS},
+        "first_aperiodic_up": {d: _first(speeds, lambda sp: (by[d, sp].get("up") or {}).get("class") == "aperiodic")
+                               for d in MODELS},
+        "at155": {d: by[d, 155.0]["class"] for d in MODELS if (d, 155.0) in by},
+        "chaos155": {d: by[d, 155.0].get("chaos") for d in MODELS if (d, 155.0) in by},
+        "first_chaotic": {d: next((sp for sp in speeds if by[d, sp].get("chaos") == "chaotic"), None) for d in MODELS},
+        "judged": {d: any(by[d, sp].get("chaos") not in (None, "n/a") for sp in speeds) for d in MODELS},
+        "coexisting": {d: [sp for sp in speeds[1:] if coexist(by[d, sp])] for d in MODELS},
+        "extended": {d: [sp for sp in speeds if by[d, sp].get("revolutions", 0) > s["revolutions"]] for d in MODELS},
+    }
 
-    png = _figure(ctx, by, speeds)
 
-    def cell(r):
-        text = f"{r['class']}, rms {fmt(r['rms'], 3)}, p-p {fmt(r['p2p'], 3)}"
-        if r.get("lyapunov") is not None:
-            text += f", λ1 {fmt(r['lyapunov'], 3)} ± {fmt(r['lyapunov_se'], 2)} 1/s ({r['chaos']})"
-        if r.get("revolutions", s["revolutions"]) > s["revolutions"]:
-            text += f" ({r['revolutions']:g} rev)"
-        if r.get("up") and r["up"] is not r and coexist(r):
-            text += f"; up-sweep: {r['up']['class']}, p-p {fmt(r['up']['p2p'], 3)}"
-        return text
+def _cell(r: dict, s: dict) -> str:
+    """One run in the table: its class and statistics, lambda_1, its length if continued, and the
+    up-sweep's motion where it differs."""
+    text = f"{r['class']}, rms {fmt(r['rms'], 3)}, p-p {fmt(r['p2p'], 3)}"
+    if r.get("lyapunov") is not None:
+        text += f", λ1 {fmt(r['lyapunov'], 3)} ± {fmt(r['lyapunov_se'], 2)} 1/s ({r['chaos']})"
+    if r.get("revolutions", s["revolutions"]) > s["revolutions"]:
+        text += f" ({r['revolutions']:g} rev)"
+    if r.get("up") and r["up"] is not r and coexist(r):
+        text += f"; up-sweep: {r['up']['class']}, p-p {fmt(r['up']['p2p'], 3)}"
+    return text
 
-    rows = [[f"{sp:g}"] + [cell(by[d, sp]) for d in MODELS] for sp in speeds]
-    first_aperiodic, first_aperiodic_up = {}, {}
-    for d in MODELS:
-        ap = [sp for sp in speeds if by[d, sp]["class"] == "aperiodic"]
-        first_aperiodic[d] = min(ap) if ap else None
-        ap = [sp for sp in speeds if (by[d, sp].get("up") or {}).get("class") == "aperiodic"]
-        first_aperiodic_up[d] = min(ap) if ap else None
-    at155 = {d: by[d, 155.0]["class"] for d in MODELS if (d, 155.0) in by}
-    chaos155 = {d: by[d, 155.0].get("chaos") for d in MODELS if (d, 155.0) in by}
-    first_chaotic = {d: next((sp for sp in speeds if by[d, sp].get("chaos") == "chaotic"), None) for d in MODELS}
-    judged = {d: any(by[d, sp].get("chaos") not in (None, "n/a") for sp in speeds) for d in MODELS}
-    coexisting = {d: [sp for sp in speeds[1:] if coexist(by[d, sp])] for d in MODELS}
-    extended = {d: [sp for sp in speeds if by[d, sp].get("revolutions", 0) > s["revolutions"]] for d in MODELS}
 
-    checks = _checks(first_aperiodic, at155, speeds) + _lyapunov_checks(first_chaotic, chaos155, judged)
+def _markdown(png, rig, s: dict, by: dict, found: dict) -> str:
+    """The study's section: the figure, the protocol, the paper's statements checked, the table."""
+    speeds = s["speeds"]
+    rows = [[f"{sp:g}"] + [_cell(by[d, sp], s) for d in MODELS] for sp in speeds]
+    checks = (_checks(found["first_aperiodic"], found["at155"], speeds)
+              + _lyapunov_checks(found["first_chaotic"], found["chaos155"], found["judged"]))
+    coexisting, extended, first_aperiodic_up = found["coexisting"], found["extended"], found["first_aperiodic_up"]
     n_co = sum(len(v) for v in coexisting.values())
     co_text = "; ".join(f"{d}: {', '.join(f'{v:g}' for v in coexisting[d])}" for d in MODELS if coexisting[d])
-    md = "\n\n".join([
+    return "\n\n".join([
         f"![Figs. 4-5](img/{png.name})",
+        _protocol(rig, s),
+        "**Not compared with measurements:** the paper's Figs. 4–5 plot the measured α_r of Alzate et al. "
+        "(2007) and their analytical results; those data are not available here, so only the paper's "
+        "statements are compared.",
+        md_table(["the paper states (Sec. 4)", "camdyn", "reproduced"], checks),
+        "Up-sweep start, first aperiodic speed: " + ", ".join(
+            f"{d} {fmt(first_aperiodic_up[d]) if first_aperiodic_up[d] else 'none'}" for d in MODELS) + ". "
+        + (f"The two starts end on different motions at {n_co} model-speed pairs ({co_text})." if n_co else
+           "The two starts end on the same motion at every speed.")
+        + (" Runs continued beyond " + f"{s['revolutions']} revolutions: "
+           + "; ".join(f"{d}: {', '.join(f'{v:g}' for v in extended[d])}" for d in MODELS if extended[d]) + "."
+           if any(extended.values()) else ""),
+        "Whether another assumed geometry (r_c, χ0, d_x, Θ0) of the reference rig reproduces the paper's onsets "
+        "is scanned by `python -m camdyn.studies chaos-scan` (next section).",
+        md_table(["Ω_c (rev/min)"] + [f"model {d}" for d in MODELS], rows),
+    ])
+
+
+def _protocol(rig, s: dict) -> str:
+    """The settings, the classifier, the Lyapunov verdict, the continued runs and the two starts."""
+    return (
         f"Experiment's settings (`reference-experiment`: line contact 16 mm, k_s = {rig.k_s:.3g} N/m, "
         f"Coulomb friction μ_m = 0.3, the damping constants of Section 4), constant cam speed, started from "
         f"the static equilibrium (as in Sec. 4); {s['revolutions']} revolutions per run, statistics over the last "
@@ -116,27 +161,7 @@ def run(ctx: Context) -> StudyOutput:
         "speed is also run from a second start, the end state of the next slower speed's run (a slow "
         "up-sweep; after a run that stopped, the sweep goes on from the static-equilibrium run's end state); where the two starts end on different motions (class, or peak-to-peak differing by more "
         "than 10 %) the table gives both: the rig is multistable there. The first-aperiodic speeds below are "
-        "those of the static-equilibrium start, the paper's protocol.",
-        "**Not compared with measurements:** the paper's Figs. 4–5 plot the measured α_r of Alzate et al. "
-        "(2007) and their analytical results; those data are not available here, so only the paper's "
-        "statements are compared.",
-        md_table(["the paper states (Sec. 4)", "camdyn", "reproduced"], checks),
-        "Up-sweep start, first aperiodic speed: " + ", ".join(
-            f"{d} {fmt(first_aperiodic_up[d]) if first_aperiodic_up[d] else 'none'}" for d in MODELS) + ". "
-        + (f"The two starts end on different motions at {n_co} model-speed pairs ({co_text})." if n_co else
-           "The two starts end on the same motion at every speed.")
-        + (" Runs continued beyond " + f"{s['revolutions']} revolutions: "
-           + "; ".join(f"{d}: {', '.join(f'{v:g}' for v in extended[d])}" for d in MODELS if extended[d]) + "."
-           if any(extended.values()) else ""),
-        "Whether another assumed geometry (r_c, χ0, d_x, Θ0) of the reference rig reproduces the paper's onsets "
-        "is scanned by `python -m camdyn.studies chaos-scan` (next section).",
-        md_table(["Ω_c (rev/min)"] + [f"model {d}" for d in MODELS], rows),
-    ])
-    numbers = {"first_aperiodic_rpm": first_aperiodic, "first_chaotic_rpm_lyapunov": first_chaotic,
-               "chaos_at_155_lyapunov": chaos155, "first_aperiodic_rpm_upsweep": first_aperiodic_up,
-               "class_at_155": at155, "coexisting_rpm": coexisting,
-               "runs": [{k: v for k, v in r.items() if k not in ("section", "t", "alpha_r", "end_state")} for r in runs]}
-    return StudyOutput(NAME, TITLE, md, numbers, [png])
+        "those of the static-equilibrium start, the paper's protocol.")
 
 
 def _figure(ctx: Context, by: dict, speeds: list):

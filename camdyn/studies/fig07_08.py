@@ -169,62 +169,10 @@ def run(ctx: Context) -> StudyOutput:
     runs = parallel_map(_job, jobs, ctx.fast)
     legs = parallel_map(branch, s["branches"], ctx.fast)
     ctx.log(f"{NAME}: {sum(len(b['lambda']) for b in legs)} orbits continued")
-    alpha_star = static_equilibrium(rig).alpha
-    sat = math.pi / 2 - alpha_star
-
-    def p2p(r):
-        return r["p2p"] if r["p2p"] is not None else None
-
-    fig, ax = figure(1, 2, figsize=(11, 5.2))
-    low = [r for r in runs if r["speed_rpm"] in s["low"]]
-    grid_low = np.linspace(min(s["low"]) - 5, max(s["low"]) + 5, 80)
-    for xi, ls in zip(XI_LOW, ("-", "--", "-.", ":")):
-        ax[0].plot(grid_low, [energy_balance_peak(rig, w, xi) for w in grid_low], "k", ls=ls, lw=0.9,
-                   label=f"energy balance, ξ = {xi:g}")
-    ax[0].plot([r["speed_rpm"] for r in low], [p2p(r) or np.nan for r in low], "o", color="tab:red",
-               label="contact model (damping D)")
-    _draw_branches(ax[0], legs)
-    ax[0].set_title("(a) Fig. 7: lower speeds, with the continued branches")
-    allspeeds = np.geomspace(100, 2e4, 200)
-    for xi, ls in zip(XI_BROAD, ("-", "--", ":")):
-        ax[1].plot(allspeeds, [energy_balance_peak(rig, w, xi) for w in allspeeds], "k", ls=ls, lw=0.9,
-                   label=f"energy balance, ξ = {xi:g}")
-    ok = [r for r in runs if r["outcome"] == "SUCCESS"]
-    stopped = [r for r in runs if r["outcome"] != "SUCCESS"]
-    ax[1].plot([r["speed_rpm"] for r in ok], [p2p(r) or np.nan for r in ok], "o", color="tab:red",
-               label="contact model (damping D)")
-    if stopped:
-        ax[1].plot([r["speed_rpm"] for r in stopped], [sat] * len(stopped), "^", color="tab:red", mfc="none",
-                   label="contact model: follower reached 90° (run stopped)")
-    ax[1].axhline(PAPER["alpha_rp_saturation"]["value"], color="tab:gray", lw=0.8, ls=(0, (1, 3)),
-                  label="paper: saturation at 1.36 rad")
-    ax[1].set_xscale("log")
-    ax[1].set_title("(b) Fig. 8: broad range of speeds")
-    for a in ax:
-        a.set_xlabel("cam speed Ω_c (rev/min)")
-        a.set_ylabel("α_rp (rad)")
-        a.grid(alpha=0.3, which="both")
-        a.legend(fontsize=7)
-    ax[0].legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)   # below: the branches fill (a)
-    png = save(fig, ctx.png("fig7-8"))
-
-    rows, numbers_runs = [], []
-    for r in runs:
-        xi = xi_needed(rig, r["speed_rpm"], p2p(r)) if r["outcome"] == "SUCCESS" else None
-        rows.append([fmt(r["speed_rpm"]), fmt(p2p(r), 3) if r["outcome"] == "SUCCESS" else "–",
-                     r["outcome"] if r["outcome"] != "SUCCESS" else r["class"],
-                     fmt(energy_balance_peak(rig, r["speed_rpm"], 0.05), 3),
-                     xi if isinstance(xi, str) or xi is None else f"{xi:.3f}"])
-        numbers_runs.append({"speed_rpm": r["speed_rpm"], "alpha_rp": p2p(r), "outcome": r["outcome"],
-                             "class": r["class"], "xi_needed": xi})
-    xi_low = [n["xi_needed"] for n in numbers_runs if n["speed_rpm"] < 160 and isinstance(n["xi_needed"], float)]
-    below = [n for n in numbers_runs if n["speed_rpm"] < 160 and n["alpha_rp"] is not None]
-    under = [n["speed_rpm"] for n in below if n["alpha_rp"] <= energy_balance_peak(rig, n["speed_rpm"], 0.05)]
-    over = [n["speed_rpm"] for n in below if n["alpha_rp"] > energy_balance_peak(rig, n["speed_rpm"], 0.05)]
-    verdict = (f"Below 160 rev/min the contact model's α_rp is at or below the ξ = 0.05 energy balance at "
-               f"{', '.join(fmt(v) for v in under) or 'no speed'} rev/min (consistent with the paper's ξ < 0.05) "
-               f"and above it at {', '.join(fmt(v) for v in over) or 'no speed'} rev/min, where the follower "
-               "has settled on the large period-1 flight (see Figs. 4–5): there no ξ ≤ 1 matches.")
+    sat = math.pi / 2 - static_equilibrium(rig).alpha
+    png = _figure(ctx, rig, s, runs, legs, sat)
+    rows, numbers_runs = _table(rig, runs)
+    found = _below_160(rig, numbers_runs)
     eb_top = energy_balance_peak(rig, 1e5, 1.0)
     md = "\n\n".join([
         f"![Figs. 7-8](img/{png.name})",
@@ -236,7 +184,7 @@ def run(ctx: Context) -> StudyOutput:
         f"gives {eb_top:.4f} rad), the paper's 1.36 rad by construction of the reference rig (α* was fitted "
         f"to it). In the contact model the follower thrown towards 90° meets the singular spring of Eq. 11 "
         f"(tan α): camdyn stops such a run at 90° − 0.02 rad (`ANGLE_LIMIT`) and it is plotted at the "
-        f"saturation value. " + verdict + " The last column gives the ξ for which the energy balance reproduces "
+        f"saturation value. " + found["verdict"] + " The last column gives the ξ for which the energy balance reproduces "
         "the contact model ('< 0': even ξ = 0 over-predicts).",
         "**Not compared with measurements:** the paper's Figs. 7–8 also plot the measured α_rp and the "
         "analytical results of Alzate et al. (2007); those data are not available here.",
@@ -245,7 +193,83 @@ def run(ctx: Context) -> StudyOutput:
                   "α_rp energy balance ξ = 0.05 (rad)", "ξ that matches the contact model"], rows),
     ])
     numbers = {"saturation_rad": sat, "energy_balance_top": eb_top, "runs": numbers_runs,
-               "xi_needed_below_160": xi_low, "below_xi005_rpm": under, "above_xi005_rpm": over,
+               "xi_needed_below_160": found["xi_low"], "below_xi005_rpm": found["under"],
+               "above_xi005_rpm": found["over"],
                "branches": [{k: b[k] for k in ("name", "events", "end")} | {"from": b["lambda"][0], "to": b["lambda"][-1]}
                             for b in legs]}
     return StudyOutput(NAME, TITLE, md, numbers, [png])
+
+
+def _figure(ctx: Context, rig, s: dict, runs: list[dict], legs: list[dict], sat: float):
+    """Fig. 7 (low speeds, with the continued branches) beside Fig. 8 (the broad range); the PNG path."""
+    fig, ax = figure(1, 2, figsize=(11, 5.2))
+    _draw_low(ax[0], rig, s, runs, legs)
+    _draw_broad(ax[1], rig, runs, sat)
+    for a in ax:
+        a.set_xlabel("cam speed Ω_c (rev/min)")
+        a.set_ylabel("α_rp (rad)")
+        a.grid(alpha=0.3, which="both")
+        a.legend(fontsize=7)
+    ax[0].legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)   # below: the branches fill (a)
+    return save(fig, ctx.png("fig7-8"))
+
+
+def _draw_low(ax, rig, s: dict, runs: list[dict], legs: list[dict]) -> None:
+    """Fig. 7: the energy balance for XI_LOW, the contact model's runs and the continued branches."""
+    low = [r for r in runs if r["speed_rpm"] in s["low"]]
+    grid_low = np.linspace(min(s["low"]) - 5, max(s["low"]) + 5, 80)
+    for xi, ls in zip(XI_LOW, ("-", "--", "-.", ":")):
+        ax.plot(grid_low, [energy_balance_peak(rig, w, xi) for w in grid_low], "k", ls=ls, lw=0.9,
+                label=f"energy balance, ξ = {xi:g}")
+    ax.plot([r["speed_rpm"] for r in low], [r["p2p"] or np.nan for r in low], "o", color="tab:red",
+            label="contact model (damping D)")
+    _draw_branches(ax, legs)
+    ax.set_title("(a) Fig. 7: lower speeds, with the continued branches")
+
+
+def _draw_broad(ax, rig, runs: list[dict], sat: float) -> None:
+    """Fig. 8: the energy balance for XI_BROAD over the broad range, the runs (stopped ones at the
+    saturation value) and the paper's saturation."""
+    allspeeds = np.geomspace(100, 2e4, 200)
+    for xi, ls in zip(XI_BROAD, ("-", "--", ":")):
+        ax.plot(allspeeds, [energy_balance_peak(rig, w, xi) for w in allspeeds], "k", ls=ls, lw=0.9,
+                label=f"energy balance, ξ = {xi:g}")
+    ok = [r for r in runs if r["outcome"] == "SUCCESS"]
+    stopped = [r for r in runs if r["outcome"] != "SUCCESS"]
+    ax.plot([r["speed_rpm"] for r in ok], [r["p2p"] or np.nan for r in ok], "o", color="tab:red",
+            label="contact model (damping D)")
+    if stopped:
+        ax.plot([r["speed_rpm"] for r in stopped], [sat] * len(stopped), "^", color="tab:red", mfc="none",
+                label="contact model: follower reached 90° (run stopped)")
+    ax.axhline(PAPER["alpha_rp_saturation"]["value"], color="tab:gray", lw=0.8, ls=(0, (1, 3)),
+               label="paper: saturation at 1.36 rad")
+    ax.set_xscale("log")
+    ax.set_title("(b) Fig. 8: broad range of speeds")
+
+
+def _table(rig, runs: list[dict]) -> tuple[list[list], list[dict]]:
+    """The report's rows and the recorded numbers of each run, with the xi that matches it."""
+    rows, numbers_runs = [], []
+    for r in runs:
+        xi = xi_needed(rig, r["speed_rpm"], r["p2p"]) if r["outcome"] == "SUCCESS" else None
+        rows.append([fmt(r["speed_rpm"]), fmt(r["p2p"], 3) if r["outcome"] == "SUCCESS" else "–",
+                     r["outcome"] if r["outcome"] != "SUCCESS" else r["class"],
+                     fmt(energy_balance_peak(rig, r["speed_rpm"], 0.05), 3),
+                     xi if isinstance(xi, str) or xi is None else f"{xi:.3f}"])
+        numbers_runs.append({"speed_rpm": r["speed_rpm"], "alpha_rp": r["p2p"], "outcome": r["outcome"],
+                             "class": r["class"], "xi_needed": xi})
+    return rows, numbers_runs
+
+
+def _below_160(rig, numbers_runs: list[dict]) -> dict:
+    """Below 160 rev/min: the speeds where the contact model is at or under the xi = 0.05 energy
+    balance and those where it is above, the xi that match, and the sentence saying so."""
+    xi_low = [n["xi_needed"] for n in numbers_runs if n["speed_rpm"] < 160 and isinstance(n["xi_needed"], float)]
+    below = [n for n in numbers_runs if n["speed_rpm"] < 160 and n["alpha_rp"] is not None]
+    under = [n["speed_rpm"] for n in below if n["alpha_rp"] <= energy_balance_peak(rig, n["speed_rpm"], 0.05)]
+    over = [n["speed_rpm"] for n in below if n["alpha_rp"] > energy_balance_peak(rig, n["speed_rpm"], 0.05)]
+    verdict = (f"Below 160 rev/min the contact model's α_rp is at or below the ξ = 0.05 energy balance at "
+               f"{', '.join(fmt(v) for v in under) or 'no speed'} rev/min (consistent with the paper's ξ < 0.05) "
+               f"and above it at {', '.join(fmt(v) for v in over) or 'no speed'} rev/min, where the follower "
+               "has settled on the large period-1 flight (see Figs. 4–5): there no ξ ≤ 1 matches.")
+    return {"xi_low": xi_low, "under": under, "over": over, "verdict": verdict}

@@ -8,7 +8,9 @@ import camdyn
 from camdyn.analysis.statics import natural_frequency
 from camdyn.analysis.signal import peak_frequency, spectrum
 
-from .common import PAPER, Context, StudyOutput, figure, fmt, md_table, reference_rig, rel, save, simulate
+from .common import (PAPER, Context, StudyOutput, figure, fmt, md_table, reference_rig, rel, save, simulate,
+                     spectrum_panels)
+from .fig16 import instantaneous_frequency_at
 
 NAME, TITLE = "fig10", "Fig. 10: α spectra, line vs point contact, de- vs self-energizing"
 
@@ -43,39 +45,42 @@ def run(ctx: Context) -> StudyOutput:
     runs = spectra_runs(rig, revs)
     fig, ax = figure(1, 2, figsize=(11, 4))
     rows, numbers = [], {}
-    for key, label, contact, speed, pkey, color in CASES:
-        r, f, A = runs[key]
-        scene = camdyn.Scene(contact=contact, damping="D", friction="coulomb")
-        jac = natural_frequency(rig, scene, camdyn.ConstantSpeed(speed)).Hz
-        lo, hi = (900.0, 1800.0) if contact == "point" else (1700.0, 2700.0)
-        peak = resonance(f, A, lo, hi)
-        paper = PAPER[pkey]["value"]
-        low = f <= 60
-        ax[0].semilogy(f[low], A[low], ".-", ms=3, lw=0.7, color=color, label=label)
-        band = (f > 800) & (f < 2800)
-        ax[1].semilogy(f[band], A[band], lw=0.7, color=color, label=f"{label}: peak {peak:.0f} Hz")
-        ax[1].axvline(paper, color=color, ls=":", lw=1)
-        rows.append([label, f"{paper:g}", f"{jac:.1f} ({rel(jac, paper):+.1e})", f"{peak:.0f} ({rel(peak, paper):+.1e})",
-                     r.outcome.name, len(r.impacts())])
-        from .fig16 import instantaneous_frequency
-        last = r.t >= r.t[-1] - r.period
-        sub = np.flatnonzero(last)[::10]
-        sweep = instantaneous_frequency(rig, scene, camdyn.ConstantSpeed(speed), type(
-            "R", (), {"t": r.t[sub], "alpha": r.alpha[sub], "alpha_dot": r.alpha_dot[sub], "regime": r.regime[sub]})())
-        numbers[key] = {"sweep_Hz": [float(np.nanmin(sweep)), float(np.nanmax(sweep))], "paper_Hz": paper, "jacobian_Hz": jac, "spectrum_peak_Hz": peak, "outcome": r.outcome.name,
-                        "impacts": int(len(r.impacts())), "backend": r.meta.get("backend")}
-    ax[0].set_title("(a) harmonics of Ω_c (5 Hz)")
-    ax[0].set_xlabel("frequency (Hz)")
-    ax[0].set_ylabel("|α| (rad)")
-    ax[0].legend(fontsize=7)
-    ax[0].grid(alpha=0.3)
-    ax[1].set_title("(b) resonance (dotted: the paper's 2182 / 2125 / 1331 Hz)")
-    ax[1].set_xlabel("frequency (Hz)")
-    ax[1].legend(fontsize=7)
-    ax[1].grid(alpha=0.3)
+    for case in CASES:
+        row, numbers[case[0]] = _case(rig, case, runs[case[0]], ax)
+        rows.append(row)
+    spectrum_panels(ax, "(a) harmonics of Ω_c (5 Hz)", "(b) resonance (dotted: the paper's 2182 / 2125 / 1331 Hz)")
     png = save(fig, ctx.png("fig10"))
     h = {key: runs[key][2][np.argmin(np.abs(runs[key][1] - 5.0 * k))] for key in runs for k in (1,)}
-    md = "\n\n".join([
+    return StudyOutput(NAME, TITLE, _markdown(png, revs, rows, numbers, h), numbers, [png])
+
+
+def _case(rig, case: tuple, run: tuple, ax) -> tuple[list, dict]:
+    """One case drawn on both panels; its table row and its numbers (the Jacobian's frequency at
+    rest, the spectral peak, the natural frequency's sweep over the last revolution)."""
+    key, label, contact, speed, pkey, color = case
+    r, f, A = run
+    scene = camdyn.Scene(contact=contact, damping="D", friction="coulomb")
+    jac = natural_frequency(rig, scene, camdyn.ConstantSpeed(speed)).Hz
+    lo, hi = (900.0, 1800.0) if contact == "point" else (1700.0, 2700.0)
+    peak = resonance(f, A, lo, hi)
+    paper = PAPER[pkey]["value"]
+    low = f <= 60
+    ax[0].semilogy(f[low], A[low], ".-", ms=3, lw=0.7, color=color, label=label)
+    band = (f > 800) & (f < 2800)
+    ax[1].semilogy(f[band], A[band], lw=0.7, color=color, label=f"{label}: peak {peak:.0f} Hz")
+    ax[1].axvline(paper, color=color, ls=":", lw=1)
+    row = [label, f"{paper:g}", f"{jac:.1f} ({rel(jac, paper):+.1e})", f"{peak:.0f} ({rel(peak, paper):+.1e})",
+           r.outcome.name, len(r.impacts())]
+    last = np.flatnonzero(r.t >= r.t[-1] - r.period)[::10]
+    sweep = instantaneous_frequency_at(rig, scene, camdyn.ConstantSpeed(speed), r, last)
+    return row, {"sweep_Hz": [float(np.nanmin(sweep)), float(np.nanmax(sweep))], "paper_Hz": paper,
+                 "jacobian_Hz": jac, "spectrum_peak_Hz": peak, "outcome": r.outcome.name,
+                 "impacts": int(len(r.impacts())), "backend": r.meta.get("backend")}
+
+
+def _markdown(png, revs: int, rows: list, numbers: dict, h: dict) -> str:
+    """The figure, the settings, the table, and the paper's statement against camdyn's spectra."""
+    return "\n\n".join([
         f"![Fig. 10](img/{png.name})",
         f"Reference rig (Sections 6–8: k_s = 2000 N/m, line contact 1.6 mm, e = 0.1 r_c, Coulomb friction "
         f"μ_m = 0.3, damping D with ζ_D = 0.01, β_D = 4.25 s/m), 300 rev/min, {revs} revolutions from the "
@@ -103,4 +108,3 @@ def run(ctx: Context) -> StudyOutput:
         f"spectral peaks against {numbers['line_de']['jacobian_Hz'] - numbers['line_se']['jacobian_Hz']:.0f} Hz "
         "at rest.",
     ])
-    return StudyOutput(NAME, TITLE, md, numbers, [png])

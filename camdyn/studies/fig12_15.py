@@ -40,39 +40,61 @@ def run(ctx: Context) -> StudyOutput:
     rig = reference_rig().replace(e=0.7 * reference_rig().r_c)
     loss = contact_loss_speed(rig)
     runs = _runs(rig, ctx.fast)
-    pngs, rows, numbers = [], [], {}
-    for motion, figs in (("constant", "12-13"), ("oscillating", "14-15")):
-        fig, ax = figure(3, 2, figsize=(12, 8.5), sharex=True)
-        for j, (vr, vr_label) in enumerate(VR):
-            for fr, fr_label, color, ls in FRICTION:
-                r = runs[motion, vr, fr]
-                x = (r.t - r.t[0]) / r.period
-                for i, (q, unit) in enumerate((("v_r", "m/s"), ("F_f", "N"), ("N_x", "N"))):
-                    ax[i, j].plot(x, getattr(r, q), color=color, ls=ls, lw=0.9,
-                                  label=f"{fr_label}" + ("" if r.ok else f" — stopped: {r.outcome.name}"))
-                    ax[i, j].set_ylabel(f"{q} ({unit})")
-                    ax[i, j].grid(alpha=0.3)
-                key = f"{motion}/{vr}/{fr}"
-                numbers[key] = {"outcome": r.outcome.name, "backend": r.meta.get("backend"),
-                                "v_r_sign_changes": _sign_changes(r.v_r),
-                                "periods": float((r.t[-1] - r.t[0]) / r.period), "v_r_min": float(r.v_r.min()),
-                                "v_r_max": float(r.v_r.max()), "F_f_range": [float(r.F_f.min()), float(r.F_f.max())],
-                                "N_x_range": [float(r.N_x.min()), float(r.N_x.max())],
-                                "stick_samples": int(np.count_nonzero(np.char.find(r.regime.astype(str), "stick") >= 0)),
-                                "impacts": int(len(r.impacts()))}
-                rows.append([motion, vr, fr, r.outcome.name, numbers[key]["v_r_sign_changes"],
-                             f"{fmt(r.v_r.min(), 3)} … {fmt(r.v_r.max(), 3)}",
-                             f"{fmt(r.F_f.min(), 3)} … {fmt(r.F_f.max(), 3)}",
-                             f"{fmt(r.N_x.min(), 3)} … {fmt(r.N_x.max(), 3)}", numbers[key]["stick_samples"]])
-            ax[0, j].set_title(vr_label)
-            ax[0, j].legend(fontsize=7)
-            ax[2, j].set_xlabel("t / T (cam revolutions)" if motion == "constant" else "t / T (oscillation periods)")
-        what = ("constant speed 50 rev/min" if motion == "constant"
-                else "oscillating cam, Θ_p = π, ω_c = 40 rev/min")
-        fig.suptitle(f"Figs. {figs}: e = 0.7 r_c, {what}, damping D (ζ_D = 0.01, β_D = 4.25 s/m)")
-        pngs.append(save(fig, ctx.png(f"fig{figs}")))
-    c = numbers
-    md = "\n\n".join([
+    numbers = {"/".join(key): _numbers(r) for key, r in runs.items()}
+    pngs = [_figure(ctx, runs, motion, figs) for motion, figs in (("constant", "12-13"), ("oscillating", "14-15"))]
+    md = _markdown(pngs, loss, _rows(runs, numbers), numbers, ctx.fast)
+    numbers["contact_loss_rpm_e07"] = loss
+    return StudyOutput(NAME, TITLE, md, numbers, pngs)
+
+
+def _numbers(r) -> dict:
+    """One run's outcome and ranges, and its sign changes of v_r and samples sticking."""
+    return {"outcome": r.outcome.name, "backend": r.meta.get("backend"),
+            "v_r_sign_changes": _sign_changes(r.v_r),
+            "periods": float((r.t[-1] - r.t[0]) / r.period), "v_r_min": float(r.v_r.min()),
+            "v_r_max": float(r.v_r.max()), "F_f_range": [float(r.F_f.min()), float(r.F_f.max())],
+            "N_x_range": [float(r.N_x.min()), float(r.N_x.max())],
+            "stick_samples": int(np.count_nonzero(np.char.find(r.regime.astype(str), "stick") >= 0)),
+            "impacts": int(len(r.impacts()))}
+
+
+def _rows(runs: dict, numbers: dict) -> list[list]:
+    """The table's rows, in the figures' order (cam motion, then v_r, then friction)."""
+    rows = []
+    for key, r in runs.items():
+        n = numbers["/".join(key)]
+        rows.append([*key, r.outcome.name, n["v_r_sign_changes"],
+                     f"{fmt(r.v_r.min(), 3)} … {fmt(r.v_r.max(), 3)}",
+                     f"{fmt(r.F_f.min(), 3)} … {fmt(r.F_f.max(), 3)}",
+                     f"{fmt(r.N_x.min(), 3)} … {fmt(r.N_x.max(), 3)}", n["stick_samples"]])
+    return rows
+
+
+def _figure(ctx: Context, runs: dict, motion: str, figs: str):
+    """v_r, F_f and N_x of one cam motion, printed v_r left and kinematic right; the PNG path."""
+    fig, ax = figure(3, 2, figsize=(12, 8.5), sharex=True)
+    for j, (vr, vr_label) in enumerate(VR):
+        for fr, fr_label, color, ls in FRICTION:
+            r = runs[motion, vr, fr]
+            x = (r.t - r.t[0]) / r.period
+            for i, (q, unit) in enumerate((("v_r", "m/s"), ("F_f", "N"), ("N_x", "N"))):
+                ax[i, j].plot(x, getattr(r, q), color=color, ls=ls, lw=0.9,
+                              label=f"{fr_label}" + ("" if r.ok else f" — stopped: {r.outcome.name}"))
+                ax[i, j].set_ylabel(f"{q} ({unit})")
+                ax[i, j].grid(alpha=0.3)
+        ax[0, j].set_title(vr_label)
+        ax[0, j].legend(fontsize=7)
+        ax[2, j].set_xlabel("t / T (cam revolutions)" if motion == "constant" else "t / T (oscillation periods)")
+    what = ("constant speed 50 rev/min" if motion == "constant"
+            else "oscillating cam, Θ_p = π, ω_c = 40 rev/min")
+    fig.suptitle(f"Figs. {figs}: e = 0.7 r_c, {what}, damping D (ζ_D = 0.01, β_D = 4.25 s/m)")
+    return save(fig, ctx.png(f"fig{figs}"))
+
+
+def _markdown(pngs: list, loss: float, rows: list, c: dict, fast: bool) -> str:
+    """The figures, the settings, the paper's statements against camdyn's runs (``c``: their
+    numbers by "motion/v_r/friction"), the table."""
+    return "\n\n".join([
         f"![Figs. 12-13](img/{pngs[0].name})",
         f"![Figs. 14-15](img/{pngs[1].name})",
         f"Reference rig with e = 0.7 r_c (contact lost only above {loss:.4g} rev/min by inverse kinematics, so "
@@ -96,10 +118,8 @@ def run(ctx: Context) -> StudyOutput:
         f"models I and II differ only by tanh(s v_r) < 1. What changes: the discontinuity of Figs. 12–13 "
         f"exists only through the printed v_r. For the oscillating cam v_r reverses with Θ̇ under either "
         f"form (kinematic: {c['oscillating/kinematic/tanh']['v_r_sign_changes']} changes over "
-        f"{'one period' if ctx.fast else 'two periods'}, model II), so the discontinuity of Figs. 14–15 is "
+        f"{'one period' if fast else 'two periods'}, model II), so the discontinuity of Figs. 14–15 is "
         f"physical; the two forms differ in the size and timing of v_r.",
         md_table(["cam", "v_r", "friction", "outcome", "v_r sign changes over the run", "v_r (m/s)", "F_f (N)", "N_x (N)",
                   "samples sticking"], rows),
     ])
-    numbers["contact_loss_rpm_e07"] = loss
-    return StudyOutput(NAME, TITLE, md, numbers, pngs)

@@ -4,15 +4,18 @@ non-linear one. The paper's linear model (Eqs. 36-38, as printed) and camdyn's e
 Jacobian linearization are both shown."""
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 import camdyn
 from camdyn.analysis.signal import peak_frequency, spectrum
 
-from .common import Context, StudyOutput, figure, fmt, md_table, reference_rig, save, simulate
+from .common import Context, StudyOutput, figure, fmt, md_table, reference_rig, save, simulate, spectrum_panels
 
 NAME, TITLE = "fig16", "Fig. 16: linearized vs non-linear model"
 FS = 20_000.0
+SPEED_RPM = 300.0
 MODELS = [("nonlinear", "non-linear", "tab:blue"), ("linear_paper", "linear, Eqs. 36–38 as printed", "tab:red"),
           ("linear_exact", "linear, exact Jacobian linearization", "tab:green")]
 
@@ -33,48 +36,55 @@ def instantaneous_frequency(rig, scene, cam, result) -> np.ndarray:
     return out
 
 
+def instantaneous_frequency_at(rig, scene, cam, result, rows) -> np.ndarray:
+    """:func:`instantaneous_frequency` on the samples ``rows`` of ``result`` only."""
+    sub = SimpleNamespace(t=result.t[rows], alpha=result.alpha[rows], alpha_dot=result.alpha_dot[rows],
+                          regime=result.regime[rows])
+    return instantaneous_frequency(rig, scene, cam, sub)
+
+
 def run(ctx: Context) -> StudyOutput:
     rig = reference_rig()
     revs = 2 if ctx.fast else 10
-    speed = 300.0
-    fc = speed / 60.0
     fig, ax = figure(1, 2, figsize=(11, 4))
     rows, numbers = [], {}
     for model, label, color in MODELS:
-        scene = camdyn.Scene(contact="line", damping="D", friction="coulomb", model=model)
-        r = simulate(rig, scene, speed_rpm=speed, revolutions=revs, sample_rate_Hz=FS)
-        n = int(round(revs * r.period * FS))
-        f, A = spectrum(r.t[:n], r.alpha[:n], window="rect")
-        h = np.array([A[np.argmin(np.abs(f - k * fc))] for k in range(1, 7)])
-        peak = peak_frequency(f, A, fmin=1700.0, fmax=2700.0)
-        step = max(1, int(FS / 2000))  # the stiffness along one revolution, every 0.5 ms
-        last = r.t >= r.t[-1] - r.period
-        sub = np.flatnonzero(last)[::step]
-        finst = instantaneous_frequency(rig, scene, camdyn.ConstantSpeed(speed),
-                                        type("R", (), {"t": r.t[sub], "alpha": r.alpha[sub],
-                                                       "alpha_dot": r.alpha_dot[sub], "regime": r.regime[sub]})())
-        fmin_i, fmax_i = float(np.nanmin(finst)), float(np.nanmax(finst))
-        low = f <= 40
-        ax[0].semilogy(f[low], A[low], ".-", ms=3, lw=0.7, color=color, label=label)
-        band = (f > 1800) & (f < 2600)
-        ax[1].semilogy(f[band], A[band], lw=0.7, color=color, label=f"{label}: peak {peak:.0f} Hz")
-        rows.append([label, fmt(h[0], 3), fmt(h[1] / h[0], 3), fmt(h[2] / h[0], 3), f"{peak:.0f}",
-                     f"{fmin_i:.0f} … {fmax_i:.0f}", r.outcome.name])
-        numbers[model] = {"fundamental": float(h[0]), "harmonics_over_fundamental": (h[1:] / h[0]).tolist(),
-                          "peak_Hz": peak, "instantaneous_Hz": [fmin_i, fmax_i],
-                          "outcome": r.outcome.name, "backend": r.meta.get("backend")}
-    ax[0].set_title("(a) harmonics of Ω_c")
-    ax[0].set_xlabel("frequency (Hz)")
-    ax[0].set_ylabel("|α| (rad)")
-    ax[0].legend(fontsize=7)
-    ax[0].grid(alpha=0.3)
-    ax[1].set_title("(b) around the natural frequency")
-    ax[1].set_xlabel("frequency (Hz)")
-    ax[1].legend(fontsize=7)
-    ax[1].grid(alpha=0.3)
+        row, numbers[model] = _model_run(rig, revs, model, label, color, ax)
+        rows.append(row)
+    spectrum_panels(ax, "(a) harmonics of Ω_c", "(b) around the natural frequency")
     png = save(fig, ctx.png("fig16"))
+    return StudyOutput(NAME, TITLE, _markdown(png, revs, rows, numbers), numbers, [png])
+
+
+def _model_run(rig, revs: int, model: str, label: str, color: str, ax) -> tuple[list, dict]:
+    """One model at SPEED_RPM drawn on both panels; its table row and its numbers (the harmonics,
+    the resonance peak, the natural frequency along the last revolution)."""
+    fc = SPEED_RPM / 60.0
+    scene = camdyn.Scene(contact="line", damping="D", friction="coulomb", model=model)
+    r = simulate(rig, scene, speed_rpm=SPEED_RPM, revolutions=revs, sample_rate_Hz=FS)
+    n = int(round(revs * r.period * FS))
+    f, A = spectrum(r.t[:n], r.alpha[:n], window="rect")
+    h = np.array([A[np.argmin(np.abs(f - k * fc))] for k in range(1, 7)])
+    peak = peak_frequency(f, A, fmin=1700.0, fmax=2700.0)
+    step = max(1, int(FS / 2000))  # the stiffness along one revolution, every 0.5 ms
+    last = np.flatnonzero(r.t >= r.t[-1] - r.period)[::step]
+    finst = instantaneous_frequency_at(rig, scene, camdyn.ConstantSpeed(SPEED_RPM), r, last)
+    fmin_i, fmax_i = float(np.nanmin(finst)), float(np.nanmax(finst))
+    low = f <= 40
+    ax[0].semilogy(f[low], A[low], ".-", ms=3, lw=0.7, color=color, label=label)
+    band = (f > 1800) & (f < 2600)
+    ax[1].semilogy(f[band], A[band], lw=0.7, color=color, label=f"{label}: peak {peak:.0f} Hz")
+    row = [label, fmt(h[0], 3), fmt(h[1] / h[0], 3), fmt(h[2] / h[0], 3), f"{peak:.0f}",
+           f"{fmin_i:.0f} … {fmax_i:.0f}", r.outcome.name]
+    return row, {"fundamental": float(h[0]), "harmonics_over_fundamental": (h[1:] / h[0]).tolist(),
+                 "peak_Hz": peak, "instantaneous_Hz": [fmin_i, fmax_i],
+                 "outcome": r.outcome.name, "backend": r.meta.get("backend")}
+
+
+def _markdown(png, revs: int, rows: list, numbers: dict) -> str:
+    """The figure, the paper's statement, camdyn's harmonics and side bands, and the table."""
     nl, lp = numbers["nonlinear"], numbers["linear_paper"]
-    md = "\n\n".join([
+    return "\n\n".join([
         f"![Fig. 16](img/{png.name})",
         "The paper (Sec. 8): 'the linear system has only the fundamental harmonic of Ω_c while the non-linear "
         "system exhibits the super-harmonics of Ω_c ... The linear system has a single peak at the natural "
@@ -95,4 +105,3 @@ def run(ctx: Context) -> StudyOutput:
         md_table(["model", "α amplitude at f_c (rad)", "2 f_c / f_c", "3 f_c / f_c", "peak (Hz)",
                   "natural frequency along the run (Hz)", "outcome"], rows),
     ])
-    return StudyOutput(NAME, TITLE, md, numbers, [png])

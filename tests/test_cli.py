@@ -367,7 +367,7 @@ def test_messages_name_the_option_suggest_and_point_at_the_commands_help(argv, w
 def test_solver_names_come_from_the_engine():
     """The CLI's backends and methods are the engine's (one helper), not a list of its own."""
     from camdyn.engine.tableau import TABLEAUS
-    from camdyn.runs.simulation import BACKENDS
+    from camdyn.engine import BACKENDS
 
     backends, methods = cli._solvers()
     assert tuple(backends) == tuple(BACKENDS) and set(methods) == set(TABLEAUS)

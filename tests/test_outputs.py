@@ -10,7 +10,7 @@ import pytest
 
 import camdyn
 from camdyn.io import files, metadata
-from camdyn.cli.commands import main
+from camdyn.cli import main
 from camdyn.model.rig import PARAMETERS
 
 xr = pytest.importorskip("xarray")

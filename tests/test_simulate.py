@@ -231,7 +231,7 @@ def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
     import argparse
     import time
 
-    from camdyn.cli import commands as cli
+    from camdyn.cli import common as cli
     monkeypatch.setattr(cli, "_progress_enabled", lambda args: False)  # as on a terminal
     with cli._busy("simulating", argparse.Namespace(), after=0.05) as share:
         share(0.5)  # before the bar first draws (after 0.05 s), which it then does every 0.5 s

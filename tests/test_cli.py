@@ -441,6 +441,25 @@ def test_simulate_and_sweep_save_netcdf_with_the_same_option():
         assert (args.netcdf if argv[0] == "simulate" else args.out) == "a.nc"
 
 
+@pytest.mark.parametrize("argv", [
+    ["sweep", "--speeds", "1300", "--revolutions", "2", "--transient-revolutions", "1"],
+    ["sweep", "--speeds", "1300", "--param", "k_s", "--values", "2000", "--revolutions", "2",
+     "--transient-revolutions", "1", "--samples-per-revolution", "8"],
+    ["simulate", "--speed-rpm", "1300", "--revolutions", "2", "--sample-rate-Hz", "1000"],
+    ["lyapunov", "--speed-rpm", "1300", "--revolutions", "2", "--transient-revolutions", "0", "--batches", "2"]])
+def test_every_command_that_runs_the_engine_takes_every_solver_option(argv, capsys):
+    """The solver options are built in one place for every command (the sweep once dropped
+    --max-step and --max-events): one switch allowed stops the run as MAX_EVENTS."""
+    code = main(["--no-progress", *argv, "--max-events", "1"])
+    out, err = capsys.readouterr()
+    if argv[0] == "sweep":
+        assert code == 3 and "1 MAX_EVENTS" in out, out
+    elif argv[0] == "simulate":
+        assert code == 3 and ": MAX_EVENTS (more regime switches than" in out, out
+    else:   # the exponents need the whole run: refused as bad input
+        assert code == 2 and "more regime switches than EventSettings.max_events" in err, err
+
+
 def _help(command, capsys):
     with pytest.raises(SystemExit):
         main([command, "--help"])

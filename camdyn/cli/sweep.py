@@ -5,7 +5,7 @@ import argparse
 import sys
 
 from .common import UsageError, _check_outputs, _parse_values
-from .options import _add_file, _add_physics, _add_solver, _rig, _scene
+from .options import _add_file, _add_physics, _add_solver, _backend, _rig, _scene, _solver_options
 from .parser import add_command
 from .resume import _resume_sweep
 from .sweeping import _executor, _sweep_interrupted, _sweep_module, _sweep_progress, _sweep_report
@@ -36,9 +36,7 @@ def cmd_sweep(args) -> int:
     if args.samples_per_revolution < 1:
         raise UsageError("--samples-per-revolution must be at least 1")
     _check_outputs(args, "out", "plot")
-    solver = dict(method=args.method, rtol=args.rtol, atol=args.atol)
-    if args.backend:
-        solver["backend"] = args.backend
+    solver = dict(options=_solver_options(args), backend=_backend(args))
     with _executor(args, sweeps) as executor, _sweep_interrupted(args, args.out):
         common = dict(executor=executor, progress=_sweep_progress(args), out=args.out, overwrite=args.overwrite,
                       invalid="skip" if args.skip_invalid else "raise", **solver)

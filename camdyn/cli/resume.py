@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .._checks import is_real
 from .common import UsageError, _check_outputs, _flag, _parse_values
 from .options import _FileOption, _rig
 from .sweeping import _executor, _sweep_interrupted, _sweep_progress, _sweep_report
@@ -107,7 +108,7 @@ def _same_setting(typed, recorded) -> bool:
         return typed.resolve() == recorded.resolve()
     if isinstance(typed, list) or isinstance(recorded, np.ndarray):
         return recorded is not None and np.array_equal(np.asarray(typed, dtype=float), np.asarray(recorded))
-    if isinstance(typed, (int, float)) and not isinstance(typed, bool) and recorded is not None:
+    if is_real(typed) and recorded is not None:
         return not isinstance(recorded, str) and float(typed) == float(recorded)
     return typed == recorded
 

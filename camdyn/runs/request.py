@@ -131,7 +131,7 @@ SPAN_KEYWORDS = tuple(f.name for f in fields(Span))
 SOLVER_KEYWORDS = {"method": "method", "rtol": "rtol", "atol": "atol", "max_step": "max_step", "events": "events",
                    "energy_ledger": "ledger", "step_control": "step_control"}
 #: the keywords run_request takes besides the loose ones
-WHOLE = ("span", "options", "y0", "backend", "stop")
+_WHOLE = ("span", "options", "y0", "backend", "stop")
 
 
 def run_request(*, span: Span | None = None, options: SolverOptions | None = None, y0=None,
@@ -166,7 +166,7 @@ def _refuse_loose(loose: Mapping, keywords, whole: str, kind: str) -> None:
 
 
 def _unknown(name: str, value) -> ParameterError:
-    valid = (*WHOLE, *SPAN_KEYWORDS, *SOLVER_KEYWORDS)
+    valid = (*_WHOLE, *SPAN_KEYWORDS, *SOLVER_KEYWORDS)
     close = difflib.get_close_matches(name, valid, n=1)
     problem = "is not a keyword of camdyn.simulate" + (f" (did you mean {close[0]!r}?)" if close else "")
     return ParameterError(name, value, f"one of {', '.join(valid)}", problem=problem)

@@ -6,7 +6,7 @@ import math
 import camdyn
 from camdyn import generated
 from camdyn.engine.config import METHODS as _METHODS
-from camdyn.runs.simulation import BACKENDS as _BACKENDS  # "compiled", "python"
+from camdyn.engine import BACKENDS as _BACKENDS  # "compiled", "python"
 
 RIG = camdyn.example_rig()
 

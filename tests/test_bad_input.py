@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import camdyn
-from camdyn.cli.commands import main as cli_main
+from camdyn.cli import main as cli_main
 from camdyn.errors import CamdynError, ParameterError
 from camdyn.model.rig import PARAMETERS
 from registry import BACKENDS, RIG

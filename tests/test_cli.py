@@ -10,8 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-from camdyn.cli import commands as cli
-from camdyn.cli.commands import main
+from camdyn.cli import app, common, model, options
+from camdyn.cli import main
 
 PNG = b"\x89PNG\r\n\x1a\n"
 QUICK = ["--speed-rpm", "1100", "--revolutions", "2", "--sample-rate-Hz", "5000"]  # impacting, < 1 s
@@ -280,7 +280,7 @@ def test_internal_errors_are_one_line_exit_5_and_traceback_on_request(monkeypatc
     def broken(args):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(cli, "cmd_scenes", broken)
+    monkeypatch.setattr(model, "cmd_scenes", broken)
     assert main(["scenes"]) == 5
     line = one_error_line(capsys, starts="camdyn: internal error")
     assert "boom" in line and "--traceback" in line
@@ -292,7 +292,7 @@ def test_interrupt_exits_130(monkeypatch, capsys):
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "cmd_scenes", interrupted)
+    monkeypatch.setattr(model, "cmd_scenes", interrupted)
     assert main(["scenes"]) == 130
     assert capsys.readouterr().err.strip() == "camdyn: interrupted"
 
@@ -312,12 +312,12 @@ def test_console_script_exit_code_and_no_traceback():
 
 
 def test_parse_values():
-    assert cli._parse_values("1:3:3", "x") == [1.0, 2.0, 3.0]
-    assert cli._parse_values("1,10", "x") == [1.0, 10.0]
-    assert np.allclose(cli._parse_values("1:100:3:log", "x"), [1, 10, 100])
+    assert common._parse_values("1:3:3", "x") == [1.0, 2.0, 3.0]
+    assert common._parse_values("1,10", "x") == [1.0, 10.0]
+    assert np.allclose(common._parse_values("1:100:3:log", "x"), [1, 10, 100])
     for bad in ("", "1:2", "1:2:0", "a,b", "0:1:3:log", "1:2:3:lin"):
-        with pytest.raises(cli.UsageError):
-            cli._parse_values(bad, "x")
+        with pytest.raises(common.UsageError):
+            common._parse_values(bad, "x")
 
 
 # ------------------------------------------------------------------ issue 14: messages (D)
@@ -367,11 +367,11 @@ def test_messages_name_the_option_suggest_and_point_at_the_commands_help(argv, w
 def test_solver_names_come_from_the_engine():
     """The CLI's backends and methods are the engine's (one helper), not a list of its own."""
     from camdyn.engine.tableau import TABLEAUS
-    from camdyn.runs.simulation import BACKENDS
+    from camdyn.engine import BACKENDS
 
-    backends, methods = cli._solvers()
+    backends, methods = options._solvers()
     assert tuple(backends) == tuple(BACKENDS) and set(methods) == set(TABLEAUS)
-    help_text = cli._parser().parse_args.__self__.commands["simulate"].format_help()
+    help_text = app._parser().parse_args.__self__.commands["simulate"].format_help()
     for name in (*backends, *methods):
         assert name in help_text
 
@@ -414,8 +414,8 @@ def test_spectrum_input_must_be_a_saved_run(name, words, tmp_path, capsys):
 
 # ------------------------------------------------------------------ values with a minus sign (F)
 def test_ranges_may_start_with_a_minus_sign(capsys):
-    args = cli._parser().parse_args(["sweep", "--speeds", "-1500:-1200:2"])
-    assert cli._parse_values(args.speeds, "--speeds") == [-1500.0, -1200.0]
+    args = app._parser().parse_args(["sweep", "--speeds", "-1500:-1200:2"])
+    assert common._parse_values(args.speeds, "--speeds") == [-1500.0, -1200.0]
     assert main(["contact-loss", "--k-s", "-500:8000:5:log"]) == 2
     assert "a log range needs positive ends" in one_error_line(capsys)  # read, then refused with the reason
     assert main(["contact-loss", "--k-s", "-500,8000"]) == 2
@@ -437,8 +437,27 @@ def test_spectrum_keeps_every_whole_period_after_the_transient(capsys):
 # ------------------------------------------------------------------ one name, honest help (H)
 def test_simulate_and_sweep_save_netcdf_with_the_same_option():
     for argv in (["simulate", "--speed-rpm", "1", "--netcdf", "a.nc"], ["sweep", "--speeds", "1", "--netcdf", "a.nc"]):
-        args = cli._parser().parse_args(argv)
+        args = app._parser().parse_args(argv)
         assert (args.netcdf if argv[0] == "simulate" else args.out) == "a.nc"
+
+
+@pytest.mark.parametrize("argv", [
+    ["sweep", "--speeds", "1300", "--revolutions", "2", "--transient-revolutions", "1"],
+    ["sweep", "--speeds", "1300", "--param", "k_s", "--values", "2000", "--revolutions", "2",
+     "--transient-revolutions", "1", "--samples-per-revolution", "8"],
+    ["simulate", "--speed-rpm", "1300", "--revolutions", "2", "--sample-rate-Hz", "1000"],
+    ["lyapunov", "--speed-rpm", "1300", "--revolutions", "2", "--transient-revolutions", "0", "--batches", "2"]])
+def test_every_command_that_runs_the_engine_takes_every_solver_option(argv, capsys):
+    """The solver options are built in one place for every command (the sweep once dropped
+    --max-step and --max-events): one switch allowed stops the run as MAX_EVENTS."""
+    code = main(["--no-progress", *argv, "--max-events", "1"])
+    out, err = capsys.readouterr()
+    if argv[0] == "sweep":
+        assert code == 3 and "1 MAX_EVENTS" in out, out
+    elif argv[0] == "simulate":
+        assert code == 3 and ": MAX_EVENTS (more regime switches than" in out, out
+    else:   # the exponents need the whole run: refused as bad input
+        assert code == 2 and "more regime switches than EventSettings.max_events" in err, err
 
 
 def _help(command, capsys):
@@ -449,10 +468,10 @@ def _help(command, capsys):
 
 def test_backend_and_method_help_state_the_real_defaults_and_names(capsys):
     text = _help("simulate", capsys)
-    backends, methods = cli._solvers()
+    backends, methods = options._solvers()
     for command in ("simulate", "sweep"):
         text = " ".join(_help(command, capsys).split())
-        assert f"(default: {cli._default_backend()};" in text and "{default_backend}" not in text
+        assert f"(default: {options._default_backend()};" in text and "{default_backend}" not in text
         assert f"{', '.join(backends)} (default" in text and f"{', '.join(methods)} (default: DOP853)" in text
 
 
@@ -533,11 +552,11 @@ def test_every_piece_of_advice_a_command_prints_is_one_of_its_options(command, e
     from camdyn.orbits.continuation import ContinuationOutcome
     from camdyn.orbits.shooting import OrbitOutcome
     from camdyn.outcome import Outcome
-    args = cli._parser().parse_args([command, *extra])
+    args = app._parser().parse_args([command, *extra])
     enums = (ContinuationOutcome, OrbitOutcome, Outcome) if command == "continue" else (Outcome,)
     for enum in enums:
         for outcome in enum:
-            text = cli._in_flags(outcome.message, args)
+            text = common._in_flags(outcome.message, args)
             left = [w for w in _words_left(text) if w not in ("t_end", "n T")]
             assert not left, (command, outcome.name, left, text)
             assert "=camdyn" not in text and "='" not in text, (command, outcome.name, text)

@@ -24,6 +24,7 @@ MODULES = [
     "model.presets",
     "model.ondemand",
     "runs.simulation",
+    "runs.request",
     "runs.result",
     "runs.stopping",
     "runs.quasistatic",

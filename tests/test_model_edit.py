@@ -41,7 +41,7 @@ import pytest
 import camdyn
 from camdyn.model import presets
 from camdyn.model import rig as rig_module
-from camdyn.cli.commands import main
+from camdyn.cli import main
 from camdyn.errors import ParameterError
 
 sp = pytest.importorskip("sympy")

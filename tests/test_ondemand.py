@@ -11,7 +11,7 @@ import pytest
 
 import camdyn
 from camdyn.model import ondemand
-from camdyn.cli.commands import main
+from camdyn.cli import main
 from camdyn.errors import SceneError
 from camdyn.model.model import Model
 from camdyn.model.scene import variational_kernels

@@ -10,7 +10,7 @@ import pytest
 
 import camdyn
 from camdyn.io import files, metadata
-from camdyn.cli.commands import main
+from camdyn.cli import main
 from camdyn.model.rig import PARAMETERS
 
 xr = pytest.importorskip("xarray")
@@ -60,6 +60,36 @@ def test_a_saved_run_runs_again_to_the_same_result(saved):
     assert np.array_equal(again.alpha, saved["alpha"].values)
     assert np.array_equal(again.F_n, saved["F_n"].values)
     assert np.array_equal(again.impacts(), saved["impact_t"].values)
+
+
+def test_a_saved_run_runs_again_with_other_options_given_whole(saved):
+    """options= replaces the saved method and tolerances (not refused as given twice); the saved
+    span stays."""
+    from camdyn.engine import SolverOptions
+    from camdyn.runs.request import Span
+
+    saved_run = metadata.from_attributes(saved.attrs)
+    options = SolverOptions(method="RK45", rtol=1e-9)
+    again = saved_run.simulate(options=options)
+    direct = camdyn.simulate(saved_run.rig, saved_run.scene, saved_run.cam, options=options,
+                             span=Span(revolutions=1.0, sample_rate_Hz=4000.0))
+    assert np.array_equal(again.t, saved["t"].values) and np.array_equal(again.alpha, direct.alpha)
+    assert not np.array_equal(again.alpha, saved["alpha"].values)   # another method: other numbers
+
+
+def test_settings_given_as_objects_are_recorded_as_the_keywords_that_build_them(saved):
+    from camdyn.engine import EventSettings, SolverOptions
+    from camdyn.runs.request import Span
+
+    options = SolverOptions(rtol=1e-9, events=EventSettings(max_events=10), step_control="scipy", ledger=True)
+    settings = {"backend": "python", "span": Span(t_end=0.5, sample_rate_Hz=100.0, t_start=2.0), "options": options}
+    result = metadata.from_attributes(saved.attrs).simulate(span=Span(t_end=0.01, sample_rate_Hz=1000.0))
+    a = metadata.run_attributes(result, camdyn.example_rig(), settings=settings)
+    solver = {k[len("solver_"):]: v for k, v in a.items() if k.startswith("solver_")}
+    assert solver == {"backend": "python", "sample_rate_Hz": 100.0, "method": "DOP853", "rtol": 1e-9, "atol": 1e-12,
+                      "events": repr(EventSettings(max_events=10)), "energy_ledger": 1, "step_control": "scipy",
+                      "t_end": 0.5, "t_start": 2.0}
+    assert list(solver)[:5] == ["backend", "sample_rate_Hz", "method", "rtol", "atol"]
 
 
 def test_a_rig_file_is_recorded_by_its_path(tmp_path):

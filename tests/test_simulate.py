@@ -231,7 +231,7 @@ def test_the_cli_bar_shows_the_percentage(capsys, monkeypatch):
     import argparse
     import time
 
-    from camdyn.cli import commands as cli
+    from camdyn.cli import common as cli
     monkeypatch.setattr(cli, "_progress_enabled", lambda args: False)  # as on a terminal
     with cli._busy("simulating", argparse.Namespace(), after=0.05) as share:
         share(0.5)  # before the bar first draws (after 0.05 s), which it then does every 0.5 s
@@ -261,3 +261,63 @@ def test_outputs_are_computed_when_first_read_and_equal_the_kernel_at_the_sample
     again = pickle.loads(pickle.dumps(r))
     assert type(again.outputs) is dict and again.outputs.keys() == r.outputs.keys()
     np.testing.assert_array_equal(again.F_n, r.F_n)
+
+
+# --- what a run is asked for: simulate's keywords build a Span and a SolverOptions once -----------
+def test_loose_keywords_and_the_objects_given_whole_are_the_same_run():
+    """``revolutions=..., rtol=..., energy_ledger=...`` build the Span and SolverOptions that
+    ``span=`` and ``options=`` pass whole: the same run, bit for bit, and the same request."""
+    from camdyn.engine import EventSettings, SolverOptions
+    from camdyn.runs.request import Span, run_request
+
+    loose = dict(revolutions=1.5, sample_rate_Hz=4000.0, t_start=0.25, method="RK45", rtol=1e-9, atol=1e-13,
+                 max_step=1e-3, events=EventSettings(max_events=5000), energy_ledger=True, step_control="scipy")
+    span = Span(revolutions=1.5, sample_rate_Hz=4000.0, t_start=0.25)
+    options = SolverOptions(method="RK45", rtol=1e-9, atol=1e-13, max_step=1e-3, events=EventSettings(max_events=5000),
+                            ledger=True, step_control="scipy")
+    assert run_request(**loose) == run_request(span=span, options=options)
+    a = camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=1100, **loose)
+    b = camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=1100, span=span, options=options)
+    assert a.ok and a.switches and a.t[0] == 0.25
+    for name in ("t", "alpha", "alpha_dot", "work_in"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert a.stats["steps"] == b.stats["steps"] and a.stats["rejected_steps"] == b.stats["rejected_steps"]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(revolution=2), r"^revolution is not a keyword of camdyn.simulate \(did you mean 'revolutions'\?\): "
+                         r"must be one of span, options, y0, backend, stop, t_end, revolutions, .*energy_ledger"),
+    (dict(ledger=True, revolutions=2), r"^ledger is not a keyword .*did you mean 'energy_ledger'"),
+    (dict(span="span", t_end=0.1), r"^t_end = 0.1 is given beside span=: must be set in the Span or given as a "
+                                   r"keyword, not both"),
+    (dict(revolutions=2, options="options", rtol=1e-9), r"^rtol = 1e-09 is given beside options="),
+    (dict(revolutions=2, options="options"), r"^options = 'options' is not valid: must be a camdyn.engine.SolverOptions"),
+    (dict(span=2.0), r"^span = 2.0 is out of range: must be a camdyn.runs.Span"),
+    (dict(revolutions=2, stop=16), r"^stop = 16 .*must be None or a camdyn.StopWhenPeriodic"),
+])
+def test_an_unknown_doubled_or_wrong_keyword_is_refused_naming_it(kwargs, match, monkeypatch):
+    """Before any work: no model is built."""
+    import camdyn.runs.simulation
+    from camdyn.errors import ParameterError
+
+    def no_model(*args):
+        raise AssertionError("a model was built")
+
+    monkeypatch.setattr(camdyn.runs.simulation, "checked_model", no_model)
+    with pytest.raises(ParameterError, match=match):
+        camdyn.simulate(RIG, camdyn.Scene(), speed_rpm=300, **kwargs)
+
+
+def test_the_span_is_checked_and_stored_as_floats():
+    from camdyn.errors import ParameterError
+    from camdyn.runs.request import Span
+
+    span = Span(revolutions=np.int64(3), sample_rate_Hz=np.float32(1000), t_start=1)
+    assert (span.revolutions, span.sample_rate_Hz, span.t_start) == (3.0, 1000.0, 1.0)
+    assert all(type(v) is float for v in (span.revolutions, span.sample_rate_Hz, span.t_start))
+    for kwargs, match in ((dict(), "t_end is not given: exactly one of"), (dict(t_end=1.0, revolutions=2), "exactly one"),
+                          (dict(revolutions=True), "revolutions = True is not a real number"),
+                          (dict(t_end=math.inf), r"t_end = inf is out of range: must be t_end > 0 \(s\)"),
+                          (dict(t_end=1.0, t_start=math.nan), "t_start = nan is out of range: must be a finite time")):
+        with pytest.raises(ParameterError, match=match):
+            Span(**kwargs)

@@ -259,7 +259,7 @@ def _files_under(folder):
 
 
 def test_an_installed_camdyn_writes_to_the_working_folder_never_into_the_package(tmp_path, monkeypatch, capsys):
-    from camdyn.cli.commands import main
+    from camdyn.cli import main
 
     package = Path(camdyn.__file__).resolve().parent
     before = _files_under(package)

@@ -192,13 +192,46 @@ def test_a_rig_too_stiff_for_an_explicit_method_is_an_invalid_point():
 
 @pytest.mark.parametrize("settings, error, match", [
     (dict(revolutions=2, rtol=1.0), ParameterError, "rtol"),
-    (dict(revolution=3), TypeError, "not a keyword of camdyn.simulate"),
+    (dict(revolution=3), ParameterError, "revolution is not a keyword of camdyn.simulate .did you mean .revolutions.?"),
     (dict(revolutions=2, t_end=1.0), ParameterError, "t_end"), (dict(revolutions=-1), ParameterError, "revolutions"),
     (dict(revolutions=2, backend="gpu"), ParameterError, "backend"),
     (dict(revolutions=2, y0=[1.0]), ParameterError, "y0")])
 def test_settings_shared_by_every_point_are_checked_at_once(settings, error, match):
     with pytest.raises(error, match=match):
         S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, progress=False, **settings)
+
+
+@pytest.mark.parametrize("settings", [dict(revolutions=2, rtol=1.0), dict(revolution=3),
+                                      dict(revolutions=2, t_end=1.0), dict(revolutions=-1),
+                                      dict(revolutions=2, backend="gpu"), dict(revolutions=2, y0=[1.0]),
+                                      dict(revolutions=2, options=camdyn.engine.SolverOptions(), atol=1e-9),
+                                      dict(t_end=0.1, sample_rate_Hz=0)])
+def test_a_sweep_refuses_the_settings_simulate_refuses_with_its_message(settings):
+    """One builder (camdyn.runs.request.run_request) for both: the same error, word for word."""
+    with pytest.raises(ParameterError) as direct:
+        camdyn.simulate(RIG, SCENE, speed_rpm=900.0, **settings)
+    with pytest.raises(ParameterError) as swept:
+        S.sweep(RIG, SCENE, {"speed_rpm": [900.0]}, progress=False, **settings)
+    assert str(swept.value) == str(direct.value)
+
+
+def test_span_and_options_given_whole_run_the_same_points_and_are_recorded_as_keywords(serial, tmp_path):
+    """A sweep takes simulate's span= and options= as simulate does; the file records them as the
+    loose keywords (method and tolerances always, max_step where it is not the default)."""
+    from camdyn.engine import SolverOptions
+    from camdyn.runs.request import Span
+
+    out = tmp_path / "whole.nc"
+    options = SolverOptions(rtol=1e-8, max_step=0.5)   # longer than a run: the same steps as without it
+    ds = S.sweep(RIG, SCENE, GRID, S.Summary(1), span=Span(revolutions=2), options=options,
+                 samples_per_revolution=32, progress=False, out=out)
+    xr.testing.assert_equal(ds, serial)   # values, not the attributes
+    a = ds.attrs
+    assert (a["simulate_revolutions"], a["simulate_method"], a["simulate_rtol"], a["simulate_atol"]) == \
+        (2.0, "DOP853", 1e-8, 1e-12)
+    assert a["simulate_max_step"] == 0.5 and "simulate_sample_rate_Hz" not in a   # set per point
+    assert not [k for k in a if k in ("simulate_span", "simulate_options")]
+    xr.testing.assert_equal(S.resume(out, progress=False), serial)   # finished: read back
 
 
 def test_a_point_that_raises_in_a_worker_is_recorded_and_the_sweep_completes(serial, caplog):

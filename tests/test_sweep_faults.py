@@ -15,8 +15,8 @@ import pytest
 
 import camdyn
 from camdyn.sweep import api as S
-from camdyn.cli import commands as cli
-from camdyn.cli.commands import main
+from camdyn.cli import app, sweeping
+from camdyn.cli import main
 from registry import RIG
 from sweep_faults import Faulty, InterruptAfter, WithDeathSignal
 
@@ -263,8 +263,8 @@ def test_cli_report_says_how_to_run_the_points_not_run(tmp_path, capsys):
     out = tmp_path / "map.nc"
     with InterruptAfter(0) as executor, pytest.raises(KeyboardInterrupt):
         S.sweep(RIG, SCENE, GRID, S.Summary(1), executor=executor, out=out, **KW)
-    args = cli._parser().parse_args(["sweep", "--resume", str(out), "--jobs", "2"])
-    assert cli._sweep_report(S.load_partial(out), args, S, str(out)) == 3
+    args = app._parser().parse_args(["sweep", "--resume", str(out), "--jobs", "2"])
+    assert sweeping._sweep_report(S.load_partial(out), args, S, str(out)) == 3
     report = capsys.readouterr().out
     assert "12 points, 0 without impacts after the transient, 0 impacting, 12 did not succeed" in report
     assert f"the 12 NOT_RUN points are kept for later: 'camdyn sweep --resume {out} --jobs 2' runs them" in report
@@ -281,7 +281,7 @@ def test_cli_lists_invalid_points_or_skips_them(tmp_path, capsys, monkeypatch):
     assert "3 of 4 grid points are invalid (listed above); --skip-invalid runs the others" in err
     assert not list(tmp_path.iterdir())
     figures = []
-    monkeypatch.setattr(cli, "_save_figure", lambda fig, path: figures.append(fig))
+    monkeypatch.setattr(sweeping, "_save_figure", lambda fig, path: figures.append(fig))
     assert main(args + ["--skip-invalid", "--out", str(tmp_path / "e.nc"), "--plot", str(tmp_path / "e.png")]) == 0
     out = capsys.readouterr().out
     assert "4 points, 1 without impacts after the transient, 0 impacting, 3 skipped as invalid (--skip-invalid), " \

@@ -1,6 +1,6 @@
-"""The ``camdyn`` command (commands: the parser and the commands)."""
+"""The ``camdyn`` command (app: the parser and main; one module per family of commands)."""
 from __future__ import annotations
 
-from .commands import main
+from .app import main
 
 __all__ = ["main"]

@@ -1,6 +1,6 @@
 """``python -m camdyn.cli``: the ``camdyn`` command."""
 import sys
 
-from .commands import main
+from .app import main
 
 sys.exit(main())

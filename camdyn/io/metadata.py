@@ -174,8 +174,9 @@ def run_attributes(result, rig=None, *, rig_source: str | None = None,
         Where the rig came from; by default ``rig.origin`` (a preset's name or a rig file's path).
     settings : mapping, optional
         The keyword arguments given to :func:`camdyn.simulate` (``method``, ``rtol``,
-        ``atol``, ``backend``, ``sample_rate_Hz``, ``revolutions`` or ``t_end``...);
-        default ``result.meta["settings"]`` when present.
+        ``atol``, ``backend``, ``sample_rate_Hz``, ``revolutions`` or ``t_end``...; a ``span``
+        or ``options`` given whole is recorded as those loose keywords:
+        :func:`camdyn.runs.request.loose_keywords`); default ``result.meta["settings"]`` when present.
 
     Returns
     -------
@@ -193,11 +194,12 @@ def run_attributes(result, rig=None, *, rig_source: str | None = None,
     from .._version import __version__
     from ..errors import ParameterError
     from ..model.rig import Rig
+    from ..runs.request import loose_keywords
 
     rig = rig if rig is not None else result.meta.get("rig")
     if not isinstance(rig, Rig):
         raise ParameterError("rig", None, "the Rig the run used (result.meta holds only its name)")
-    settings = settings if settings is not None else result.meta.get("settings", {})
+    settings = loose_keywords(settings if settings is not None else result.meta.get("settings", {}))
     cam = result.meta.get("cam")
     scene = scene_options(result.scene)
     title = describe_scene(result.scene) + (f", {describe_cam(cam)}" if describe_cam(cam) else "")
@@ -226,10 +228,15 @@ class SavedRun:
     settings: dict = field(default_factory=dict)
 
     def simulate(self, **overrides):
-        """:func:`camdyn.simulate` with the saved rig, scene, cam and settings (``overrides`` win)."""
+        """:func:`camdyn.simulate` with the saved rig, scene, cam and settings (``overrides`` win;
+        a ``span`` or ``options`` among them replaces the saved settings of its fields)."""
+        from ..runs.request import SOLVER_KEYWORDS, SPAN_KEYWORDS
         from ..runs.simulation import simulate
 
-        return simulate(self.rig, self.scene, self.cam, **{**self.settings, **overrides})
+        replaced = {"span": SPAN_KEYWORDS, "options": SOLVER_KEYWORDS}
+        dropped = {k for whole, keys in replaced.items() if whole in overrides for k in keys}
+        settings = {k: v for k, v in self.settings.items() if k not in dropped}
+        return simulate(self.rig, self.scene, self.cam, **{**settings, **overrides})
 
 
 def _python(value):

@@ -1,5 +1,6 @@
-"""Runs of the hybrid model: simulate and its Result (simulation, result), long runs in pieces
-(pieces), runs that stop once periodic (stopping), the quasi-static contact orbit (quasistatic)."""
+"""Runs of the hybrid model: simulate and its Result (simulation, result), what a run is asked
+for (request: Span, RunRequest), long runs in pieces (pieces), runs that stop once periodic
+(stopping), the quasi-static contact orbit (quasistatic)."""
 from __future__ import annotations
 
 from .._lazy import lazy
@@ -10,10 +11,11 @@ _EXPORTS = {
     'QuasiStaticOrbit': '.quasistatic',
     'QuasiStaticOutcome': '.quasistatic',
     'Result': '.result',
+    'RunRequest': '.request',
     'SETTLE_BLOCKS': '.stopping',
+    'Span': '.request',
     'StopWhenPeriodic': '.stopping',
     'Watch': '.stopping',
-    'check_start': '.simulation',
     'checked_model': '.simulation',
     'contact_mode': '.quasistatic',
     'extend': '.stopping',
@@ -21,13 +23,12 @@ _EXPORTS = {
     'per_revolution': '.stopping',
     'quasi_static_orbit': '.quasistatic',
     'rigid_kinematics': '.quasistatic',
-    'run_duration': '.simulation',
-    'sample_count': '.simulation',
+    'run': '.simulation',
+    'run_request': '.request',
     'section_state': '.quasistatic',
     'settling': '.stopping',
     'simulate': '.simulation',
     'solve_at': '.quasistatic',
-    'solver_options': '.simulation',
 }
 
 __getattr__, __dir__ = lazy(__name__, _EXPORTS)

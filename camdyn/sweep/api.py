@@ -51,13 +51,14 @@ from typing import Callable, ClassVar, Mapping, Sequence
 
 import numpy as np
 
+from .._checks import flag, integer
 from ..analysis.statics import contact_loss_speed, residual_stats
 from ..model.cam import ConstantSpeed
 from ..errors import CamdynError, ParameterError
 from ..runs.result import Result
 from ..model.rig import Rig
 from ..model.scene import Scene
-from ..runs.simulation import BACKENDS
+from ..runs.request import DEFAULT_BACKEND
 from ..runs.stopping import StopWhenPeriodic
 from .check import InvalidGridError, check_by_running, check_grid, check_settings
 from .dispatch import Dispatch, chunks_of, process_pool, run_serial, worker_count
@@ -101,7 +102,8 @@ class PoincareSection:
         "impacts_per_rev": Summary.variables["impacts_per_rev"]}
 
     def __call__(self, result: Result) -> dict:
-        per_rev = max(1, int(round(result.period * _sample_rate(result))))
+        rate = _sample_rate(result)   # NaN for a run that stopped before its second sample
+        per_rev = max(1, int(round(result.period * rate))) if math.isfinite(rate) else 1
         section = result.alpha[::per_rev][self.transient_revolutions:]
         summary = Summary(self.transient_revolutions)(result)
         return {"alpha_section": (("revolution",), section), "impacts_per_rev": summary["impacts_per_rev"]}
@@ -121,14 +123,9 @@ class _RunOptions:
     retries: int = 2
 
     def __post_init__(self):
-        if self.chunksize is not None and not _whole(self.chunksize, 1):
-            raise ParameterError("chunksize", self.chunksize, "an integer >= 1 (points per task), or None")
-        if not _whole(self.retries, 0):
-            raise ParameterError("retries", self.retries, "an integer >= 0")
-
-
-def _whole(value, least: int) -> bool:
-    return not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= least
+        if self.chunksize is not None:
+            integer("chunksize", self.chunksize, "an integer >= 1 (points per task), or None", lambda n: n >= 1)
+        integer("retries", self.retries, "an integer >= 0", lambda n: n >= 0)
 
 
 def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: Callable = Summary(), *,
@@ -176,9 +173,12 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
         ``points_stopped_converged``; the saving is logged.  A run that has not converged is
         never stopped.  Default off (on in :func:`bifurcation`).
     **simulate_kwargs
-        Given to :func:`camdyn.simulate` at every point (``revolutions``, ``rtol``,
-        ``backend`` -- "compiled" unless given -- ``cam`` or ``speed_rpm`` when the speed is
-        not a grid axis, ...).
+        simulate's keywords for every point (``span`` or ``revolutions``/``t_end``...,
+        ``options`` or ``rtol``..., ``backend`` -- "compiled" unless given -- ``y0``, and ``cam``
+        or ``speed_rpm`` when the speed is not a grid axis): the run's
+        :class:`~camdyn.runs.request.RunRequest` is built from them once, as simulate builds it,
+        and a bad one raises before any work.  With ``samples_per_revolution`` the span's sample
+        rate is each point's own.
 
     Returns
     -------
@@ -237,8 +237,8 @@ def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finis
     kwargs = dict(kwargs)
     if not callable(measure):
         raise ParameterError("measure", measure, "a callable measure(result) -> dict")
-    if samples_per_revolution is not None and not _whole(samples_per_revolution, 1):
-        raise ParameterError("samples_per_revolution", samples_per_revolution, "an integer >= 1")
+    if samples_per_revolution is not None:
+        integer("samples_per_revolution", samples_per_revolution, "an integer >= 1", lambda n: n >= 1)
     if "speed_rpm" in kwargs:
         if "speed_rpm" in axes or "cam" in kwargs:
             raise ParameterError("speed_rpm", kwargs["speed_rpm"], "not given with a speed_rpm axis or cam=")
@@ -249,8 +249,7 @@ def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finis
         raise ParameterError("speed_rpm", None, "a grid axis 'speed_rpm', or cam=/speed_rpm= for every point")
     if "speed_rpm" in axes and scene.motion != "constant":
         raise ParameterError("grid", "speed_rpm", f"no speed_rpm axis with the scene's {scene.motion!r} motion")
-    if "backend" not in kwargs and "compiled" in BACKENDS:
-        kwargs["backend"] = "compiled"
+    kwargs.setdefault("backend", DEFAULT_BACKEND)   # recorded in the file, whatever the default
     return SweepSpec(rig, scene, axes, measure, kwargs, samples_per_revolution, finish)
 
 
@@ -262,8 +261,7 @@ class _Output:
     overwrite: bool = False
 
     def check(self) -> None:
-        if not isinstance(self.overwrite, bool):
-            raise ParameterError("overwrite", self.overwrite, "True or False")
+        flag("overwrite", self.overwrite)
         if self.out is not None:
             check_out(self.out, self.overwrite)
 
@@ -362,8 +360,7 @@ def bifurcation(rig: Rig, scene: Scene, speeds_rpm: Sequence[float], *, revoluti
     remaining revolutions are its converged cycle, repeated (``stop_period`` says which
     points stopped, ``revolutions_run`` how far each ran); ``stop=None`` runs every point to
     the end.  ``kwargs`` go to :func:`sweep` (``executor``, ``out``, ``rtol``...)."""
-    if isinstance(revolutions, bool) or not isinstance(revolutions, int) or revolutions < 1:
-        raise ParameterError("revolutions", revolutions, "an integer >= 1")
+    revolutions = integer("revolutions", revolutions, "an integer >= 1", lambda n: n >= 1)
     if not 0 <= transient_revolutions < revolutions:
         raise ParameterError("transient_revolutions", transient_revolutions, f"0 <= it < revolutions ({revolutions})")
     return sweep(rig, scene, {"speed_rpm": speeds_rpm}, PoincareSection(transient_revolutions),

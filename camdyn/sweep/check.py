@@ -1,30 +1,32 @@
 """Every point of a sweep checked before any work, with the checks :func:`camdyn.simulate` makes.
 
-The settings shared by every point (simulate's keywords) are checked once: a bad one raises at
-once.  The grid is checked point by point, by building what simulate builds: the point's rig
-(``Rig.replace`` validates every parameter), its cam (``ConstantSpeed`` validates the speed),
-the :class:`camdyn.model.model.Model` of rig, scene and cam (geometry, friction lock, static
-equilibrium, the fastest rate of its linearized motion: ``checked_model``), and the run-length limits of :mod:`camdyn.runs.simulation` (a cam period for
-``revolutions``, at most ``MAX_CONTACT_PERIODS`` periods of the contact mode, at most
-``MAX_SAMPLES`` samples).  A Model is built once per distinct rig of the grid, with one of
+The settings shared by every point (simulate's keywords) are checked once, by building the
+:class:`~camdyn.runs.request.RunRequest` of the sweep as simulate builds its own
+(:attr:`SweepSpec.request`): a bad one raises at once.  The grid is checked point by point, by
+building what simulate builds: the point's rig (``Rig.replace`` validates every parameter), its
+cam (``ConstantSpeed`` validates the speed), the :class:`camdyn.model.model.Model` of rig, scene
+and cam (geometry, friction lock, static equilibrium, the fastest rate of its linearized motion:
+``checked_model``), and the run-length limits of the point's :class:`~camdyn.runs.request.Span`
+(a cam period for ``revolutions``, at most ``MAX_CONTACT_PERIODS`` periods of the contact mode, at
+most ``MAX_SAMPLES`` samples).  A Model is built once per distinct rig of the grid, with one of
 the grid's cams: it depends on the cam only through its kind and constants, which every cam of
 a grid shares; what joins a rig to a speed is the run-length limits, checked per point.
 What only the backend checks (its methods, the scenes and cam motions it runs) is caught by
-:func:`check_by_running`: simulate itself, for a moment, at one valid point.  Anything all this
+:func:`check_by_running`: the run itself, for a moment, at one valid point.  Anything all this
 misses still fails inside the run, where the point is recorded as ERROR.
 """
 from __future__ import annotations
 
-import inspect
+import dataclasses
 import itertools
 import math
 
 import numpy as np
 
-from ..model.cam import ConstantSpeed
 from ..errors import CamdynError, ParameterError
-from ..runs.simulation import (BACKENDS, check_start, checked_model, run_duration, sample_count, simulate,
-                               solver_options)
+from ..model.cam import ConstantSpeed
+from ..runs.request import Span
+from ..runs.simulation import checked_model, run
 from .spec import CAM_NAMES, SweepSpec
 
 #: lines of an InvalidGridError's message at the most (its ``invalid`` lists every point)
@@ -51,48 +53,24 @@ class InvalidGridError(CamdynError, ValueError):
 
 def check_settings(spec: SweepSpec) -> None:
     """Check simulate's keywords shared by every point (raises at once: no point could run)."""
-    signature = inspect.signature(simulate)
-    unknown = [k for k in spec.settings if k not in signature.parameters or k in ("rig", "scene")]
-    if unknown:
-        raise TypeError(f"sweep: {unknown[0]!r} is not a keyword of camdyn.simulate "
-                        f"({', '.join(list(signature.parameters)[2:])})")
     if spec.samples_per_revolution is not None and "sample_rate_Hz" in spec.settings:
         raise ParameterError("samples_per_revolution", spec.samples_per_revolution, "not given with sample_rate_Hz")
-    args = signature.bind(spec.rig, spec.scene, **spec.settings)
-    args.apply_defaults()
-    a = args.arguments
-    if a["backend"] not in BACKENDS:
-        raise ParameterError("backend", a["backend"], f"one of {BACKENDS}")
-    if (a["t_end"] is None) == (a["revolutions"] is None):
-        raise ParameterError("t_end", a["t_end"], "exactly one of t_end (s) or revolutions")
-    for name in ("t_end", "revolutions") + (() if spec.samples_per_revolution else ("sample_rate_Hz",)):
-        if a[name] is not None:
-            _positive(name, a[name])
-    check_start(a["t_start"], a["y0"])
-    solver_options(a["method"], a["rtol"], a["atol"], a["max_step"], a["events"], a["energy_ledger"],
-                   a["step_control"])
+    spec.request  # built from the settings by simulate's own run_request: a bad one raises here
 
 
 def check_by_running(spec: SweepSpec, index: int) -> None:
-    """simulate at one valid point for a moment (one sample): a setting that only the backend
+    """The run at one valid point for a moment (one sample): a setting that only the backend
     rejects raises here, once, rather than at every point.  Other exceptions are left to the
     point's own run (recorded as ERROR there)."""
-    rig, cam, kwargs = spec.inputs(index)
-    kwargs.pop("revolutions", None)
-    kwargs["t_end"] = 1e-6 * (cam.period if math.isfinite(cam.period) else 1.0)
+    rig, cam, request = spec.inputs(index)
+    moment = Span(t_end=1e-6 * (cam.period if math.isfinite(cam.period) else 1.0),
+                  sample_rate_Hz=request.span.sample_rate_Hz, t_start=request.span.t_start)
     try:
-        simulate(rig, spec.scene, cam, **kwargs)
+        run(rig, spec.scene, cam, dataclasses.replace(request, span=moment))
     except CamdynError:
         raise
     except Exception:  # not a setting: the point's own run will record it
         pass
-
-
-def _positive(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not math.isfinite(value) or value <= 0:
-        raise ParameterError(name, value, f"{name} > 0")
-    return float(value)
 
 
 def check_grid(spec: SweepSpec) -> tuple[dict[int, str], list[str]]:
@@ -149,21 +127,15 @@ def _run_limits(spec: SweepSpec, rig, cam) -> str:
     """The checks of camdyn.simulate that join a rig to a cam: run length and sample count."""
     _, vartheta = rig
     per_rev = spec.samples_per_revolution
-    fs = per_rev / cam.period if per_rev is not None else spec.settings.get("sample_rate_Hz",
-                                                                             _default("sample_rate_Hz"))
     try:
-        duration = run_duration(cam, vartheta, spec.settings.get("t_end"), spec.settings.get("revolutions"))
-        if per_rev is not None and not (math.isfinite(fs) and fs > 0):
-            raise ParameterError("sample_rate_Hz", fs, "sample_rate_Hz > 0 (samples_per_revolution needs a "
-                                 "cam period)")
-        sample_count(duration, fs)
+        duration = spec.request.span.duration(cam, vartheta)
+        fs = per_rev / cam.period if per_rev is not None else None
+        if fs is not None and not (math.isfinite(fs) and fs > 0):
+            raise ParameterError("sample_rate_Hz", fs, "sample_rate_Hz > 0 (samples_per_revolution needs a cam period)")
+        spec.request_at(cam).span.samples(duration)
     except ParameterError as exc:
         return str(exc)
     return ""
-
-
-def _default(name: str):
-    return inspect.signature(simulate).parameters[name].default
 
 
 def _group_lines(spec: SweepSpec, reasons: dict, at: list, others: list | int | None, kind: str) -> list[str]:

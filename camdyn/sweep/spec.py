@@ -10,18 +10,21 @@ only on the spec and its index, never on the chunk or the worker that ran it.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..model.cam import ConstantSpeed
 from ..errors import ParameterError
-from ..outcome import Outcome
+from ..model.cam import ConstantSpeed
 from ..model.rig import Rig
 from ..model.scene import Scene
-from ..runs.simulation import simulate
+from ..outcome import Outcome
+from ..runs.request import RunRequest, loose_keywords, run_request
+from ..runs.simulation import run
 
 #: grid names that are not rig parameters
 CAM_NAMES = ("speed_rpm",)
@@ -42,7 +45,8 @@ class SweepSpec:
     """One sweep: ``simulate(rig with the point's parameters, scene, cam, **settings)`` at every
     point of the outer product of ``axes``, measured by ``measure``.
 
-    ``settings`` are simulate's keywords (with ``cam`` when the speed is not a grid axis);
+    ``settings`` are simulate's keywords as given (with ``cam`` when the speed is not a grid
+    axis): the sweep's record; what runs is :attr:`request`, built from them once.
     ``samples_per_revolution`` sets each point's sample rate from its own cam period;
     ``finish(dataset, spec)``, if given, adds derived variables to the assembled Dataset.
     """
@@ -75,16 +79,40 @@ class SweepSpec:
     def label(self, index: int) -> str:
         return ", ".join(f"{k}={v:g}" for k, v in self.values(index).items())
 
+    @cached_property
+    def request(self) -> RunRequest:
+        """The request every point shares, built from ``settings`` by simulate's own
+        :func:`~camdyn.runs.request.run_request` (so checked by it, once)."""
+        return run_request(**{k: v for k, v in self.settings.items() if k != "cam"})
+
+    def __getstate__(self) -> dict:
+        """Pickled without :attr:`request` (built again from ``settings`` where it is read)."""
+        return {k: v for k, v in self.__dict__.items() if k != "request"}
+
+    def record(self) -> dict:
+        """simulate's settings as the sweep's file records them: the keywords as given, a span or
+        options given whole spelled out in loose keywords (:func:`~camdyn.runs.request.loose_keywords`;
+        no sample rate with ``samples_per_revolution``, which sets it per point)."""
+        out = loose_keywords(self.settings)
+        if self.samples_per_revolution is not None:
+            out.pop("sample_rate_Hz", None)
+        return out
+
+    def request_at(self, cam) -> RunRequest:
+        """The request of a point driven by ``cam``: the shared one, sampled
+        ``samples_per_revolution`` times per cam period when that is given."""
+        if self.samples_per_revolution is None:
+            return self.request
+        span = dataclasses.replace(self.request.span, sample_rate_Hz=self.samples_per_revolution / cam.period)
+        return dataclasses.replace(self.request, span=span)
+
     def inputs(self, index: int):
-        """(rig, cam, simulate keywords) of one point; the rig and cam validate themselves."""
+        """(rig, cam, request) of one point; the rig, cam and request validate themselves."""
         values = self.values(index)
         speed = values.pop("speed_rpm", None)
         rig = self.rig.replace(**values) if values else self.rig
-        kwargs = dict(self.settings)
-        cam = ConstantSpeed(speed) if speed is not None else kwargs.pop("cam")
-        if self.samples_per_revolution is not None:
-            kwargs["sample_rate_Hz"] = self.samples_per_revolution / cam.period
-        return rig, cam, kwargs
+        cam = ConstantSpeed(speed) if speed is not None else self.settings["cam"]
+        return rig, cam, self.request_at(cam)
 
 
 def grid_axes(rig: Rig, grid: Mapping[str, Sequence[float]]) -> dict[str, np.ndarray]:
@@ -132,14 +160,14 @@ def run_chunk(spec: SweepSpec, indices: Sequence[int], attempt: int = 0) -> Chun
 def run_point(spec: SweepSpec, index: int) -> tuple[int, str, dict]:
     """(outcome code, message, measured values) of one point; an exception becomes ERROR."""
     try:
-        rig, cam, kwargs = spec.inputs(index)
-        result = simulate(rig, spec.scene, cam, **kwargs)
+        rig, cam, request = spec.inputs(index)
+        result = run(rig, spec.scene, cam, request)
         values = measured(spec.measure(result), spec.names)
     except Exception as exc:  # a failing point never sinks the sweep: it is recorded
         if _interrupted(exc):
             raise KeyboardInterrupt from exc
         return ERROR, f"{type(exc).__name__}: {exc}", {}
-    if kwargs.get("stop") is not None:        # what the convergence check did (camdyn.runs.stopping)
+    if request.stop is not None:        # what the convergence check did (camdyn.runs.stopping)
         values["revolutions_run"] = float(result.stats.get("revolutions_run", math.nan))
         values["stop_period"] = float(result.stats.get("stop_period", 0))
     return OUTCOME_CODES[result.outcome.name], "" if result.ok else result.outcome.message, values

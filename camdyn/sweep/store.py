@@ -451,7 +451,7 @@ def attributes(spec: SweepSpec) -> dict:
     if dataclasses.is_dataclass(spec.measure):
         attrs.update({f"measure_{f.name}": _attr(getattr(spec.measure, f.name))
                       for f in dataclasses.fields(spec.measure)})
-    attrs.update({f"simulate_{k}": _attr(v) for k, v in sorted(spec.settings.items())})
+    attrs.update({f"simulate_{k}": _attr(v) for k, v in sorted(spec.record().items())})
     if spec.samples_per_revolution is not None:
         attrs["samples_per_revolution"] = spec.samples_per_revolution
     attrs["outcome_codes"] = ", ".join(f"{code}={name}" for name, code in ALL_CODES.items())
@@ -482,7 +482,7 @@ def stop_saving(ds, spec: SweepSpec) -> dict:
     """The attributes that say what stopping converged runs saved: revolutions requested and run
     (summed over the points that ran) and the points that stopped."""
     ran = np.isfinite(ds["revolutions_run"].values)
-    requested = spec.settings.get("revolutions")
+    requested = spec.request.span.revolutions
     total = float(requested) * int(np.sum(ran)) if requested is not None else math.nan
     return {"revolutions_requested_total": total,
             "revolutions_run_total": float(np.nansum(ds["revolutions_run"].values)),

@@ -1,0 +1,250 @@
+"""The options several commands take, and what they build: the rig, the cam motion, the scene,
+and the run's span and solver options (built here, once, for every command that runs the engine);
+the engine's names (backends, methods); options that name a file."""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from .common import UsageError, _plot_modules
+
+
+# --------------------------------------------------------------------------- rig, cam, scene
+def _rig(args):
+    """The rig of --rig: a shipped preset's name or a .toml file."""
+    from ..errors import ParameterError
+    from ..model.presets import available, load_rig
+
+    try:
+        return load_rig(args.rig)
+    except ParameterError as exc:  # not a preset and not a .toml path
+        if exc.name != "name":
+            raise
+        import difflib
+
+        close = difflib.get_close_matches(args.rig, available(), n=1)
+        raise UsageError(f"--rig {args.rig}: no shipped rig of that name"
+                         + (f" (did you mean {close[0]!r}?)" if close else "")
+                         + f"; shipped rigs: {', '.join(available())}, or a rig file ending in .toml") from None
+
+
+def _cam(args):
+    from ..model.cam import ConstantSpeed, Oscillating
+
+    if getattr(args, "oscillating_rpm", None) is not None:
+        if args.speed_rpm is not None:
+            raise UsageError("give either --speed-rpm or --oscillating-rpm, not both")
+        return Oscillating(args.amplitude_pp, args.oscillating_rpm)
+    if args.speed_rpm is None:
+        raise UsageError("a cam motion is needed: --speed-rpm S (constant speed) or --oscillating-rpm F")
+    return ConstantSpeed(args.speed_rpm)
+
+
+def _scene(args, motion: str = "constant"):
+    from ..model.scene import Scene
+
+    return Scene(contact=getattr(args, "contact", "line"), damping=args.damping, friction=args.friction,
+                 motion=motion, model=getattr(args, "model", "nonlinear"),
+                 sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
+                 damping_sign=getattr(args, "damping_sign", "dissipative"),
+                 damping_switch=getattr(args, "damping_switch", "episode"),
+                 follower=getattr(args, "follower", "dynamic"))
+
+
+def _options():
+    from ..vocabulary import OPTIONS
+
+    return OPTIONS
+
+
+def _add_physics(p, contact: bool = True, full: bool = True):
+    opts = _options()
+    g = p.add_argument_group("rig and scene")
+    g.add_argument("--rig", default="example", help="shipped rig name (see 'camdyn scenes') or a .toml rig file "
+                                                    "(default: example)")
+    if contact:
+        g.add_argument("--contact", default="line", choices=opts["contact"], help="contact law (default: line)")
+    g.add_argument("--damping", default="D", choices=opts["damping"], help="damping model, Eqs. 24-28 (default: D)")
+    g.add_argument("--friction", default="coulomb", choices=opts["friction"],
+                   help="friction model: coulomb (I) or tanh (II) (default: coulomb)")
+    if full:
+        g.add_argument("--model", default="nonlinear", choices=opts["model"],
+                       help="non-linear, or a linearization (Section 8) (default: nonlinear)")
+        g.add_argument("--sliding-velocity", default="kinematic", choices=opts["sliding_velocity"],
+                       dest="sliding_velocity", help="v_r: derived, or as printed (misprint 8) (default: kinematic)")
+        g.add_argument("--damping-sign", default="dissipative", choices=opts["damping_sign"], dest="damping_sign",
+                       help="B/D coefficient: dissipative, or as printed (misprint 2) (default: dissipative)")
+        g.add_argument("--damping-switch", default="episode", choices=opts["damping_switch"], dest="damping_switch",
+                       help="D/E: the impact law once per contact, until maximum compression (episode, Sec. 3.4), "
+                            "or whenever the gap closes (memoryless) (default: episode)")
+        g.add_argument("--follower", default="dynamic", choices=opts["follower"],
+                       help="the hybrid model (dynamic), or the quasi-static contact orbit with no integration "
+                            "(quasistatic: a follower that never leaves the cam) (default: dynamic)")
+
+
+def _add_cam(p, required_speed: bool = False):
+    g = p.add_argument_group("cam motion (one of)")
+    g.add_argument("--speed-rpm", type=float, dest="speed_rpm", metavar="S",
+                   help="constant cam speed in rev/min; > 0 counter-clockwise (de-energizing), < 0 clockwise")
+    g.add_argument("--oscillating-rpm", type=float, dest="oscillating_rpm", metavar="F",
+                   help="oscillating cam, F oscillations per minute (Section 7.2: 40)")
+    g.add_argument("--amplitude-pp", type=float, default=math.pi, dest="amplitude_pp", metavar="RAD",
+                   help="peak-to-peak angle of the oscillating cam in rad (default: pi)")
+
+
+# --- solvers: the one place the command learns the engine's backend and method names -----------
+def _solvers() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(backends, methods) of the engine: every backend runs every method (one loop)."""
+    from ..engine.config import BACKENDS, METHODS
+
+    return BACKENDS, METHODS
+
+
+def _default_backend() -> str:
+    """The backend a run uses when not told (camdyn.runs.request.DEFAULT_BACKEND)."""
+    from ..runs.request import DEFAULT_BACKEND
+
+    return DEFAULT_BACKEND
+
+
+class _Lazy:
+    """A sequence (argparse choices) or text (help) computed on first use: the engine's names need
+    the engine's import, which a command that does not simulate should not pay for."""
+
+    def __init__(self, load):
+        self._load, self._value = load, None
+
+    def _get(self):
+        if self._value is None:
+            self._value = self._load()
+        return self._value
+
+    def __contains__(self, item):
+        return item in self._get()
+
+    def __iter__(self):
+        return iter(self._get())
+
+    def __str__(self):
+        return str(self._get())
+
+
+def _backend(args) -> str:
+    """The backend of --backend, or the default one."""
+    backend = getattr(args, "backend", None)
+    return _default_backend() if backend is None else backend
+
+
+def _add_run(p, revolutions: float = 3.0, sample_rate: float = 20_000.0):
+    g = p.add_argument_group("run and solver")
+    g.add_argument("--revolutions", type=float, default=revolutions,
+                   help=f"run length in cam periods (default: {revolutions:g})")
+    g.add_argument("--t-end", type=float, dest="t_end", metavar="SECONDS", help="run length in seconds instead")
+    g.add_argument("--sample-rate-Hz", type=float, default=sample_rate, dest="sample_rate_Hz", metavar="HZ",
+                   help=f"output samples per second (default: {sample_rate:g})")
+    _add_solver(g)
+
+
+def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s (default: {default_backend}; "
+                                      "python: the same loop in Python, slow, for checking)",
+                rtol: float = 1e-8, atol: float = 1e-12):
+    g.add_argument("--method", default="DOP853", metavar="METHOD", choices=_Lazy(lambda: _solvers()[1]),
+                   help="Runge-Kutta pair with dense output: %(choices)s (default: DOP853)")
+    g.add_argument("--rtol", type=float, default=rtol, help=f"relative tolerance (default: {rtol:g})")
+    g.add_argument("--atol", type=float, default=atol, help=f"absolute tolerance (default: {atol:g})")
+    g.add_argument("--backend", metavar="BACKEND", choices=_Lazy(lambda: _solvers()[0]), default=None,
+                   help=backend_help)
+    g.add_argument("--max-step", type=float, default=math.inf, dest="max_step", metavar="SECONDS",
+                   help="largest step the integrator may take (default: no limit)")
+    g.add_argument("--max-events", type=int, default=1_000_000, dest="max_events", metavar="N",
+                   help="most regime switches one run may have before it stops as MAX_EVENTS (default: 1000000)")
+
+
+def _MAP_OPTIONS():
+    """The tolerances of the periodic analyses (camdyn.engine.config.MAP_OPTIONS), their default on
+    the command line too (numba-free: the parser is built without it)."""
+    from ..engine.config import MAP_OPTIONS
+
+    return MAP_OPTIONS
+
+
+def _solver_options(args):
+    """The engine's SolverOptions from the solver options of ``_add_solver``: built here, for
+    every command that takes them."""
+    from ..engine.config import EventSettings, SolverOptions
+
+    return SolverOptions(method=args.method, rtol=args.rtol, atol=args.atol, max_step=args.max_step,
+                         events=EventSettings(max_events=args.max_events))
+
+
+def _span(args, cam):
+    """The run's Span from the run options of ``_add_run``: --t-end seconds, or --revolutions of
+    the cam (a cam at rest has no period: --t-end only), sampled at --sample-rate-Hz."""
+    from ..runs.request import Span
+
+    if args.t_end is not None:
+        return Span(t_end=args.t_end, sample_rate_Hz=args.sample_rate_Hz)
+    if not math.isfinite(cam.period):
+        raise UsageError(f"--speed-rpm {args.speed_rpm:g} holds the cam still: with no cam period, the run "
+                         "length cannot be counted in --revolutions; give it in seconds with --t-end SECONDS")
+    return Span(revolutions=args.revolutions, sample_rate_Hz=args.sample_rate_Hz)
+
+
+# --- file options: their kind is checked while the command line is read, before any work -------
+_KINDS = {"csv": "a CSV file", "netcdf": "a NetCDF file", "plot": "a figure", "run": "a saved run"}
+
+
+def _plot_formats() -> dict[str, str]:
+    _plot_modules()
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return FigureCanvasBase.get_supported_filetypes()
+
+
+def _file_of_kind(kind: str, flag: str, value: str) -> str:
+    """``value`` checked for ``kind`` (csv, netcdf, plot, run): the path to use (a missing ending
+    gets the default one), or UsageError naming ``flag``."""
+    from ..io.files import SUFFIXES, FileFormatError, check_suffix
+
+    if kind == "plot":
+        formats = _plot_formats()
+        suffix = Path(value).suffix.lower()
+        if not suffix:
+            return value + ".png"
+        if suffix[1:] not in formats:
+            raise UsageError(f"{flag} {value}: matplotlib cannot write {suffix} figures; use one of "
+                             f"{', '.join('.' + f for f in sorted(formats))}")
+        return value
+    if kind == "run":
+        suffix = Path(value).suffix.lower()
+        if suffix not in SUFFIXES["csv"] + SUFFIXES["netcdf"]:
+            raise UsageError(f"{flag} {value}: a saved run is a .csv or .nc file written by 'camdyn simulate'")
+        return value
+    try:
+        return check_suffix(value, kind)
+    except FileFormatError as exc:
+        raise UsageError(f"{flag} {exc}") from None
+
+
+class _FileOption(argparse.Action):
+    """An option naming a file of one kind; checks the kind and records which flag gave it
+    (``args.flags[dest]``), so that later messages name the flag the user typed."""
+
+    def __init__(self, option_strings, dest, kind: str, deprecated_for: str | None = None, **kwargs):
+        self.kind, self.deprecated_for = kind, deprecated_for
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, value, option_string=None):
+        if self.deprecated_for:
+            print(f"camdyn: {option_string} is deprecated here; use {self.deprecated_for}", file=sys.stderr)
+        setattr(namespace, self.dest, _file_of_kind(self.kind, option_string, value))
+        flags = dict(getattr(namespace, "flags", None) or {})
+        flags[self.dest] = option_string
+        namespace.flags = flags
+
+
+def _add_file(g, flag: str, kind: str, help_: str, *aliases: str, dest: str | None = None, **kw):
+    """An option naming a file of one kind (checked when read: see _FileOption)."""
+    g.add_argument(flag, *aliases, action=_FileOption, kind=kind, metavar="FILE", dest=dest, help=help_, **kw)

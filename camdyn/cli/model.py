@@ -153,15 +153,15 @@ def cmd_scenes(args) -> int:
 def cmd_cache(args) -> int:
     """List camdyn's caches of this user (compiled code, scenes derived on demand), or clear them."""
     from ..model import ondemand
-    from ..engine import cache
+    from .. import engine
 
     if args.clear or args.clear_stale:
-        removed = cache.clear(stale_only=args.clear_stale)
+        removed = engine.clear_cache(stale_only=args.clear_stale)
         removed += ondemand.clear(stale_only=args.clear_stale)
         print(f"removed {len(removed)} cache folder(s)" + "".join(f"\n  {d}" for d in removed))
         return EXIT_OK
-    entries = cache.entries()
-    print(f"camdyn's compiled code for this user: {cache.user_cache_root()} (set {cache.ENV} to move it)")
+    entries = engine.cache_entries()
+    print(f"camdyn's compiled code for this user: {engine.user_cache_root()} (set {engine.CACHE_ENV} to move it)")
     if not entries:
         print("  empty: the first run compiles the engine")
     for folder, size, current in entries:

@@ -97,7 +97,7 @@ def _add_cam(p, required_speed: bool = False):
 # --- solvers: the one place the command learns the engine's backend and method names -----------
 def _solvers() -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(backends, methods) of the engine: every backend runs every method (one loop)."""
-    from ..engine.config import BACKENDS, METHODS
+    from ..engine import BACKENDS, METHODS
 
     return BACKENDS, METHODS
 
@@ -165,7 +165,7 @@ def _add_solver(g, backend_help: str = "who runs the engine's loop: %(choices)s 
 def _MAP_OPTIONS():
     """The tolerances of the periodic analyses (camdyn.engine.config.MAP_OPTIONS), their default on
     the command line too (numba-free: the parser is built without it)."""
-    from ..engine.config import MAP_OPTIONS
+    from ..engine import MAP_OPTIONS
 
     return MAP_OPTIONS
 
@@ -173,7 +173,7 @@ def _MAP_OPTIONS():
 def _solver_options(args):
     """The engine's SolverOptions from the solver options of ``_add_solver``: built here, for
     every command that takes them."""
-    from ..engine.config import EventSettings, SolverOptions
+    from ..engine import EventSettings, SolverOptions
 
     return SolverOptions(method=args.method, rtol=args.rtol, atol=args.atol, max_step=args.max_step,
                          events=EventSettings(max_events=args.max_events))

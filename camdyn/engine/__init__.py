@@ -32,7 +32,8 @@ _LAZY = {"integrate": ".driver", "Trajectory": ".driver", "Switch": ".switches",
          "frozen_step": ".variational", "record_saltation": ".saltation", "switch_saltation": ".saltation",
          "saltation_matrix": ".saltation", "compiled_kernels": ".kernels", "python_kernels": ".kernels",
          "outputs_on_samples": ".kernels", "transition_surfaces": ".tables", "user_cache_root": ".cache",
-         "cache_dir": ".cache", "source_hash": ".cache", "remove_folders": ".cache"}
+         "cache_dir": ".cache", "source_hash": ".cache", "remove_folders": ".cache", "cache_entries": ".cache",
+         "clear_cache": ".cache", "CACHE_ENV": ".cache", "STEP_CONTROL": ".config"}
 
 __all__ = ["SolverOptions", "EventSettings", "StepControl", "PI_CONTROL", "SCIPY_CONTROL", "MAP_OPTIONS", "LOOK_AHEAD",
            "ANGLE_LIMIT", "BACKENDS", "METHODS", "step_control", *_LAZY]

@@ -26,7 +26,7 @@ import warnings
 from functools import lru_cache
 from pathlib import Path
 
-ENV = "CAMDYN_CACHE_DIR"
+CACHE_ENV = "CAMDYN_CACHE_DIR"
 PACKAGE = Path(__file__).resolve().parent.parent          # camdyn/
 ENGINE = Path(__file__).resolve().parent                   # camdyn/engine/
 #: folders of the user cache root that are not compiled code (camdyn.model.ondemand's scenes)
@@ -35,8 +35,8 @@ OTHER_FOLDERS = ("scenes",)
 
 def user_cache_root() -> Path:
     """The folder of camdyn's caches for this user ($CAMDYN_CACHE_DIR or the platform's)."""
-    if os.environ.get(ENV):
-        return Path(os.environ[ENV]).expanduser()
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV]).expanduser()
     if sys.platform == "win32":
         base = Path(os.environ.get("LOCALAPPDATA", Path.home() / "AppData" / "Local"))
     elif sys.platform == "darwin":
@@ -67,7 +67,7 @@ def cache_dir() -> Path:
     return user_cache_root() / engine_key()
 
 
-def entries() -> list[tuple[Path, int, bool]]:
+def cache_entries() -> list[tuple[Path, int, bool]]:
     """(folder, bytes, current) for each cache folder under the user cache root."""
     root = user_cache_root()
     if not root.is_dir():
@@ -79,9 +79,9 @@ def entries() -> list[tuple[Path, int, bool]]:
     return out
 
 
-def clear(stale_only: bool = False) -> list[Path]:
+def clear_cache(stale_only: bool = False) -> list[Path]:
     """Delete the cache folders (only those of other versions or engines with ``stale_only``)."""
-    return remove_folders(entries(), stale_only)
+    return remove_folders(cache_entries(), stale_only)
 
 
 def remove_folders(listed, stale_only: bool) -> list[Path]:

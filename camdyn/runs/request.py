@@ -24,7 +24,7 @@ from typing import Mapping
 import numpy as np
 
 from .._checks import finite, real
-from ..engine.config import BACKENDS, STEP_CONTROL, EventSettings, SolverOptions
+from ..engine import BACKENDS, STEP_CONTROL, EventSettings, SolverOptions
 from ..errors import ParameterError
 from .stopping import StopWhenPeriodic
 

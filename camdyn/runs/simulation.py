@@ -7,11 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..engine.config import SolverOptions
-from ..engine.driver import Trajectory, integrate
-from ..engine.loop import ALPHA, ALPHA_DOT, LEDGER_ROWS, WORK
-from ..engine.switches import Switches
-from ..engine.tables import transition_surfaces
+from ..engine import SolverOptions, Switches, Trajectory, integrate, transition_surfaces
 from ..errors import CamdynError, ParameterError
 from ..model.cam import CamMotion, cam_motion
 from ..model.model import Model
@@ -196,9 +192,9 @@ def _result(model: Model, traj, backend: str) -> Result:
     sample's mode, computed when first read: :class:`~camdyn.runs.result.Outputs`) and the ledger's
     works."""
     K = model.kernels
-    t, alpha, alpha_dot = traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT]
+    t, alpha, alpha_dot = traj.t, traj.alpha, traj.alpha_dot
     names = list(K.OUTPUTS)
-    if traj.y.shape[0] == LEDGER_ROWS:  # the works of FLOWS (P_in, D_c, D_f), in that order
+    if traj.has_ledger:  # the works of FLOWS (P_in, D_c, D_f), in that order
         names += list(LEDGER_OUTPUTS)
     outputs = Outputs(names, functools.partial(_output_values, model, traj, backend))
     theta = np.broadcast_to(model.cam_state(t)[CAM_THETA], t.shape).astype(float) if t.size else t.copy()
@@ -214,9 +210,9 @@ LEDGER_OUTPUTS = ("work_in", "dissipated_contact", "dissipated_friction")
 
 def _output_values(model: Model, traj, backend: str) -> dict:
     """The output quantities at every sample of ``traj`` and the ledger's works, by name."""
-    values = model.outputs_at(traj.mode, traj.t, traj.y[ALPHA], traj.y[ALPHA_DOT], backend)
+    values = model.outputs_at(traj.mode, traj.t, traj.alpha, traj.alpha_dot, backend)
     outputs = dict(zip(model.kernels.OUTPUTS, values))
-    if traj.y.shape[0] == LEDGER_ROWS:
-        for i, name in enumerate(LEDGER_OUTPUTS):
-            outputs[name] = traj.y[WORK + i].copy()
+    if traj.has_ledger:
+        for name, work in zip(LEDGER_OUTPUTS, traj.works):
+            outputs[name] = work.copy()
     return outputs

@@ -51,6 +51,8 @@ _EXPORTS = {
     "ContinuationOutcome": "camdyn.orbits.continuation",
     "zero_one_test": "camdyn.analysis.chaos01",
     "StopWhenPeriodic": "camdyn.runs.stopping",
+    "Span": "camdyn.runs.request",
+    "SolverOptions": "camdyn.engine",
     "quasi_static_orbit": "camdyn.runs.quasistatic",
     "QuasiStaticOrbit": "camdyn.runs.quasistatic",
     "QuasiStaticOutcome": "camdyn.runs.quasistatic",

@@ -210,3 +210,9 @@ def test_no_text_in_any_figure_is_smaller_than_the_minimum(impacting):
         fig.canvas.draw()
         sizes = [t.get_fontsize() for t in fig.findobj(Text) if t.get_text().strip() and t.get_visible()]
         assert sizes and min(sizes) >= plots.MIN_FONT_PT, fig
+
+
+def test_every_continuation_event_has_its_marker():
+    from camdyn.io.plots import EVENT_MARKERS
+    from camdyn.orbits.continuation import EVENTS
+    assert set(EVENT_MARKERS) == set(EVENTS)

@@ -15,7 +15,7 @@ RIG16 = RIG.replace(l_lambda=0.016)
 SCENE = camdyn.Scene(damping="D", friction="coulomb")
 LOSS = camdyn.contact_loss_speed(RIG16)
 STOP = camdyn.StopWhenPeriodic()
-#: the sweep benchmark's tolerances (benchmarks/performance.py: SWEEP_RTOL, atol = 1e-4 rtol)
+#: the sweep benchmark's tolerances (benchmarks/sweep_stop.py: RTOL, ATOL = 1e-4 rtol)
 KW = dict(rtol=1e-7, atol=1e-11)
 
 

@@ -22,10 +22,8 @@ from .result import Outputs, Result
 from .stopping import StopWhenPeriodic
 
 #: the fastest rate (rad/s) of the linearized motion a run accepts (Model.fastest_rate): an
-#: explicit Runge-Kutta step is at most a few times 1/rate (measured with DOP853: 4.4e8 steps per
-#: simulated second at 2.75e9 rad/s, zeta_D = 1e5 on the example rig; far from equilibrium many
-#: more: 3.3e9 per second at 1.2e7 rad/s, k_s = 1e14), so 1e7 rad/s is ~2e6 steps per simulated
-#: second and more; the shipped rigs are below 5e4 rad/s (reference-experiment: 4.3e4)
+#: explicit Runge-Kutta step is at most a few times 1/rate, so a faster motion would take millions
+#: of steps per simulated second (docs/design-notes.md, *The fastest motion a run accepts*)
 MAX_RATE = 1e7
 
 

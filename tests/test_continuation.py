@@ -441,6 +441,9 @@ class _AnalyticMap:
     def __call__(self, x):
         return self.f(np.asarray(x, dtype=float), self.lam)
 
+    def admits(self, x):
+        return True
+
     def evaluate(self, x):
         return MapValue(self(x), 0, 0, 0)
 

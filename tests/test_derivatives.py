@@ -131,12 +131,32 @@ class _SwitchyMap:
     options = DEFAULT_OPTIONS
     A = np.array([[0.5, 0.2], [0.1, 0.3]])
 
+    def __init__(self):
+        self.runs = 0
+
+    def admits(self, x):
+        return True
+
     def evaluate(self, x):
+        self.runs += 1
         x = np.asarray(x, dtype=float)
         return MapValue(self.A @ x, 0, 0, 0, (1,) if abs(x[0]) > 1e-7 else ())
 
     def __call__(self, x):
         return self.evaluate(x).state
+
+
+class _StiffContactMap(_SwitchyMap):
+    """P(x) = A x in a mode whose domain is x[0] <= 1e-7 (a stiff contact's deflection smaller
+    than any step above the floor): a perturbed state in column 0 is outside it."""
+
+    def admits(self, x):
+        return x[0] <= 1e-7
+
+    def evaluate(self, x):
+        if not self.admits(x):
+            raise MapFailure(f"the state {tuple(x)} is outside the mode's domain")
+        return super().evaluate(x)
 
 
 def test_an_unresolved_column_without_fallback_is_reported_unresolved():
@@ -152,10 +172,26 @@ def test_an_unresolved_column_falls_back_and_says_so():
         .derivative(np.zeros(2))
     assert d.resolved and np.array_equal(d.jacobian, _SwitchyMap.A) and "finite differences unresolved" in d.note
 
+    section_map = _SwitchyMap()
+    FiniteDifferences(section_map, np.ones(2), fallback=lambda m: (lambda x: (exact.value, exact.jacobian))) \
+        .derivative(np.zeros(2))
+    assert section_map.runs == 1 + 2 * 3     # the base, then column 0's three steps above the floor; not column 1
+
     def failing(section_map):
         raise MapFailure("the scene has no variational kernels (a linear model)")
     d = FiniteDifferences(_SwitchyMap(), np.ones(2), fallback=failing).derivative(np.zeros(2))
     assert not d.resolved and "the fallback failed: the scene has no variational kernels" in d.note
+
+
+def test_a_step_outside_the_start_modes_domain_is_shrunk_without_a_run():
+    """No run is made from a perturbed state the start mode's domain does not hold (the check
+    costs no run): the base run alone, then the fallback."""
+    exact = MapDerivative(np.zeros(2), _SwitchyMap.A.copy(), "exact")
+    section_map = _StiffContactMap()
+    d = FiniteDifferences(section_map, np.ones(2), fallback=lambda m: (lambda x: (exact.value, exact.jacobian))) \
+        .derivative(np.zeros(2))
+    assert section_map.runs == 1
+    assert d.resolved and "outside it" in d.note and "column 1" not in d.note
 
 
 # ------------------------------------------------------------------ rigs with a small contact margin

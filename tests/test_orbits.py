@@ -234,6 +234,9 @@ class FakeMap:
     def __call__(self, x):
         return np.asarray(self.fn(np.asarray(x, dtype=float)), dtype=float)
 
+    def admits(self, x):
+        return True
+
     def evaluate(self, x):
         return MapValue(self(x), 0, 0, 0)
 

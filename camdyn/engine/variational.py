@@ -82,24 +82,48 @@ def _initial_step(rhs, jacobian, p, m, t, y, f0, t_end, rtol, atol, exponent, lo
 
 @njit(cache=True, error_model="numpy")
 def _error(K, h, y, y_new, rtol, atol, method):
-    """The attempt's error norm (:func:`~camdyn.engine.stepper.error_norm` over N_AUGMENTED components)."""
-    scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
-    e5, e3 = np.zeros(N_AUGMENTED), np.zeros(N_AUGMENTED)
-    for j in range(method.n_stages + 1):
-        e5 += method.coef[method.e_row, j] * K[j]
-        e3 += method.coef[method.e3_row, j] * K[j]
+    """The attempt's error norm (:func:`~camdyn.engine.stepper.error_norm` over N_AUGMENTED
+    components), summed component by component in the order NumPy's array expressions take."""
+    coef, e, e3 = method.coef, method.e_row, method.e3_row
+    s5, s3 = 0.0, 0.0
+    for i in range(N_AUGMENTED):
+        scale = atol[i] + np.maximum(abs(y[i]), abs(y_new[i])) * rtol
+        a5, a3 = 0.0, 0.0
+        for j in range(method.n_stages + 1):
+            a5 += coef[e, j] * K[j, i]
+            a3 += coef[e3, j] * K[j, i]
+        if method.error_kind == 0:
+            x = a5 * h / scale
+            s5 += x * x
+        else:
+            s5 += (a5 / scale) ** 2
+            s3 += (a3 / scale) ** 2
     if method.error_kind == 0:
-        return _norm(e5 * h / scale)
-    return blended(np.sum((e5 / scale) ** 2), np.sum((e3 / scale) ** 2), h, N_AUGMENTED)
+        return rms(s5, N_AUGMENTED)
+    return blended(s5, s3, h, N_AUGMENTED)
+
+
+@njit(cache=True, error_model="numpy")
+def _stages(rhs, jacobian, p, m, t, t0, y, h, method, look_ahead, K, z, jac):
+    """The stages of one attempt of size h into K[1..n_stages] (the last, at the attempt's end,
+    the FSAL stage), z the state of the last: the solution."""
+    coef, n = method.coef, method.n_stages
+    for s in range(1, n + 1):
+        for i in range(N_AUGMENTED):
+            v = y[i]
+            for j in range(s):
+                v += (h * coef[s, j]) * K[j, i]
+            z[i] = v
+        augmented_field(rhs, jacobian, p, m, t + coef[method.c_row, s] * h, z, t0, look_ahead, jac, K[s])
 
 
 @njit(cache=True, error_model="numpy")
 def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, look_ahead, control):
     """y (N_AUGMENTED) at t_end from y at t0 in mode m, the step size set by ``control`` (a
-    :class:`~camdyn.engine.stepper.StepControl`); returns (y, ok)."""
-    coef, n = method.coef, method.n_stages
+    :class:`~camdyn.engine.config.StepControl`); returns (y, ok)."""
+    n = method.n_stages
     K = np.empty((n + 1, N_AUGMENTED))
-    jac, z = np.empty(2), np.empty(N_AUGMENTED)
+    jac, z, y_new = np.empty(2), np.empty(N_AUGMENTED), np.empty(N_AUGMENTED)
     y = y.copy()
     t = t0
     augmented_field(rhs, jacobian, p, m, t, y, t0, look_ahead, jac, K[0])
@@ -113,13 +137,7 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
                 return y, False
             t_new = min(t + h_abs, t_end)
             h = t_new - t
-            for s in range(1, n + 1):                 # the stages, then the FSAL stage (row b)
-                z[:] = y
-                for j in range(s):
-                    z += (h * coef[s, j]) * K[j]
-                augmented_field(rhs, jacobian, p, m, t + coef[method.c_row, s] * h, z, t0, look_ahead, jac, K[s])
-                if s == n:
-                    y_new = z.copy()
+            _stages(rhs, jacobian, p, m, t, t0, y, h, method, look_ahead, K, y_new, jac)
             err = _error(K, h, y, y_new, rtol, atol, method)
             if err < 1.0:
                 h_abs = h * accepted_factor(err, err_prev, rejected, method.exponent, control.a, control.b)
@@ -127,8 +145,10 @@ def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, loo
                 break
             h_abs = h * rejected_factor(err, method.exponent)
             rejected = True
-        t, y = t_new, y_new
-        K[0] = K[n]
+        t = t_new
+        for i in range(N_AUGMENTED):
+            y[i] = y_new[i]
+            K[0, i] = K[n, i]
     return y, True
 
 

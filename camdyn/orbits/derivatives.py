@@ -107,18 +107,23 @@ def _path_change(base: MapValue, plus: MapValue, minus: MapValue, h: float) -> s
     return f"at step {h:.3g} a perturbed run crossed other surfaces than the base run"
 
 
-def resolved_difference(evaluate: Callable[[float], MapValue], base: MapValue, column: Column):
+def resolved_difference(evaluate: Callable[[float], MapValue], base: MapValue, column: Column,
+                        admits: Callable[[float], bool] | None = None):
     """The central difference (P(+h) - P(-h)) / 2h of ``evaluate`` (the map at a signed offset
     along one direction) and its step h, under the module's rule: from ``column.first``, h is
     divided by :data:`SHRINK` while a perturbed run takes another hybrid path than ``base`` or
     leaves its mode's domain, and until the differences at h and h / SHRINK agree to
     ``column.tol`` (scaled): the smaller one is returned, its truncation error about 1/15 of their
-    difference.  Raises :class:`Unresolved`, saying why, when no step above ``column.floor``
-    works, and the :class:`~camdyn.orbits.section_map.MapFailure` of a run that fails."""
+    difference.  ``admits(offset)``, when given, tells without a run whether the perturbed state
+    is in the start mode's domain: a step is then shrunk before either of its runs is made.
+    Raises :class:`Unresolved`, saying why, when no step above ``column.floor`` works, and the
+    :class:`~camdyn.orbits.section_map.MapFailure` of a run that fails."""
     why, secant, last = "the first step is below the floor", None, None
     h = column.first
     while h >= column.floor:
         try:
+            if admits is not None and not (admits(h) and admits(-h)):
+                raise MapFailure(f"at step {h:.3g} a perturbed state is outside it")
             plus, minus = evaluate(h), evaluate(-h)
         except MapFailure as failure:
             if failure.outcome is not None:
@@ -143,6 +148,12 @@ def resolved_difference(evaluate: Callable[[float], MapValue], base: MapValue, c
     raise Unresolved(f"no step down to {column.floor:.3g} gives a resolved difference ({why})", secant)
 
 
+def _perturbed(x: np.ndarray, j: int, offset: float) -> np.ndarray:
+    y = x.copy()
+    y[j] += offset
+    return y
+
+
 class FiniteDifferences:
     """The Jacobian provider by central differences of ``section_map``, under the module's rule.
 
@@ -151,7 +162,9 @@ class FiniteDifferences:
     ``step_factor`` multiplies the first steps (to check a Jacobian against a second step);
     ``fallback``: the provider factory used where a column cannot be resolved (None: the
     derivative is returned with ``resolved=False``).  A call costs 4 runs of the map given
-    ``base``, 5 without, more when a step is shrunk."""
+    ``base``, 5 without, more when a step is shrunk (none for a step whose perturbed state is
+    outside the start mode's domain); after a column that cannot be resolved, the fallback's
+    cost instead of the other column's."""
 
     name = "finite_differences"
 
@@ -178,20 +191,21 @@ class FiniteDifferences:
         for j in range(2):
             column = Column.of(max(abs(x[j]), self.scale[j]), self.scale[j] / self.scale, rtol, first[j])
             try:
-                J[:, j], steps[j] = resolved_difference(self._along(x, j), base, column)
+                J[:, j], steps[j] = resolved_difference(self._along(x, j), base, column, self._admits(x, j))
             except Unresolved as failure:
                 notes.append(f"column {j}: {failure}")
                 J[:, j], steps[j] = failure.secant or (np.full(2, np.nan), first[j])
+                if self.fallback is not None:     # the fallback gives every column: no run for the others
+                    break
         if not notes:
-            return MapDerivative(base.state, J, self.name, steps)
+            return MapDerivative(base.state, J, self.name, steps, end_mode=base.end_mode)
         return self._fall_back(x, base, J, steps, "; ".join(notes))
 
     def _along(self, x: np.ndarray, j: int) -> Callable[[float], MapValue]:
-        def evaluate(offset: float) -> MapValue:
-            y = x.copy()
-            y[j] += offset
-            return self.section_map.evaluate(y)
-        return evaluate
+        return lambda offset: self.section_map.evaluate(_perturbed(x, j, offset))
+
+    def _admits(self, x: np.ndarray, j: int) -> Callable[[float], bool]:
+        return lambda offset: self.section_map.admits(_perturbed(x, j, offset))
 
     def _fall_back(self, x, base: MapValue, J, steps, note: str) -> MapDerivative:
         if self.fallback is not None:
@@ -201,8 +215,9 @@ class FiniteDifferences:
                 note = f"{note}; the fallback failed: {failure}"
             else:
                 return MapDerivative(d.value, d.jacobian, d.provider, d.steps, d.resolved,
-                                     f"finite differences unresolved ({note}), so {d.provider}")
-        return MapDerivative(base.state, J, self.name, steps, False, f"finite differences unresolved: {note}")
+                                     f"finite differences unresolved ({note}), so {d.provider}", d.end_mode)
+        return MapDerivative(base.state, J, self.name, steps, False, f"finite differences unresolved: {note}",
+                             base.end_mode)
 
 
 def _variational_fallback(section_map: StroboscopicMap) -> Variational:

@@ -126,11 +126,20 @@ class StroboscopicMap:
         t0, (a, ad) = self.phase, map(float, x)
         if self.mode is None:
             return self._domain.initial_mode(t0, a, ad)
-        s = self._domain.surface_crossed(self.mode, t0, a, ad)
+        s = self._surface_crossed(x)
         if s >= 0:
             raise MapFailure(f"the state {tuple(map(float, x))} is across surface {self._domain.surfaces[s]!r} of "
                              f"mode {self._domain.modes[self.mode]!r} at the section: outside the mode's domain")
         return self.mode
+
+    def _surface_crossed(self, x) -> int:
+        """The surface of the given mode's domain that ``x`` is across at the section, else -1."""
+        return self._domain.surface_crossed(self.mode, self.phase, float(x[0]), float(x[1]))
+
+    def admits(self, x) -> bool:
+        """Whether a run can start from ``x``: it is in the given mode's domain at the section
+        (always, when the automaton's initial rule chooses the mode).  No run is made."""
+        return self.mode is None or self._surface_crossed(x) < 0
 
     def evaluate(self, x) -> MapValue:
         """P_n(x) with the start and end modes; raises :class:`MapFailure` when the run fails."""
@@ -174,7 +183,8 @@ class MapDerivative:
     ``steps``: the central-difference step of each column (rad, rad/s; NaN for a derivative not
     taken by differences); ``resolved``: False when the finite differences could not be resolved
     and no fallback could (``jacobian`` is then a secant across the largest step that ran: a
-    direction for Newton's method, not for multipliers); ``note``: why, or which fallback was taken."""
+    direction for Newton's method, not for multipliers); ``note``: why, or which fallback was taken;
+    ``end_mode``: the mode the run from x ends in, where the provider ran it (else None)."""
 
     value: np.ndarray
     jacobian: np.ndarray
@@ -182,6 +192,7 @@ class MapDerivative:
     steps: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
     resolved: bool = True
     note: str = ""
+    end_mode: int | None = None
 
 
 class JacobianProvider(Protocol):

@@ -317,7 +317,9 @@ def _verdict(section_map: StroboscopicMap, found: NewtonResult) -> tuple[OrbitOu
         message = f"{message}: {found.failure}"
     if outcome is not OrbitOutcome.CONVERGED:
         return outcome, message
-    end = section_map.evaluate(found.x).end_mode
+    end = found.derivative.end_mode
+    if end is None:                          # a provider that does not say: the run once more
+        end = section_map.evaluate(found.x).end_mode
     if end != section_map.mode:
         modes = section_map.model.kernels.MODES
         outcome = OrbitOutcome.MODE_CHANGED

@@ -242,7 +242,7 @@ class Variational:
                         settings=self.settings)
         except TangentFailure as failure:
             raise MapFailure(str(failure), failure.outcome) from failure
-        return MapDerivative(r.state, r.phi, self.name)
+        return MapDerivative(r.state, r.phi, self.name, end_mode=r.end_mode)
 
 
 def variational(section_map: StroboscopicMap, scale=None, settings: TangentSettings = TangentSettings()) -> Variational:

@@ -30,6 +30,8 @@ Modes and their surfaces (non-linear model):
   contact_*_fwd --(slip, -1)--> contact_*_stick if both one-sided fields point at v_r = 0
                                 (Filippov sliding mode, misprint 12), else contact_*_bwd
   contact_*_stick --(slip_rate_fwd, +1)--> contact_*_fwd; --(slip_rate_bwd, -1)--> contact_*_bwd
+  contact_* --(junction, +1 or -1)--> the same mode   a cam of arcs: the step restarts where the
+                                                       contact passes from one arc to the next
 
 With ``damping_switch="episode"`` (the default, Sec. 3.4) the impact law acts from first
 contact to maximum compression and the viscous law from there to separation: the law is
@@ -168,5 +170,9 @@ def build(spec: SceneSpec) -> Automaton:
         transitions += _damping_transitions(spec, mode)
         if coulomb:
             transitions += _slip_transitions(spec, mode)
+    if spec.profile == "arcs":  # the curvature jumps at a junction of arcs: restart there, same mode
+        surfaces += ("junction",)
+        transitions += [Transition(mode.name, "junction", direction, (Target(mode.name),))
+                        for mode in all_modes if mode.contact for direction in (+1, -1)]
     initial = _entering(spec, (Condition("gap", -1),)) + (Target("free"),)
     return Automaton(all_modes, surfaces, {"gap": "gap_rate"}, initial, tuple(transitions))

@@ -30,8 +30,10 @@ from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from . import laws
+from . import profile as H
 from . import symbols as S
 from . import trig
+from .profile_code import PROFILE_BLOCK, evaluator_source
 from .automaton import Automaton
 from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
@@ -39,7 +41,8 @@ from camdyn.vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSI
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
-UNITS = {**{name: p.unit for name, p in S.PARAMS.items()}, "Y_e": "Pa"}
+UNITS = {**{name: p.unit for name, p in S.PARAMS.items()}, "Y_e": "Pa",
+         PROFILE_BLOCK: "m and rad: the profile's data (derive.profile_code)"}
 ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
         "s": "surface index: a position in SURFACES (SURFACE_<NAME> constants)",
         "t": "time (s)", "alpha": "follower angle alpha (rad, clockwise)",
@@ -71,6 +74,26 @@ class _Scalar(PythonCodePrinter):
         x = self._print(expr.args[0])
         return f"({x})*sqrt(abs({x}))"
 
+    def _print_SupportFunction(self, expr):
+        """h^(n)(phi): the scene's profile evaluator, reading the profile's data at the end of p."""
+        return f"profile({expr.order}, {self._print(expr.args[1])}, p, PROFILE_OFFSET)"
+
+
+    def _print_JunctionFunction(self, expr):
+        """The arcs' junction indicator (derive.profile.JunctionFunction), from the profile's data."""
+        return f"junction_indicator({expr.order}, {self._print(expr.args[1])}, p, PROFILE_OFFSET)"
+
+
+class _PackScalar(_Scalar):
+    """pack()'s printer: the evaluator reads the profile's data from the mapping's block."""
+
+    def _print_SupportFunction(self, expr):
+        return f"profile({expr.order}, {self._print(expr.args[1])}, {_BLOCK_LOCAL}, 0)"
+
+
+#: pack()'s local name of the profile's data block
+_BLOCK_LOCAL = "profile_block"
+
 
 class _Vector(NumPyPrinter):
     def __init__(self):
@@ -78,8 +101,26 @@ class _Vector(NumPyPrinter):
 
 
 def _is_constant(name: str) -> bool:
-    """A trigonometric constant of derive.trig (sin_<angle>, cos_<angle>), computed by pack()."""
-    return name.startswith(("sin_", "cos_"))
+    """A constant pack() computes: a trigonometric one of derive.trig (sin_<angle>, cos_<angle>),
+    or the cam's support function at a parameter-only angle (h<n>_at_<angle>)."""
+    return name.startswith(("sin_", "cos_")) or (name[:1] == "h" and name[2:6] == "_at_")
+
+
+def _constant_unit(name: str) -> str:
+    """The unit of a constant of pack(): 1 for a sine or cosine, m/rad^n for h^(n)."""
+    if name.startswith(("sin_", "cos_")):
+        return "1"
+    return "m" if name[1] == "0" else f"m/rad^{name[1]}"
+
+
+def _profile_constants(exprs: tuple[sp.Expr, ...]) -> tuple[tuple[sp.Expr, ...], dict]:
+    """The calls h^(n)(c) of a parameter-only angle c (the 0-state's, Eq. 5) as constants of
+    pack(): {symbol h<n>_at_<c>: the call}, and the expressions with the symbols."""
+    constant = {call: sp.Symbol(f"h{call.order}_at_{trig._slug(call.args[1])}", real=True)
+                for x in exprs for call in H.calls(x) if H.is_constant_call(call)}
+    if not constant:
+        return exprs, {}
+    return tuple(sp.sympify(x).xreplace(constant) for x in exprs), {sym: call for call, sym in constant.items()}
 
 
 def _param_names(exprs) -> list[str]:
@@ -152,8 +193,9 @@ class _Family:
 
 @lru_cache(maxsize=None)
 def _economised(exprs: tuple[sp.Expr, ...]) -> tuple[tuple[sp.Expr, ...], dict]:
+    exprs, profile_constants = _profile_constants(exprs)
     out, constants = trig.economise(list(exprs))
-    return tuple(out), dict(sorted(constants.items(), key=lambda kv: kv[0].name))
+    return tuple(out), dict(sorted({**constants, **profile_constants}.items(), key=lambda kv: kv[0].name))
 
 
 def _families(cases: tuple[Case, ...]) -> list[_Family]:
@@ -395,25 +437,32 @@ def _hash(mod: SceneModule) -> str:
     return h.hexdigest()[:16]
 
 
-def _pack_code(params: list[str], constants: dict) -> tuple[str, list[str]]:
+def _pack_code(params: list[str], constants: dict, profile: bool) -> tuple[str, list[str]]:
     derived = {**laws.CONSTANTS, **constants}
     inputs = [n for n in PARAM_ORDER if n in params and n not in {s.name for s in laws.CONSTANTS}]
     for sym, definition in derived.items():
         if sym.name in params:
             inputs += [n for n in _param_names([definition]) if n not in inputs]
-    inputs = [n for n in PARAM_ORDER if n in inputs]
-    printer = _Scalar()
+    inputs = [n for n in PARAM_ORDER if n in inputs] + ([PROFILE_BLOCK] if profile else [])
+    printer = _PackScalar()
     lines = ["def pack(values):",
              '    """Parameter vector p (laid out as PARAMS) from a mapping of the INPUTS names, SI units.',
              "",
              "    Computes the laws' constants (Y_e, Eq. 14) and the sines and cosines of parameter-only",
-             "    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call.",
-             '    """']
-    lines += [f"    {n} = float(values[{n!r}])" for n in inputs]
+             "    angles (sin_<angle>, cos_<angle>: derive.trig) once, here, not in every kernel call."]
+    if profile:
+        lines += [f"    The cam's profile data (values[{PROFILE_BLOCK!r}], a flat array: see profile()) follows",
+                  "    the named parameters, from p[PROFILE_OFFSET] on; the support function at the 0-state's",
+                  "    angle (h<n>_at_<angle>, Eq. 5) is computed here once."]
+    lines += ['    """']
+    lines += [f"    {n} = float(values[{n!r}])" for n in inputs if n != PROFILE_BLOCK]
+    if profile:
+        lines.append(f"    {_BLOCK_LOCAL} = numpy.ascontiguousarray(values[{PROFILE_BLOCK!r}], dtype=float)")
     for sym, definition in derived.items():
         if sym.name in params:
             lines.append(f"    {sym.name} = {printer.doprint(definition)}")
-    lines.append(f"    return numpy.array([{', '.join(params)}], dtype=float)")
+    named = f"numpy.array([{', '.join(params)}], dtype=float)"
+    lines.append(f"    return numpy.concatenate(({named}, {_BLOCK_LOCAL}))" if profile else f"    return {named}")
     return "\n".join(lines), inputs
 
 
@@ -562,21 +611,33 @@ def _module_text(header: str, doc: list[str], imports: list[str], data: list[str
 _MATH = "from math import *  # noqa: F401,F403  (sin, cos, sqrt, ... on floats)"
 
 
+def _profile_parts(L: "_Layout") -> tuple[list[str], list[str], list[str]]:
+    """A scene on a cam other than the circle: the imports, data and code its modules add for
+    the profile evaluator (derive.profile_code); nothing for the paper's circle."""
+    family = L.mod.spec.profile
+    if family == "eccentric":
+        return [], [], []
+    data = ["# --- the cam's profile (derive.profile_code): its data follows PARAMS in p ---",
+            f"PROFILE = {family!r}", f"PROFILE_OFFSET = {len(L.params)}"]
+    return ["import numba"], data, [evaluator_source(family)]
+
+
 def _scene_source(L: _Layout) -> str:
     """The text of a scene's module (``scene_<slug>``)."""
     spec, A = L.mod.spec, L.mod.automaton
     companion = variational_name(spec) if L.mod.variational else None
-    pack, inputs = _pack_code(L.params, L.constants)
+    pack, inputs = _pack_code(L.params, L.constants, spec.profile != "eccentric")
+    extra_imports, extra_data, extra_code = _profile_parts(L)
     data = ["SCENE = " + repr(spec.derived_options()), f"SLUG = {spec.slug!r}",
             "#: the companion module of the variational kernels, beside this one (None: the scene has none)",
             f"VARIATIONAL = {companion!r}", "PARAMS = " + repr(tuple(L.params)), "INPUTS = " + repr(tuple(inputs)),
-            "UNITS = " + repr({n: UNITS.get(n, "1" if _is_constant(n) else None)
+            "UNITS = " + repr({n: UNITS.get(n, _constant_unit(n) if _is_constant(n) else None)
                                for n in L.params + [i for i in inputs if i not in L.params]})]
     data += _automaton_code(A)
     data += ["# --- output quantities (camdyn.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
-    data += _index_constants("OUT", OUTPUTS)
-    return _module_text(L.header(), _module_doc(spec, A, companion), [_MATH, "", "import numpy"], data,
-                        [pack] + L.kernels(L.mod.functions))
+    data += _index_constants("OUT", OUTPUTS) + extra_data
+    return _module_text(L.header(), _module_doc(spec, A, companion), [_MATH, "", "import numpy"] + extra_imports,
+                        data, extra_code + [pack] + L.kernels(L.mod.functions))
 
 
 def _variational_source(L: _Layout) -> str:
@@ -589,7 +650,10 @@ def _variational_source(L: _Layout) -> str:
         names = tuple(n[len(SENSITIVITY_PREFIX):] for n in sensitivity)
         data += ["# --- continuation parameters of field_sensitivity (vocabulary.CONTINUATION_PARAMETERS) ---",
                  "SENSITIVITY = " + repr(names)] + _index_constants("SENS", names)
-    return _module_text(L.header(), _variational_doc(spec), [_MATH], data, L.kernels(L.mod.variational))
+    extra_imports, extra_data, extra_code = _profile_parts(L)
+    imports = [_MATH, ""] + extra_imports if extra_imports else [_MATH]
+    return _module_text(L.header(), _variational_doc(spec), imports, data + extra_data,
+                        extra_code + L.kernels(L.mod.variational))
 
 
 def sources(spec: SceneSpec) -> dict[str, str]:

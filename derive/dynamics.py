@@ -19,48 +19,59 @@ from . import laws
 from camdyn import vocabulary
 from . import symbols as S
 from .graph import Definition, flatten, quantity, substitutions
-from .geometry import N, E_to_Gc, P_to_Ob, chi, follower_frame, psi_i_conditioned, psi_j_conditioned
+from .geometry import (N, E_to_Gc, E_to_Oc_general, P_to_Ob, curvature_radius, follower_frame, psi_i_conditioned,
+                       psi_i_general, psi_j_conditioned, psi_j_general)
 from .symbols import Theta, alpha, t
 
 B = follower_frame(alpha)
 SLIDING_VELOCITY_FORMS = vocabulary.SLIDING_VELOCITY_FORMS
 
 
-@lru_cache(maxsize=None)
-def gap() -> sp.Expr:
-    """psi_i(alpha(t), Theta(t)) (Eq. 6, cancellation-free form)."""
-    return psi_i_conditioned(alpha, Theta)
+ECCENTRIC = "eccentric"  # the paper's cam (vocabulary.PROFILES[0])
 
 
 @lru_cache(maxsize=None)
-def psi_j() -> sp.Expr:
-    return psi_j_conditioned(alpha, Theta)
+def gap(profile: str = ECCENTRIC) -> sp.Expr:
+    """psi_i(alpha(t), Theta(t)) (Eq. 6, cancellation-free form); for a cam other than the
+    paper's circle, through its support function (geometry.psi_i_general)."""
+    return (psi_i_conditioned if profile == ECCENTRIC else psi_i_general)(alpha, Theta)
 
 
 @lru_cache(maxsize=None)
-def gap_rate() -> sp.Expr:
+def psi_j(profile: str = ECCENTRIC) -> sp.Expr:
+    """psi_j (Eq. 7), or geometry.psi_j_general for any other cam."""
+    return (psi_j_conditioned if profile == ECCENTRIC else psi_j_general)(alpha, Theta)
+
+
+def chi(profile: str = ECCENTRIC) -> sp.Expr:
+    """chi = chi0 - psi_j: the contact's distance from P along the bar (Eq. 2)."""
+    return S.chi0 - psi_j(profile)
+
+
+@lru_cache(maxsize=None)
+def gap_rate(profile: str = ECCENTRIC) -> sp.Expr:
     """psi_i_dot (Eq. 8), the time derivative of the gap."""
-    return gap().diff(t)
+    return gap(profile).diff(t)
 
 
 @lru_cache(maxsize=None)
-def psi_j_rate() -> sp.Expr:
+def psi_j_rate(profile: str = ECCENTRIC) -> sp.Expr:
     """psi_j_dot (Eq. 9)."""
-    return psi_j().diff(t)
+    return psi_j(profile).diff(t)
 
 
-def material_point_velocities() -> tuple[Vector, Vector]:
+def material_point_velocities(profile: str = ECCENTRIC) -> tuple[Vector, Vector]:
     """Velocities of the follower's and the cam's material points at the contact.
 
     The follower turns about the fixed P at -alpha_dot (clockwise); the cam
     about the fixed E at Theta_dot.  The cam's point is on its surface,
-    O_c = G_c - r_c n; the follower's is O_b on the bar's surface.
+    O_c = G_c - r_c n (any cam: E + h' u - h n); the follower's is O_b on the bar's surface.
     """
     P, E = Point("P"), Point("E")
     P.set_vel(N, 0)
     E.set_vel(N, 0)
-    Ob = P.locatenew("O_b", P_to_Ob(B, chi()))
-    Oc = E.locatenew("O_c", E_to_Gc(Theta) - S.r_c * B.y)
+    Ob = P.locatenew("O_b", P_to_Ob(B, chi(profile)))
+    Oc = E.locatenew("O_c", E_to_Gc(Theta) - S.r_c * B.y if profile == ECCENTRIC else E_to_Oc_general(B))
     follower = N.orientnew("follower_body", "Axis", (-alpha, N.z))
     cam = N.orientnew("cam_body", "Axis", (Theta, N.z))
     v_b = Ob.v2pt_theory(P, N, follower)
@@ -69,7 +80,7 @@ def material_point_velocities() -> tuple[Vector, Vector]:
 
 
 @lru_cache(maxsize=None)
-def sliding_velocity(form: str = "kinematic") -> sp.Expr:
+def sliding_velocity(form: str = "kinematic", profile: str = ECCENTRIC) -> sp.Expr:
     """v_r, the velocity of the follower relative to the cam along the bar (u).
 
     "kinematic": from the material points' velocities (rigid-body kinematics).
@@ -79,9 +90,9 @@ def sliding_velocity(form: str = "kinematic") -> sp.Expr:
                  v_r > 0 for a cam turning clockwise (self-energizing).
     """
     if form == "kinematic":
-        v_b, v_c = material_point_velocities()
+        v_b, v_c = material_point_velocities(profile)
         return sp.simplify((v_b - v_c).dot(B.x))
-    if form == "printed":
+    if form == "printed" and profile == ECCENTRIC:
         return psi_j_rate() - (S.r_c + S.e * sp.sin(alpha + Theta)) * (alpha.diff(t) + Theta.diff(t))
     raise ValueError(f"sliding velocity form {form!r} is not one of {SLIDING_VELOCITY_FORMS}")
 
@@ -97,6 +108,7 @@ class ContactRegime:
     direction: int = 0               # Coulomb only: sign of v_r, +1 | -1
     damping_sign: str = "dissipative"
     sliding_velocity: str = "kinematic"
+    profile: str = ECCENTRIC        # the cam: vocabulary.PROFILES
 
 
 @dataclass(frozen=True)
@@ -111,7 +123,7 @@ class Forces:
 
 #: Symbols of the named quantities of the contact mechanics (as they appear in generated code).
 Q = SimpleNamespace(**{name: quantity(name) for name in (
-    "psi_i", "psi_i_dot", "psi_j", "chi", "F_s", "k_lambda", "c_lambda", "F_n", "v_r", "mu", "F_f",
+    "psi_i", "psi_i_dot", "psi_j", "chi", "F_s", "rho", "k_lambda", "c_lambda", "F_n", "v_r", "mu", "F_f",
     "alpha_ddot")})
 
 
@@ -125,20 +137,23 @@ def mechanics(regime: ContactRegime | None) -> tuple[Definition, ...]:
     F_s = Definition(Q.F_s, laws.spring_force(alpha), "spring force (Eq. 11)")
     if regime is None:
         return (F_s,)
-    defs = [Definition(Q.psi_i, gap(), "gap (Eq. 6); contact deflection where negative"),
-            Definition(Q.psi_i_dot, gap_rate(), "gap rate (Eq. 8)"),
-            Definition(Q.psi_j, psi_j(), "sliding of the contact point along the bar (Eq. 7)"),
+    profile = regime.profile
+    defs = [Definition(Q.psi_i, gap(profile), "gap (Eq. 6); contact deflection where negative"),
+            Definition(Q.psi_i_dot, gap_rate(profile), "gap rate (Eq. 8)"),
+            Definition(Q.psi_j, psi_j(profile), "sliding of the contact point along the bar (Eq. 7)"),
             Definition(Q.chi, S.chi0 - Q.psi_j, "moment arm of F_n about P (Eq. 2)"),
-            F_s,
-            Definition(Q.k_lambda, laws.contact_stiffness(regime.contact, Q.psi_i),
-                       "contact stiffness (Eq. 13 line, Eq. 34 point)"),
+            F_s]
+    if _radius(regime) is Q.rho:
+        defs.append(Definition(Q.rho, curvature_radius(), "the cam's radius of curvature at the contact, h + h''"))
+    defs += [Definition(Q.k_lambda, laws.contact_stiffness(regime.contact, Q.psi_i, _radius(regime)),
+                        "contact stiffness (Eq. 13 line, Eq. 34 point)"),
             Definition(Q.c_lambda, laws.damping_coefficient(regime.damping, regime.phase, _stiffness(regime), Q.psi_i,
                                                             regime.damping_sign),
                        f"contact damping, model {regime.damping} (Eqs. 24-28)"),
-            Definition(Q.F_n, laws.elastic_force(regime.contact, Q.psi_i, Q.k_lambda) - Q.c_lambda * Q.psi_i_dot,
-                       "normal contact force (Eq. 12)")]
+             Definition(Q.F_n, laws.elastic_force(regime.contact, Q.psi_i, Q.k_lambda, _radius(regime))
+                        - Q.c_lambda * Q.psi_i_dot, "normal contact force (Eq. 12)")]
     if regime.friction != "none":
-        defs += [Definition(Q.v_r, sliding_velocity(regime.sliding_velocity),
+        defs += [Definition(Q.v_r, sliding_velocity(regime.sliding_velocity, profile),
                             f"sliding velocity ({regime.sliding_velocity} form)"),
                  Definition(Q.mu, laws.friction_coefficient(regime.friction, Q.v_r, regime.direction),
                             f"friction coefficient ({regime.friction})"),
@@ -153,7 +168,15 @@ def _stiffness(regime: ContactRegime) -> sp.Expr:
     the chain rule through the named k would give 0 * inf there (Jacobians, by forward mode)."""
     if regime.contact == "line":
         return Q.k_lambda
-    return laws.contact_stiffness(regime.contact, Q.psi_i)
+    return laws.contact_stiffness(regime.contact, Q.psi_i, _radius(regime))
+
+
+def _radius(regime: ContactRegime) -> sp.Expr:
+    """The Hertz radius of a point contact: r_c on the paper's circle, the named rho = h + h''
+    on any other cam (None for line contact, whose stiffness has no radius, Eq. 13)."""
+    if regime.contact != "point":
+        return None
+    return S.r_c if regime.profile == ECCENTRIC else Q.rho
 
 
 def named_forces(regime: ContactRegime | None) -> Forces:
@@ -179,11 +202,11 @@ def forces(regime: ContactRegime | None) -> Forces:
     of alpha(t), Theta(t): :func:`mechanics` with every quantity substituted."""
     flat = substitutions(mechanics(regime))
     zero = sp.Integer(0)
-    kinematic = sliding_velocity("kinematic")
+    kinematic = sliding_velocity("kinematic", ECCENTRIC if regime is None else regime.profile)
     return Forces(flat[Q.F_s], flat.get(Q.F_n, zero), flat.get(Q.F_f, zero), flat.get(Q.v_r, kinematic))
 
 
-def applied_forces(f: Forces, chi_: sp.Expr | None = None) -> list[tuple[Vector, Vector]]:
+def applied_forces(f: Forces, chi_: sp.Expr | None = None, profile: str = ECCENTRIC) -> list[tuple[Vector, Vector]]:
     """(point relative to P, force vector on the follower) pairs.
 
     Spring: vertical, at horizontal distance d_x (Eq. 11 acts as a vertical force).
@@ -191,7 +214,7 @@ def applied_forces(f: Forces, chi_: sp.Expr | None = None) -> list[tuple[Vector,
     Friction: -F_f u at O_b, opposing the follower's sliding velocity v_r u
     relative to the cam (F_f = mu F_n with mu of the sign of v_r).
     """
-    r_Ob = P_to_Ob(B, chi() if chi_ is None else chi_)
+    r_Ob = P_to_Ob(B, chi(profile) if chi_ is None else chi_)
     r_spring = S.d_x * N.x + (-S.d_x * sp.tan(alpha)) * N.y
     return [
         (r_spring, f.F_s * N.y),
@@ -200,10 +223,10 @@ def applied_forces(f: Forces, chi_: sp.Expr | None = None) -> list[tuple[Vector,
     ]
 
 
-def moment_about_P(f: Forces, chi_: sp.Expr | None = None) -> sp.Expr:
+def moment_about_P(f: Forces, chi_: sp.Expr | None = None, profile: str = ECCENTRIC) -> sp.Expr:
     """Clockwise moment about P of the applied forces (alpha is clockwise); ``chi_`` the moment
-    arm of the contact forces (default: chi0 - psi_j, Eq. 2)."""
-    total = sum((r.cross(F) for r, F in applied_forces(f, chi_)), Vector(0))
+    arm of the contact forces (default: chi0 - psi_j of the profile's cam, Eq. 2)."""
+    total = sum((r.cross(F) for r, F in applied_forces(f, chi_, profile)), Vector(0))
     return -total.dot(N.z)
 
 

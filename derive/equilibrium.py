@@ -22,15 +22,15 @@ def at_rest(expr: sp.Expr) -> sp.Expr:
     return expr.subs({alpha.diff(t): 0, Theta.diff(t): 0}).subs(Theta, S.theta0)
 
 
-def static_gap() -> tuple[sp.Expr, sp.Expr]:
+def static_gap(profile: str = dynamics.ECCENTRIC) -> tuple[sp.Expr, sp.Expr]:
     """(psi_i*, psi_j*) as functions of alpha: Eqs. 16 and 17."""
-    return at_rest(dynamics.gap()), at_rest(dynamics.psi_j())
+    return at_rest(dynamics.gap(profile)), at_rest(dynamics.psi_j(profile))
 
 
-def static_moment(contact: str) -> sp.Expr:
+def static_moment(contact: str, profile: str = dynamics.ECCENTRIC) -> sp.Expr:
     """M(alpha) at rest, undamped and frictionless: Eq. 18 is M(alpha*) = 0."""
-    regime = dynamics.ContactRegime(contact=contact)
-    return at_rest(dynamics.moment_about_P(dynamics.forces(regime)))
+    regime = dynamics.ContactRegime(contact=contact, profile=profile)
+    return at_rest(dynamics.moment_about_P(dynamics.forces(regime), profile=profile))
 
 
 def state_jacobian(alpha_ddot: sp.Expr) -> sp.Matrix:

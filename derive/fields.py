@@ -25,7 +25,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import dynamics, energy, equilibrium, geometry, laws, linear
+from . import dynamics, energy, equilibrium, geometry, laws, linear, profile
 from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
@@ -84,7 +84,8 @@ def regime(spec: SceneSpec, mode: Mode, direction: int | None = None) -> dynamic
         direction = {"fwd": 1, "bwd": -1}.get(mode.slip, 0)
     return dynamics.ContactRegime(contact=spec.contact, damping=spec.damping, phase=phase,
                                   friction=spec.friction, direction=direction,
-                                  damping_sign=spec.damping_sign, sliding_velocity=spec.sliding_velocity)
+                                  damping_sign=spec.damping_sign, sliding_velocity=spec.sliding_velocity,
+                                  profile=spec.profile)
 
 
 # --- the pieces ---------------------------------------------------------------------------
@@ -93,7 +94,7 @@ V_R_PARTIALS = tuple(quantity(n) for n in ("dv_r_dt", "dv_r_dalpha", "dv_r_dalph
 
 def _slip_partials(spec: SceneSpec) -> tuple[Definition, ...]:
     """v_r and its partial derivatives in t, alpha, alpha_dot (the sliding mode's ingredients)."""
-    v = plain(dynamics.sliding_velocity(spec.sliding_velocity), spec.motion)
+    v = plain(dynamics.sliding_velocity(spec.sliding_velocity, spec.profile), spec.motion)
     notes = ("dv_r/dt at fixed state", "dv_r/dalpha", "dv_r/dalpha_dot")
     return (Definition(Q.v_r, v, f"sliding velocity ({spec.sliding_velocity} form)"),) + tuple(
         Definition(sym, v.diff(x), note) for sym, x, note in zip(V_R_PARTIALS, (S.t_s, S.alpha_s, S.alpha_dot), notes))
@@ -147,12 +148,18 @@ def jacobian(spec: SceneSpec, mode: Mode) -> Kernel:
 def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
     """The value of surface ``name`` under the mode's laws (None where it has no meaning)."""
     if name == "gap":
-        return Kernel((Definition(Q.psi_i, plain(dynamics.gap(), spec.motion), "gap (Eq. 6)"),), (Q.psi_i,))
+        return Kernel((Definition(Q.psi_i, plain(dynamics.gap(spec.profile), spec.motion), "gap (Eq. 6)"),),
+                      (Q.psi_i,))
     if name == "gap_rate":
-        return Kernel((Definition(Q.psi_i_dot, plain(dynamics.gap_rate(), spec.motion), "gap rate (Eq. 8)"),),
+        return Kernel((Definition(Q.psi_i_dot, plain(dynamics.gap_rate(spec.profile), spec.motion),
+                                  "gap rate (Eq. 8)"),),
                       (Q.psi_i_dot,))
     if name == "slip":
         return Kernel(_slip_partials(spec)[:1], (Q.v_r,))
+    if name == "junction":
+        value = quantity("junction")
+        phi = plain(geometry.phi_contact(), spec.motion)
+        return Kernel((Definition(value, profile.junction(phi), "the arcs' junction indicator"),), (value,))
     if name in ("slip_rate_fwd", "slip_rate_bwd") and mode.contact:
         side = _mechanics(spec, mode, direction=1 if name == "slip_rate_fwd" else -1)
         v_t, v_a, v_ad = V_R_PARTIALS
@@ -168,14 +175,14 @@ def continuation_parameters(spec: SceneSpec, modes) -> tuple[str, ...]:
 
 
 @lru_cache(maxsize=None)
-def _equilibrium_rates(contact: str, name: str) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
+def _equilibrium_rates(contact: str, profile: str, name: str) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
     """(quantity, its derivative by parameter ``name``) for the equilibrium's alpha*, chi* and
     vartheta, where not zero: M(alpha*) = 0 (Eq. 18) gives dalpha*/dq = -M_q / M_alpha (implicit
     function theorem), chi* = chi0 - psi_j*(alpha*) (Eq. 17) and vartheta = sqrt(-M_alpha / I_Pb)
     (Eq. 23), all at alpha = alpha*, as the runtime solves them (camdyn.model.model)."""
     q = S.PARAMS[name].symbol
-    M = S.to_plain(equilibrium.static_moment(contact))
-    psi_j = S.to_plain(equilibrium.static_gap()[1])
+    M = S.to_plain(equilibrium.static_moment(contact, profile))
+    psi_j = S.to_plain(equilibrium.static_gap(profile)[1])
     at = {S.alpha_s: S.alpha_star}
     M_a = M.diff(S.alpha_s)
     d_alpha = (-M.diff(q) / M_a).subs(at)
@@ -197,7 +204,7 @@ def field_sensitivity(spec: SceneSpec, mode: Mode, names: tuple[str, ...]) -> Ke
         direct = derivatives(f.definitions, q)
         defs += direct
         total = derivative_symbol("alpha_ddot", q, direct)
-        for sym, rate in _equilibrium_rates(spec.contact, name):
+        for sym, rate in _equilibrium_rates(spec.contact, spec.profile, name):
             if sym not in done:
                 done[sym] = derivatives(f.definitions, sym)
                 defs += done[sym]
@@ -281,10 +288,11 @@ def spring_potential() -> sp.Expr:
 
 
 @lru_cache(maxsize=None)
-def _energy_terms(contact: str):
+def _energy_terms(contact: str, profile: str):
     """V_s(alpha), its derivative in the named form d_x F_s, and in contact V_c(psi_i), in
-    plain symbols (psi_i named)."""
-    return spring_potential(), S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i)
+    plain symbols (psi_i named; a point contact on a cam other than the circle: rho named)."""
+    radius = Q.rho if contact == "point" and profile != dynamics.ECCENTRIC else S.r_c
+    return spring_potential(), S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i, radius)
 
 
 def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
@@ -297,13 +305,14 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
     else:
         defs = _mechanics(spec, mode)
     geometry_defs = []
-    for sym, expr, note in ((Q.psi_i, dynamics.gap(), "gap (Eq. 6)"), (Q.psi_i_dot, dynamics.gap_rate(), "Eq. 8"),
-                            (Q.psi_j, dynamics.psi_j(), "Eq. 7")):
+    for sym, expr, note in ((Q.psi_i, dynamics.gap(spec.profile), "gap (Eq. 6)"),
+                            (Q.psi_i_dot, dynamics.gap_rate(spec.profile), "Eq. 8"),
+                            (Q.psi_j, dynamics.psi_j(spec.profile), "Eq. 7")):
         if sym not in {d.symbol for d in defs}:
             geometry_defs.append(Definition(sym, plain(expr, spec.motion), note))
     defs = tuple(geometry_defs) + defs
     names = {d.symbol for d in defs}
-    kinematic = plain(dynamics.sliding_velocity("kinematic"), spec.motion)
+    kinematic = plain(dynamics.sliding_velocity("kinematic", spec.profile), spec.motion)
     if Q.v_r in names and spec.sliding_velocity == "kinematic":
         v_kin = Q.v_r
     else:
@@ -311,7 +320,7 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
         defs += (Definition(v_kin, kinematic, "relative velocity of the contact points along the bar"),)
     v_r_out = Q.v_r if Q.v_r in names else v_kin
     forces = dynamics.Forces(Q.F_s, Q.F_n if r else zero, Q.F_f if Q.F_f in names else zero, v_r_out)
-    V_s, dV_s, V_c = _energy_terms(spec.contact)
+    V_s, dV_s, V_c = _energy_terms(spec.contact, spec.profile)
     E = S.I_Pb * S.alpha_dot**2 / 2 + V_s + (V_c if r else zero)
     if r is None:  # free flight: no contact force, nothing delivered or dissipated
         dE_dt = D_c = D_f = zero
@@ -320,8 +329,7 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
         D_c, D_f = -F_d * Q.psi_i_dot, forces.F_f * v_kin
         dE_dt = (S.I_Pb * Q.alpha_ddot + dV_s) * S.alpha_dot + V_c.diff(Q.psi_i) * Q.psi_i_dot
     named = [(quantity("N_x"), plain(dynamics.bearing_force_x(forces), spec.motion), "bearing force (Eq. 35)"),
-             (quantity("alpha_i"), plain(geometry.rigid_contact_angle(S.Theta), spec.motion),
-              "follower angle in rigid contact (Eq. 29)"),
+             (quantity("alpha_i"), _rigid_contact_output(spec), "follower angle in rigid contact (Eq. 29)"),
              (quantity("energy"), E, "T + V_s + V_c (Section 5)"),
              (quantity("D_c"), D_c, "power dissipated by contact damping"),
              (quantity("D_f"), D_f, "power dissipated by friction"),
@@ -332,3 +340,12 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
               "F_f": forces.F_f, "v_r": v_r_out}
     results = tuple(values.get(name, quantity(name)) for name in OUTPUTS)
     return Kernel(defs, results).pruned()
+
+
+def _rigid_contact_output(spec: SceneSpec) -> sp.Expr:
+    """alpha_i (Eq. 29, misprint 10) on the paper's circle; NaN on any other cam, where the
+    rigid contact angle is the root of psi_i(alpha, Theta) = 0, with no closed form (the
+    OUTPUTS entry says so)."""
+    if spec.profile == dynamics.ECCENTRIC:
+        return plain(geometry.rigid_contact_angle(S.Theta), spec.motion)
+    return sp.nan

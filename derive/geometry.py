@@ -17,6 +17,7 @@ from functools import lru_cache
 import sympy as sp
 from sympy.physics.vector import ReferenceFrame, Vector
 
+from .profile import h
 from .symbols import Theta, alpha, alpha0, chi0, e, r_c, theta0, w_b
 
 N = ReferenceFrame("N")
@@ -116,3 +117,55 @@ def reach_margin(cam_angle: sp.Expr = Theta) -> sp.Expr:
     """|P->G_c| - (r_c + w_b/2): negative where no follower angle touches the cam."""
     r = P_to_Gc(cam_angle)
     return sp.sqrt(r.dot(N.x) ** 2 + r.dot(N.y) ** 2) - (r_c + w_b / 2)
+
+
+# --- any convex cam: the loop through the support function (derive.profile) ---------------
+def phi_contact(a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> sp.Expr:
+    """The body angle of the cam's outward normal at the contact: the normal is -n, at the
+    fixed angle 3 pi/2 - a, so phi = 3 pi/2 - a - Theta (derive.profile's conventions)."""
+    return 3 * sp.pi / 2 - a - cam_angle
+
+
+def P_to_E_general() -> Vector:
+    """Eq. 5 for any cam: in the 0-state the bar's surface touches the cam's support line of
+    normal angle phi0 = phi_contact(alpha0, theta0) at chi0, so P->E = P->O_b - E->O_c with
+    E->O_c = R(theta0) c(phi0) = h'(phi0) u0 - h(phi0) n0 (u0, n0 the bar's frame there)."""
+    B0 = follower_frame(alpha0)
+    phi0 = phi_contact(alpha0, theta0)
+    return (chi0 - h(phi0, 1)) * B0.x + (w_b / 2 + h(phi0)) * B0.y
+
+
+def psi_i_general(a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> sp.Expr:
+    """The gap for any cam: the distance along n from the bar's surface (P.n + w_b/2) to the
+    cam's support line of normal -n (E.n - h(phi)), psi_i = P->E . n - w_b/2 - h(phi).
+
+    With d = a - alpha0, P->E . n = (chi0 - h'(phi0)) sin d + (w_b/2 + h(phi0)) cos d; written
+    with cos d - 1 = -2 sin^2(d/2) so that no term is of the size of the geometry itself but
+    the difference h(phi0) - h(phi).  With the paper's circle it is Eq. 6
+    (tests/test_derive_equations.py proves it)."""
+    d = a - alpha0
+    phi0 = phi_contact(alpha0, theta0)
+    return ((chi0 - h(phi0, 1)) * sp.sin(d) - (w_b + 2 * h(phi0)) * sp.sin(d / 2) ** 2
+            + h(phi0) - h(phi_contact(a, cam_angle)))
+
+
+def psi_j_general(a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> sp.Expr:
+    """psi_j = chi0 - chi for any cam, chi = P->E . u + h'(phi) the contact point's distance
+    from P along the bar (the contact point is E + h'(phi) u - h(phi) n); Eq. 7 with the
+    paper's circle."""
+    d = a - alpha0
+    phi0 = phi_contact(alpha0, theta0)
+    return (2 * (chi0 - h(phi0, 1)) * sp.sin(d / 2) ** 2 + (w_b / 2 + h(phi0)) * sp.sin(d)
+            + h(phi0, 1) - h(phi_contact(a, cam_angle), 1))
+
+
+def E_to_Oc_general(B: ReferenceFrame, a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> Vector:
+    """The cam's contact point from E, in the bar's frame: R(Theta) c(phi) = h'(phi) u - h(phi) n."""
+    phi = phi_contact(a, cam_angle)
+    return h(phi, 1) * B.x - h(phi) * B.y
+
+
+def curvature_radius(a: sp.Expr = alpha, cam_angle: sp.Expr = Theta) -> sp.Expr:
+    """rho = h + h'' at the contact: the Hertz radius of a point contact (Eq. 34 with r_c -> rho)."""
+    phi = phi_contact(a, cam_angle)
+    return h(phi) + h(phi, 2)

@@ -36,17 +36,18 @@ def equivalent_modulus() -> sp.Expr:
 CONSTANTS: dict[sp.Symbol, sp.Expr] = {Y_e: equivalent_modulus()}
 
 
-def contact_stiffness(law: str, psi_i: sp.Expr) -> sp.Expr:
+def contact_stiffness(law: str, psi_i: sp.Expr, radius: sp.Expr = S.r_c) -> sp.Expr:
     """k_lambda(psi_i): Eq. 13 (line, constant) or Eq. 34 (point, Hertz, grows as |psi_i|^0.5).
 
     The point law uses |psi_i|, so inside the contact regime an integration stage
     that overshoots to psi_i > 0 gets a finite (odd, C1) extension, never a NaN.
-    Misprint 11: r_c is the only radius of curvature, l_lambda does not enter.
+    Misprint 11: the cam's radius of curvature is the only one, l_lambda does not enter;
+    ``radius`` is r_c for the paper's circle, rho = h + h'' at the contact for any other cam.
     """
     if law == "line":
         return sp.pi / 4 * Y_e * S.l_lambda
     if law == "point":
-        return sp.Rational(4, 3) * Y_e * sp.sqrt(S.r_c * sp.Abs(psi_i))
+        return sp.Rational(4, 3) * Y_e * sp.sqrt(radius * sp.Abs(psi_i))
     raise ValueError(f"contact law {law!r} is not one of {CONTACT_LAWS}")
 
 
@@ -61,24 +62,27 @@ class SignedPow32(sp.Function):
         return sp.Rational(3, 2) * sp.sqrt(sp.Abs(self.args[0]))
 
 
-def elastic_force(law: str, psi_i: sp.Expr, k_lambda: sp.Expr | None = None) -> sp.Expr:
+def elastic_force(law: str, psi_i: sp.Expr, k_lambda: sp.Expr | None = None, radius: sp.Expr = S.r_c) -> sp.Expr:
     """-k_lambda(psi_i) psi_i, the elastic part of F_n in Eq. 12.
 
     ``k_lambda``: the stiffness as already computed (a named quantity), used as it is for the
-    line law; the point law is written with :class:`SignedPow32` for a clean derivative."""
+    line law; the point law is written with :class:`SignedPow32` for a clean derivative.
+    ``radius``: as in :func:`contact_stiffness`."""
     if law == "point":
-        return -sp.Rational(4, 3) * Y_e * sp.sqrt(S.r_c) * SignedPow32(psi_i)
+        return -sp.Rational(4, 3) * Y_e * sp.sqrt(radius) * SignedPow32(psi_i)
     return -(contact_stiffness(law, psi_i) if k_lambda is None else k_lambda) * psi_i
 
 
-def contact_potential(law: str, psi_i: sp.Expr) -> sp.Expr:
+def contact_potential(law: str, psi_i: sp.Expr, radius: sp.Expr = S.r_c) -> sp.Expr:
     """Elastic energy stored in the contact at deflection |psi_i| (psi_i <= 0 in contact).
 
     Built as the integral of the elastic normal force -k_lambda(psi) psi over the
-    deflection, so that its derivative is the force of Eq. 12 by construction.
+    deflection, so that its derivative is the force of Eq. 12 by construction.  With a
+    radius that varies along the cam (point contact on a cam other than a circle) it is the
+    energy at the present radius: the Hertz force is then not exactly conservative.
     """
     x, delta = sp.symbols("x delta", nonnegative=True)  # deflection, its final value
-    energy = sp.integrate(contact_stiffness(law, -x) * x, (x, 0, delta))
+    energy = sp.integrate(contact_stiffness(law, -x, radius) * x, (x, 0, delta))
     return energy.subs(delta, sp.Abs(psi_i))  # even in psi_i: finite on stage overshoot
 
 

@@ -135,16 +135,26 @@ def _single(*results: sp.Expr) -> tuple[Case, ...]:
 def _static_functions(spec: SceneSpec) -> list[Function]:
     """Kernels that do not depend on a run: the equilibrium's moment (Eqs. 16-18), the rigid
     contact angle (Eq. 29) and the spring's potentials."""
-    M = S.to_plain(equilibrium.static_moment(spec.contact))
-    psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap())
+    M = S.to_plain(equilibrium.static_moment(spec.contact, spec.profile))
+    psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap(spec.profile))
+    radius = S.r_c if spec.profile == "eccentric" else S.to_plain(
+        equilibrium.at_rest(geometry.curvature_radius()))
+    static = [
+        Function("static_moment", ("alpha", "p"), (), ("M", "dM_dalpha", "psi_i", "psi_j", "k_lambda"),
+                 _single(M, M.diff(S.alpha_s), psi_i_star, psi_j_star,
+                         laws.contact_stiffness(spec.contact, psi_i_star, radius)),
+                 "Static moment about P at Theta0, its slope, psi_i*, psi_j* (Eqs. 16-18) and the contact "
+                 "stiffness k_lambda(psi_i) (Eq. 13 or 34, secant).", "tuple"),
+        Function("spring_potential", ("alpha", "p"), (), ("V_s", "V_s_printed"),
+                 _single(fields.spring_potential(), S.to_plain(energy.spring_potential_printed())),
+                 "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33.", "tuple"),
+    ]
+    if spec.profile != "eccentric":  # no closed form of the rigid contact angle on another cam
+        return static
     a_i = S.to_plain(geometry.rigid_contact_angle(S.Theta))
     a_i_th = a_i.diff(S.Theta_s)
     spring_moment = laws.spring_force(S.alpha_s).subs(S.alpha_s, a_i) * S.d_x
-    return [
-        Function("static_moment", ("alpha", "p"), (), ("M", "dM_dalpha", "psi_i", "psi_j", "k_lambda"),
-                 _single(M, M.diff(S.alpha_s), psi_i_star, psi_j_star, laws.contact_stiffness(spec.contact, psi_i_star)),
-                 "Static moment about P at Theta0, its slope, psi_i*, psi_j* (Eqs. 16-18) and the contact "
-                 "stiffness k_lambda(psi_i) (Eq. 13 or 34, secant).", "tuple"),
+    return static[:1] + [
         Function("reach", ("Theta", "p"), (), ("reach_margin",), _single(S.to_plain(geometry.reach_margin(S.Theta))),
                  "|PG_c| - (r_c + w_b/2): where negative, no follower angle touches the cam (check it before "
                  "rigid_contact, whose arcsine needs it positive).", "tuple"),
@@ -153,10 +163,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
                  _single(a_i, a_i_th, a_i_th.diff(S.Theta_s), spring_moment),
                  "Follower angle in rigid contact alpha_i(Theta) (Eq. 29, misprint 10), its derivatives in "
                  "Theta, and the spring moment F_s d_x there.", "tuple"),
-        Function("spring_potential", ("alpha", "p"), (), ("V_s", "V_s_printed"),
-                 _single(fields.spring_potential(), S.to_plain(energy.spring_potential_printed())),
-                 "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33.", "tuple"),
-    ]
+    ] + static[1:]
 
 
 @lru_cache(maxsize=None)

@@ -40,6 +40,8 @@ SURFACES: dict[str, tuple[str, str]] = {
                                "forward where it turns positive"),
     "slip_rate_bwd": ("m/s^2", "dv_r/dt under the backward-sliding field: the stuck follower slips "
                                "backward where it turns negative"),
+    "junction": ("1", "a cam of circular arcs (profile 'arcs'): zero where the contact passes a junction of "
+                      "two arcs, where the curvature jumps; the step restarts there, in the same mode"),
 }
 
 # --- output quantities ------------------------------------------------------------------------

@@ -14,6 +14,9 @@ SLIDING_VELOCITY_FORMS = ("kinematic", "printed")       # misprint 8
 DAMPING_SIGNS = ("dissipative", "printed")              # misprint 2
 DAMPING_SWITCHES = ("episode", "memoryless")            # Sec. 3.4, models D and E (see SceneSpec)
 FOLLOWERS = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
+#: the cam's shape: the paper's eccentric circle (Eq. 3-4), or a convex cam given by its support
+#: function h(phi) (docs/model-editing.md, "a new cam"): a periodic piecewise quintic, or circular arcs
+PROFILES = ("eccentric", "spline", "arcs")
 
 OPTIONS: dict[str, tuple[str, ...]] = {
     "contact": CONTACT_LAWS,
@@ -25,6 +28,7 @@ OPTIONS: dict[str, tuple[str, ...]] = {
     "damping_sign": DAMPING_SIGNS,
     "damping_switch": DAMPING_SWITCHES,
     "follower": FOLLOWERS,
+    "profile": PROFILES,
 }
 
 #: options that say how the runtime uses a derived model rather than what is derived: they have
@@ -37,6 +41,8 @@ SLUG_SUFFIXES: dict[str, tuple[str, str]] = {
     "printedsign": ("damping_sign", "printed"),
     "memoryless": ("damping_switch", "memoryless"),
     "quasistatic": ("follower", "quasistatic"),
+    "spline": ("profile", "spline"),
+    "arcs": ("profile", "arcs"),
 }
 
 #: damping models with an impact law until maximum compression, then a viscous one (Eqs. 27-28)
@@ -68,6 +74,10 @@ class SceneSpec:
         follower: "dynamic" (the hybrid model: free flight, impacts, contact) or "quasistatic"
                   (no integration: Eq. 10 solved for alpha with alpha_dot, alpha_ddot of the rigid
                   kinematics, Eq. 29, for a follower that never leaves the cam; camdyn.runs.quasistatic)
+        profile:  "eccentric" (the paper's circle, Eqs. 3-4), "spline" (a convex cam given by its
+                  support function h(phi) as a periodic piecewise quintic) or "arcs" (a cam of
+                  circular arcs, whose junctions are switching surfaces); the profile's data
+                  travels with the rig (camdyn.model.profiles)
     """
 
     contact: str = "line"
@@ -79,6 +89,7 @@ class SceneSpec:
     damping_sign: str = "dissipative"
     damping_switch: str = "episode"
     follower: str = "dynamic"
+    profile: str = "eccentric"
 
     def __post_init__(self):
         for f in fields(self):
@@ -147,6 +158,14 @@ def combination_problem(spec: SceneSpec) -> str:
         if spec.damping in ("B", "C"):
             return (f"model={spec.model!r} needs a constant damping coefficient: damping 'none', 'A', "
                     "or the viscous part of 'D'/'E'")
+    if spec.profile != "eccentric":
+        if spec.model != "nonlinear":
+            return f"profile={spec.profile!r} needs model='nonlinear' (the linear models are the paper's, Section 8)"
+        if spec.sliding_velocity != "kinematic":
+            return f"profile={spec.profile!r} needs sliding_velocity='kinematic' (the printed form is the paper's circle)"
+        if spec.follower != "dynamic":
+            return (f"profile={spec.profile!r} has no quasi-static follower yet: its rigid contact angle is "
+                    "implicit (use follower='dynamic')")
     if spec.model == "linear_paper" and spec.contact != "line":
         return "model='linear_paper' is the paper's Eqs. 36-38, for line contact only"
     return ""

@@ -53,7 +53,7 @@ def test_ints_and_numpy_scalars_stored_as_float():
 def test_table_matches_dataclass_fields():
     fields = {f.name: f for f in dataclasses.fields(Rig)}
     assert [p.name for p in PARAMETERS] == REQUIRED + OPTIONAL
-    assert list(fields) == REQUIRED + OPTIONAL + ["name", "description", "origin"]
+    assert list(fields) == REQUIRED + OPTIONAL + ["name", "description", "origin", "profile", "profile_data"]
     for p in PARAMETERS:
         has_default = fields[p.name].default is not dataclasses.MISSING
         assert p.required is not has_default

@@ -25,6 +25,15 @@ from .scene import Scene, variational_kernels
 
 _DERIVED = EQUILIBRIUM_NAMES  # computed here, not given by the rig
 _CAM = CAM_NAMES              # given by the cam motion
+_PROFILE = "profile"          # a scene's input for the cam's profile data (derive.profile_code)
+
+
+def _rig_values(rig: Rig) -> dict:
+    """The rig's parameters by name, and its cam profile's data block where it has one."""
+    values = rig.to_dict()
+    if rig.profile_data is not None:
+        values[_PROFILE] = np.array(rig.profile_data[1])
+    return values
 
 
 @dataclass(frozen=True)
@@ -58,7 +67,8 @@ def static_parameters(rig: Rig, kernels: ModuleType) -> np.ndarray:
     ``reach``, ``rigid_contact``, ``spring_potential``): the rig's values, and NaN in the slots
     those kernels never read (equilibrium results, cam constants, optional parameters not
     given), so that a read of one would show as NaN rather than pass as a made-up number."""
-    values = {name: getattr(rig, name, None) for name in kernels.INPUTS}
+    given = _rig_values(rig)
+    values = {name: given.get(name) for name in kernels.INPUTS}
     return kernels.pack({name: math.nan if v is None else v for name, v in values.items()})
 
 
@@ -99,6 +109,19 @@ def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
                        float(k_lambda), math.sqrt(-dM / rig.I_Pb))
 
 
+def _check_profile(rig: Rig, scene: Scene) -> None:
+    """The scene's cam family must be the rig's: the paper's circle needs no profile, any other
+    family the rig's ``profile`` of that family."""
+    kind = None if rig.profile_data is None else rig.profile_data[0]
+    if scene.profile == "eccentric" and kind is not None:
+        raise SceneError(f"the rig's cam is a {kind!r} profile but the scene is the paper's eccentric circle: "
+                         f"use Scene(..., profile={kind!r})")
+    if scene.profile != "eccentric" and kind != scene.profile:
+        raise SceneError(f"the scene's cam is a {scene.profile!r} profile but the rig has "
+                         f"{'none (the eccentric circle)' if kind is None else repr(kind)}: give the rig a "
+                         f"profile of that family (Rig(..., profile=...), camdyn.model.profiles)")
+
+
 def _check_cam(scene: Scene, cam) -> None:
     if getattr(cam, "kind", None) != scene.motion:
         raise SceneError(f"the scene's motion is {scene.motion!r} but the cam given is "
@@ -127,8 +150,9 @@ class Model:
             raise TypeError(f"scene must be a camdyn.Scene, got {type(scene).__name__}")
         _check_cam(scene, cam)
         self.rig, self.scene, self.cam = rig, scene, cam
+        _check_profile(rig, scene)
         self.kernels = scene.kernels()
-        optional = [n for n in self.kernels.INPUTS if n not in _DERIVED + _CAM and getattr(rig, n) is None]
+        optional = [n for n in self.kernels.INPUTS if n not in _DERIVED + _CAM + (_PROFILE,) and getattr(rig, n) is None]
         if optional:
             rig.require(*optional, why=f"scene {scene.slug}")
         self.equilibrium = solve_equilibrium(rig, self.kernels)
@@ -154,7 +178,7 @@ class Model:
     def _static_values(self) -> dict:
         """The rig's parameters and its static equilibrium by name: p without the cam's constants."""
         eq = self.equilibrium
-        return {**self.rig.to_dict(), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta}
+        return {**_rig_values(self.rig), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta}
 
     def _packed(self, cam: CamMotion) -> np.ndarray:
         """The kernels' parameter vector p: the rig, its static equilibrium and the cam's constants."""
@@ -162,7 +186,10 @@ class Model:
         return self.kernels.pack({k: values[k] for k in self.kernels.INPUTS})
 
     def _check_reach(self):
-        """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round."""
+        """The cam must stay where the follower can touch it: |PG_c| > r_c + w_b/2 all round
+        (the paper's circle; another cam's profile is checked convex where it is built)."""
+        if not hasattr(self.kernels, "reach"):
+            return
         theta, margin = _worst_reach(self.rig, self.kernels)
         if not margin > 0:
             raise GeometryError(

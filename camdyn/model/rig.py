@@ -47,7 +47,10 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+import numpy as np
+
 from ..vocabulary.parameters import RIG_PARAMETERS, RigParameter, Rule
+from ..vocabulary.scenes import PROFILES
 from .._checks import is_real
 from ..errors import ParameterError, RigFileError
 
@@ -140,6 +143,22 @@ _TEXT_FIELDS = ("name", "description")
 _FIELDS = (*_BY_NAME, *_TEXT_FIELDS)
 
 
+def _profile_data(profile) -> tuple | None:
+    """A cam profile's family and data block (``profile.kind``, ``profile.block()``: see
+    :mod:`camdyn.model.profiles`), as a hashable tuple: what rigs are compared by; None for the
+    paper's circle (no profile given)."""
+    if profile is None:
+        return None
+    kind, block = getattr(profile, "kind", None), getattr(profile, "block", None)
+    if kind not in PROFILES[1:] or not callable(block):
+        raise ParameterError("profile", profile, f"a cam profile of a family in {PROFILES[1:]} "
+                             "(camdyn.model.profiles), or None for the paper's eccentric circle")
+    data = np.ascontiguousarray(block(), dtype=float)
+    if data.ndim != 1 or not np.all(np.isfinite(data)):
+        raise ParameterError("profile", profile, "a profile whose block() is a finite 1-D array")
+    return (kind, tuple(data.tolist()))
+
+
 def _check_names(names: Collection[Any], source: str, known: Collection[str], what: str = "parameter") -> None:
     """Raise :class:`RigFileError` for names not in ``known``, suggesting close matches."""
     unknown = [n for n in names if n not in known]
@@ -168,9 +187,12 @@ def _with_declared_fields(cls: type) -> type:
         notes[p.name] = "float" if p.required else "float | None"
         if not p.required:
             setattr(cls, p.name, None)
-    notes.update(name="str", description="str", origin="str")
+    notes.update(name="str", description="str", origin="str", profile="object", profile_data="tuple")
     cls.name, cls.description = "unnamed", ""
     cls.origin = dataclasses.field(default="", compare=False)  # provenance, not physics
+    # the cam's shape when it is not the paper's circle; compared and hashed by its data
+    cls.profile = dataclasses.field(default=None, compare=False, repr=False)
+    cls.profile_data = dataclasses.field(default=None, init=False, repr=False)
     cls.__annotations__ = notes
     return dataclass(frozen=True, kw_only=True)(cls)
 
@@ -197,6 +219,7 @@ class Rig:
         for field in (*_TEXT_FIELDS, "origin"):
             if not isinstance(getattr(self, field), str):
                 raise ParameterError(field, getattr(self, field), "a string")
+        object.__setattr__(self, "profile_data", _profile_data(self.profile))
 
     @property
     def Y_e(self) -> float:
@@ -221,7 +244,7 @@ class Rig:
         """A validated copy with some fields changed; unknown names raise
         :class:`~camdyn.errors.RigFileError` with a suggestion.  The copy's ``origin`` says
         which parameters changed (unless ``origin`` is given)."""
-        _check_names(changes, "Rig.replace()", (*_FIELDS, "origin"))
+        _check_names(changes, "Rig.replace()", (*_FIELDS, "origin", "profile"))
         changed = sorted(k for k in changes if k in _BY_NAME)
         if "origin" not in changes and self.origin and changed:
             changes["origin"] = f"{self.origin}; changed {', '.join(changed)}"
@@ -230,8 +253,9 @@ class Rig:
     def to_dict(self) -> dict[str, Any]:
         """The parameters, ``name`` and ``description`` as a flat dict, optional ones not given
         as ``None`` (``origin`` left out: it is not a value of the rig); see :meth:`from_dict`."""
-        out = dataclasses.asdict(self)
-        del out["origin"]
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        for key in ("origin", "profile", "profile_data"):
+            del out[key]
         return out
 
     @classmethod

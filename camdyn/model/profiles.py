@@ -27,7 +27,7 @@ Every constructor refuses a cam that is not convex (:func:`check_convex`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,7 +35,7 @@ from .._checks import finite, integer
 from ..errors import ParameterError
 
 __all__ = ["EccentricCircle", "SplineProfile", "ArcProfile", "check_convex", "CONVEXITY_SAMPLES",
-           "JUNCTION_RTOL", "profile_from_block"]
+           "JUNCTION_RTOL", "profile_from_block", "hermite_coefficients", "quintic_pieces", "locate"]
 
 TWO_PI = 2 * math.pi
 #: angles at which convexity is checked, evenly spaced, besides every breakpoint and piece middle
@@ -143,7 +143,35 @@ def _periodic_breaks(breaks: np.ndarray, name: str) -> None:
                              problem=f"spans {span!r} rad, not 2 pi")
 
 
-def _locate(breaks: np.ndarray, phi) -> tuple[np.ndarray, np.ndarray]:
+#: d^d/dt^d t^j = j!/(j-d)! t^(j-d): the factor of c_j in the d-th derivative, d = 0..3
+_DFACTOR = np.array([[math.perm(j, d) for j in range(6)] for d in range(4)], float)
+
+
+def quintic_pieces(coeffs: np.ndarray, k: np.ndarray, t, d: int) -> np.ndarray:
+    """The d-th derivative of piece(s) k of a piecewise quintic at t = phi - phi_k (Horner)."""
+    c = coeffs[k] * _DFACTOR[d]
+    out = np.zeros(np.shape(t)) + c[..., 5]
+    for j in range(4, d - 1, -1):
+        out = out * t + c[..., j]
+    return out
+
+
+def hermite_coefficients(breaks: np.ndarray, h: np.ndarray, h1: np.ndarray, h2: np.ndarray) -> np.ndarray:
+    """The (K, 6) coefficients of the quintic Hermite spline matching h, h', h'' at the K + 1
+    ``breaks``. On a piece of width D, with r0, r1 D, r2 D^2 the misfits at the right end of the
+    left end's quadratic Taylor polynomial in h, h', h'', the cubic, quartic and quintic
+    coefficients are c3 D^3 = 10 r0 - 4 r1 + r2/2, c4 D^4 = -15 r0 + 7 r1 - r2,
+    c5 D^5 = 6 r0 - 3 r1 + r2/2 (the three end conditions solved once)."""
+    D = np.diff(breaks)
+    c0, c1, c2 = h[:-1], h1[:-1], h2[:-1] / 2
+    r0 = h[1:] - (c0 + D * (c1 + D * c2))
+    r1 = (h1[1:] - (c1 + 2 * c2 * D)) * D
+    r2 = (h2[1:] - 2 * c2) * D * D
+    return np.stack([c0, c1, c2, (10 * r0 - 4 * r1 + r2 / 2) / D ** 3,
+                     (-15 * r0 + 7 * r1 - r2) / D ** 4, (6 * r0 - 3 * r1 + r2 / 2) / D ** 5], axis=-1)
+
+
+def locate(breaks: np.ndarray, phi) -> tuple[np.ndarray, np.ndarray]:
     """The piece k holding each phi (reduced into [breaks[0], breaks[0] + 2 pi)) and phi - breaks[k]."""
     phi = np.asarray(phi, float)
     reduced = breaks[0] + np.mod(phi - breaks[0], TWO_PI)
@@ -171,7 +199,6 @@ class SplineProfile(_Profile):
     breaks: np.ndarray
     coeffs: np.ndarray
     kind = "spline"
-    _dfactor: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         breaks = _frozen(self.breaks, "breaks", "K + 1 angles (rad)", 1)
@@ -181,28 +208,18 @@ class SplineProfile(_Profile):
             raise ParameterError("coeffs", coeffs.shape, f"shape (K, 6) = ({breaks.size - 1}, 6) for {breaks.size} breaks")
         object.__setattr__(self, "breaks", breaks)
         object.__setattr__(self, "coeffs", coeffs)
-        # d^d/dt^d t^j = j!/(j-d)! t^(j-d): the factor for each derivative d and power j
-        object.__setattr__(self, "_dfactor", np.array([[math.perm(j, d) for j in range(6)] for d in range(4)], float))
         scale = float(np.abs(coeffs[:, 0]).max())
-        width = np.diff(breaks)
-        for d, what in enumerate(("h", "h'", "h''")):
-            _jumps(self._piece(np.arange(breaks.size - 1), width, d), np.roll(self._piece(np.arange(breaks.size - 1), 0.0 * width, d), -1),
-                   scale, "coeffs", what, breaks[1:])
+        pieces, width = np.arange(breaks.size - 1), np.diff(breaks)
+        for d, what in enumerate(("h", "h'", "h''")):      # each piece's right end against the next one's left
+            right_ends = quintic_pieces(coeffs, pieces, width, d)
+            _jumps(right_ends, np.roll(coeffs[:, d] * math.factorial(d), -1), scale, "coeffs", what, breaks[1:])
         check_convex(self)
-
-    def _piece(self, k: np.ndarray, t: np.ndarray, d: int) -> np.ndarray:
-        """Horner on piece k at t = phi - phi_k of the d-th derivative."""
-        c = self.coeffs[k] * self._dfactor[d]
-        out = np.zeros(np.shape(t)) + c[..., 5]
-        for j in range(4, d - 1, -1):
-            out = out * t + c[..., j]
-        return out
 
     def h(self, phi, derivative: int = 0) -> np.ndarray:
         """h^(derivative)(phi), derivative 0..3 (m; per rad^derivative)."""
         d = _derivative(derivative)
-        k, t = _locate(self.breaks, phi)
-        return self._piece(k, t, d)
+        k, t = locate(self.breaks, phi)
+        return quintic_pieces(self.coeffs, k, t, d)
 
     def junctions(self) -> np.ndarray:
         return self.breaks
@@ -223,22 +240,13 @@ class SplineProfile(_Profile):
         """The quintic Hermite spline matching h, h', h'' at every breakpoint exactly (C2).
 
         ``breaks`` phi_0..phi_K (phi_K = phi_0 + 2 pi) and the values h, h', h'' there (K + 1 each;
-        the last equal to the first: the profile is periodic). On a piece of width D, with
-        r0, r1 D, r2 D^2 the misfits of the left end's quadratic Taylor polynomial at the right end
-        in h, h', h'', the cubic, quartic and quintic coefficients are
-        c3 D^3 = 10 r0 - 4 r1 + r2/2, c4 D^4 = -15 r0 + 7 r1 - r2, c5 D^5 = 6 r0 - 3 r1 + r2/2."""
+        the last equal to the first: the profile is periodic); :func:`hermite_coefficients`."""
         breaks = _frozen(breaks, "breaks", "K + 1 angles (rad)", 1)
         _periodic_breaks(breaks, "breaks")
         values = [_frozen(v, name, f"{breaks.size} values", 1) for v, name in ((h, "h"), (h1, "h'"), (h2, "h''"))]
         if any(v.size != breaks.size for v in values):
             raise ParameterError("h", [v.size for v in values], f"{breaks.size} values each of h, h', h''")
-        (f0, f1, f2), D = values, np.diff(breaks)
-        c0, c1, c2 = f0[:-1], f1[:-1], f2[:-1] / 2
-        r0 = f0[1:] - (c0 + D * (c1 + D * c2))
-        r1 = (f1[1:] - (c1 + 2 * c2 * D)) * D
-        r2 = (f2[1:] - 2 * c2) * D * D
-        coeffs = np.stack([c0, c1, c2, (10 * r0 - 4 * r1 + r2 / 2) / D ** 3,
-                           (-15 * r0 + 7 * r1 - r2) / D ** 4, (6 * r0 - 3 * r1 + r2 / 2) / D ** 5], axis=-1)
+        coeffs = hermite_coefficients(breaks, *values)
         return cls(breaks, coeffs)
 
 
@@ -297,7 +305,7 @@ class ArcProfile(_Profile):
     def h(self, phi, derivative: int = 0) -> np.ndarray:
         """h^(derivative)(phi), derivative 0..3; at a junction the next arc's value."""
         d = _derivative(derivative)
-        k, _ = _locate(self.angles, phi)
+        k, _ = locate(self.angles, phi)
         return self._arc(k, np.asarray(phi, float), d)
 
     def junctions(self) -> np.ndarray:

@@ -202,7 +202,8 @@ class MotionLaw:
         """The lift s(theta) (derivative 0) or d^k s / d theta^k, k = 1..3, at cam angles theta
         (rad, any real: reduced modulo 2 pi). At a segment end s''' is the next segment's."""
         derivative = integer("derivative", derivative, "0, 1, 2 or 3", lambda d: 0 <= d <= 3)
-        theta = np.mod(np.asarray(theta, float), TWO_PI)
+        shape = np.shape(theta)
+        theta = np.mod(np.asarray(theta, float), TWO_PI).ravel()
         starts = self.starts
         k = np.clip(np.searchsorted(starts, theta, side="right") - 1, 0, len(self.segments) - 1)
         levels = np.cumsum([0.0] + [g.rise for g in self.segments])[:-1]
@@ -211,7 +212,7 @@ class MotionLaw:
             on = k == j
             if np.any(on) and g.law != "dwell":
                 out[on] += g.s((theta[on] - starts[j]) / g.angle, derivative)
-        return out
+        return out.reshape(shape)
 
     __call__ = s
 

@@ -199,13 +199,13 @@ def _interval_errors(exact, theta, breaks, coeffs, counts) -> tuple[np.ndarray, 
 
 
 def _choose_pieces(exact, knots: np.ndarray, tol: float, tol_curvature: float) -> np.ndarray:
-    """Pieces per knot interval: start at 2, grow each failing interval by the ratio its error
+    """Pieces per knot interval: start at 1, grow each failing interval by the ratio its error
     exceeds the tolerance to the power 1/6 (h) or 1/4 (h''), the interpolation's orders, until
     all pass; refuse when an interval stops improving (the rounding floor) or needs more than
     :data:`PIECE_LIMIT` pieces."""
     _, h, _, _ = exact(np.linspace(0, TWO_PI, CONVEXITY_SAMPLES))
     scale = float(h.max() - h.min())
-    counts = np.full(knots.size - 1, 2)
+    counts = np.full(knots.size - 1, 1)
     worst = np.inf
     while True:
         theta = _grid(knots, counts)

@@ -65,49 +65,55 @@ def _dense(law) -> np.ndarray:
                                      knots[:-1], (knots[:-1] + knots[1:]) / 2]))
 
 
-def _min_rho(law, follower, r_b: float, theta: np.ndarray) -> tuple[float, int]:
-    _, h, _, h2 = law_profile(law, follower, r_b)(theta)
-    rho = h + h2
-    k = int(np.argmin(rho))
-    return float(rho[k]), k
+def _min_rho(law, follower, r_b: float, theta: np.ndarray) -> tuple[float, float]:
+    """The smallest rho = h + h_phiphi of the exact profile and the cam angle where it is: the
+    dense angles' three lowest local minima each refined by a bounded scalar search between its
+    neighbours (sampling alone misses a sharp minimum by ~ rho'' spacing^2 / 8, 1e-7 m here)."""
+    from scipy.optimize import minimize_scalar
+    exact = law_profile(law, follower, r_b)
+
+    def rho(t):
+        _, h, _, h2 = exact(np.atleast_1d(t))
+        return h + h2
+    values = rho(theta)
+    lower = np.flatnonzero((values <= np.roll(values, 1)) & (values <= np.roll(values, -1)))
+    best_value, best_theta = float(values.min()), float(theta[np.argmin(values)])
+    for k in lower[np.argsort(values[lower])[:3]]:
+        lo = theta[k - 1] if k > 0 else theta[-1] - TWO_PI
+        hi = theta[k + 1] if k + 1 < theta.size else theta[0] + TWO_PI
+        found = minimize_scalar(lambda t: rho(t)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
+        if found.fun < best_value:
+            best_value, best_theta = float(found.fun), float(found.x)
+    return best_value, best_theta
 
 
 def smallest_base_radius(law, follower) -> float:
     """The infimum of the base circle radii r_b for which ``law`` on ``follower`` gives a convex cam
     (0 when any r_b > 0 does).
 
-    Translating: rho(phi) = r_b + s + s'' at theta = gamma - phi, so r_b > max(-(s + s''))
-    (the maximum over the dense angles, refined by a bounded scalar search around the largest).
-    Oscillating: bisection on r_b of the smallest rho over the dense angles (to 1e-12 relative),
+    The smallest rho over the dense angles, refined near its lowest minima (:func:`_min_rho`).
+    Translating: rho(phi) = r_b + s + s'' at theta = gamma - phi, so r_b > max(-(s + s'')).
+    Oscillating: Brent's root of the smallest rho as a function of r_b (to 1e-12 relative),
     assuming rho grows with r_b (it does for a follower whose contact stays on the bar)."""
     theta = _dense(law)
-    if isinstance(follower, TranslatingFollower):
-        return _translating_bound(law, theta)
+    if isinstance(follower, TranslatingFollower):            # rho = r_b + (s + s''): r_b > -min(s + s'')
+        return max(0.0, -_min_rho(law, follower, 0.0, theta)[0])
     x, y = follower.P_to_E
     top = math.hypot(x, y) - follower.w_b / 2             # the largest circle the follower reaches
     if not top > 0:
         raise GeometryError(f"the follower reaches no circle about E: |E - P| - w_b/2 = {top} m")
-    works = lambda r: _min_rho(law, follower, r, theta)[0] > 0   # noqa: E731
-    lo, hi = 0.0, top * (1 - 1e-9)
-    if not works(hi):
+    from scipy.optimize import brentq
+    rho = lambda r: _min_rho(law, follower, r, theta)[0]   # noqa: E731
+    lo, hi = top * 1e-9, top * (1 - 1e-9)
+    if not rho(hi) > 0:
         raise GeometryError("no base circle the follower reaches keeps this law's cam convex "
                             f"(tried up to r_b = {hi} m)")
-    if works(top * 1e-9):
+    if rho(lo) > 0:
         return 0.0
-    while hi - lo > 1e-12 * hi:
-        mid = (lo + hi) / 2
-        lo, hi = (lo, mid) if works(mid) else (mid, hi)
-    return hi
-
-
-def _translating_bound(law, theta: np.ndarray) -> float:
-    from scipy.optimize import minimize_scalar
-    need = -(law.s(theta) + law.s(theta, 2))
-    k = int(np.argmax(need))
-    lo, hi = theta[max(k - 1, 0)], theta[min(k + 1, theta.size - 1)]
-    best = minimize_scalar(lambda t: law.s(np.array([t]))[0] + law.s(np.array([t]), 2)[0],
-                           bounds=(lo, hi), method="bounded", options={"xatol": 1e-12})
-    return max(0.0, float(need[k]), -float(best.fun))
+    root = brentq(rho, lo, hi, xtol=1e-12 * top, rtol=1e-12)
+    while not rho(root) > 0:                               # the side of the root where the cam is convex
+        root = np.nextafter(root, math.inf) + 1e-12 * top
+    return float(root)
 
 
 def _check_law_on_follower(law, follower, r_b: float) -> None:
@@ -127,15 +133,15 @@ def _check_law_on_follower(law, follower, r_b: float) -> None:
             k = int(np.argmin(chi))
             raise GeometryError(f"the contact leaves the bar (chi = {chi[k]:.6g} m <= 0) at theta = "
                                 f"{math.degrees(theta[k]):.4f} deg")
-    rho, k = _min_rho(law, follower, r_b, theta)
+    rho, where = _min_rho(law, follower, r_b, theta)
     if not rho > 0:
-        phi = law_profile(law, follower, r_b)(theta[k:k + 1])[0][0]
+        phi = law_profile(law, follower, r_b)(np.array([where]))[0][0]
         smallest = smallest_base_radius(law, follower)
         unit = "m" if isinstance(follower, TranslatingFollower) else "rad"
         raise ParameterError("r_b", r_b, f"> {smallest!r} m, the smallest base circle radius that keeps this "
                              f"cam convex", problem=f"= {r_b!r} m undercuts the cam (lift {law.lift!r} {unit}): rho = "
                              f"{rho:.6g} m at phi = {math.degrees(phi) % 360:.4f} deg (cam angle theta = "
-                             f"{math.degrees(theta[k]):.4f} deg)")
+                             f"{math.degrees(where) % 360:.4f} deg)")
 
 
 def cam_from_law(law, follower, r_b: float, *, pieces_per_segment: int | None = None,

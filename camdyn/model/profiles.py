@@ -41,7 +41,7 @@ TWO_PI = 2 * math.pi
 #: angles at which convexity is checked, evenly spaced, besides every breakpoint and piece middle
 CONVEXITY_SAMPLES = 4096
 #: the jump of h, h' (and, for a spline, h'') allowed at a junction, relative to the cam's size
-#: max |h|: far above the rounding of a construction in double precision (~1e-15), far below any
+#: max abs(h): far above the rounding of a construction in double precision (~1e-15), far below any
 #: real step of a cam drawing (a micrometre on a 10 mm cam is 1e-4)
 JUNCTION_RTOL = 1e-9
 
@@ -194,7 +194,7 @@ class SplineProfile(_Profile):
     ``coeffs`` (K, 6), h = sum_j coeffs[k, j] (phi - phi_k)^j on [phi_k, phi_{k+1}).
 
     Checked on construction: C2 at every breakpoint including the wrap-around (h, h', h'' jump by
-    at most :data:`JUNCTION_RTOL` x max|h|), and convex (:func:`check_convex`)."""
+    at most :data:`JUNCTION_RTOL` x max abs(h)), and convex (:func:`check_convex`)."""
 
     breaks: np.ndarray
     coeffs: np.ndarray
@@ -267,7 +267,7 @@ class ArcProfile(_Profile):
     angles[-1] = angles[0] + 2 pi.
 
     Checked on construction: every rho_k > 0 (convex) and C1 at every junction (h and h' jump by at
-    most :data:`JUNCTION_RTOL` x max|h|: neighbouring circles tangent where they meet)."""
+    most :data:`JUNCTION_RTOL` x max abs(h): neighbouring circles tangent where they meet)."""
 
     angles: np.ndarray
     rho: np.ndarray
@@ -331,7 +331,7 @@ class ArcProfile(_Profile):
 
         A flank circle's centre F is R - r_b from E and R - r_n from the nose centre N; the
         tangency with a circle of centre C is on the line from F through C, so the junction's
-        outward normal is (C - F)/|C - F|. Four arcs: nose, flank, base, flank."""
+        outward normal is (C - F)/norm(C - F). Four arcs: nose, flank, base, flank."""
         r_b, r_n, d, R = (finite(n, v, "a finite length > 0, m") for n, v in (("r_b", r_b), ("r_n", r_n), ("d", d), ("R", R)))
         nose_angle = finite("nose_angle", nose_angle, "a finite angle, rad")
         for name, value in (("r_b", r_b), ("r_n", r_n), ("d", d)):

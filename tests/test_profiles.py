@@ -63,27 +63,30 @@ def test_translating_follower_on_the_eccentric_circle_is_harmonic(gamma):
     assert np.allclose(r.on_face, -EXAMPLE_E * np.sin(x), rtol=0, atol=8 * EPS * EXAMPLE_R_C)
 
 
+def _eq29(theta):
+    """The paper's rigid contact angle (Eq. 29, as derive/geometry.py writes it):
+    asin(R/|P->G_c|) - atan2(Y, X), (X, Y) = P->G_c = P->E - e (cos, sin)(Theta), R = r_c + w_b/2."""
+    X = EXAMPLE_P_TO_E[0] - EXAMPLE_E * np.cos(theta)
+    Y = EXAMPLE_P_TO_E[1] - EXAMPLE_E * np.sin(theta)
+    return np.arcsin((EXAMPLE_R_C + EXAMPLE_W_B / 2) / np.hypot(X, Y)) - np.arctan2(Y, X)
+
+
 def test_oscillating_follower_on_the_eccentric_circle_is_eq29():
-    """The general path (Newton on the support function) against the paper's closed form of the
-    rigid contact angle (Eq. 29, as derive/geometry.py writes it): asin(R/|P->G_c|) - atan2(Y, X),
-    R = r_c + w_b/2. Newton stops at a step of 4 ulp of pi: 1e-14 rad is its reach."""
+    """The general path (Newton on the support function) against Eq. 29. Newton stops at a step of
+    4 ulp of pi: 1e-14 rad is its reach."""
     cam = EccentricCircle(EXAMPLE_R_C, EXAMPLE_E)
     follower = OscillatingFollower(EXAMPLE_P_TO_E, EXAMPLE_W_B)
-    r = rigid_contact(cam, follower, THETA, omega=3.0)
-    X = EXAMPLE_P_TO_E[0] - EXAMPLE_E * np.cos(THETA)
-    Y = EXAMPLE_P_TO_E[1] - EXAMPLE_E * np.sin(THETA)
-    alpha = np.arcsin((EXAMPLE_R_C + EXAMPLE_W_B / 2) / np.hypot(X, Y)) - np.arctan2(Y, X)
+    omega = 3.0
+    r = rigid_contact(cam, follower, THETA, omega)
+    alpha = _eq29(THETA)
     assert np.abs(r.q - alpha).max() < 1e-14
     assert np.abs(follower.gap(cam, r.q, THETA)).max() < 1e-16      # rigid contact: 1e-14 rad x 0.1 m arm
-    # rates against central differences of the closed form, step h = 1e-3: truncation h^2/6 |alpha'''| omega
-    # and h^2/12 |alpha''''| omega^2 with |alpha^(n)| <~ 0.03 (alpha ~ (e/chi0) sin: e/chi0 = 0.025), ~2e-8;
-    # rounding of asin, atan2 (~eps) 4 eps omega^2 / h^2 ~ 1e-8
+    # rates against central differences of Eq. 29, step h = 1e-3: truncation h^2/6 |alpha'''| omega and
+    # h^2/12 |alpha''''| omega^2 with |alpha^(n)| <~ 0.03 (alpha ~ (e/chi0) sin, e/chi0 = 0.025): ~2e-8;
+    # rounding of asin, atan2 (~eps): 4 eps omega^2 / h^2 ~ 1e-8
     h = 1e-3
-    alpha_of = lambda t: (np.arcsin((EXAMPLE_R_C + EXAMPLE_W_B / 2) / np.hypot(EXAMPLE_P_TO_E[0] - EXAMPLE_E * np.cos(t),  # noqa: E731
-                          EXAMPLE_P_TO_E[1] - EXAMPLE_E * np.sin(t))) - np.arctan2(EXAMPLE_P_TO_E[1] - EXAMPLE_E * np.sin(t),
-                                                                                   EXAMPLE_P_TO_E[0] - EXAMPLE_E * np.cos(t)))
-    fd1 = (alpha_of(THETA + h) - alpha_of(THETA - h)) / (2 * h) * 3.0
-    fd2 = (alpha_of(THETA + h) - 2 * alpha + alpha_of(THETA - h)) / h ** 2 * 9.0
+    fd1 = (_eq29(THETA + h) - _eq29(THETA - h)) / (2 * h) * omega
+    fd2 = (_eq29(THETA + h) - 2 * alpha + _eq29(THETA - h)) / h ** 2 * omega ** 2
     assert np.abs(r.q_dot - fd1).max() < 1e-7
     assert np.abs(r.q_ddot - fd2).max() < 1e-7
     assert np.all(r.on_face > 0.09)                                    # the moment arm chi ~ chi0 = 0.1 m

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import integer
 from ..errors import ParameterError
 from .profiles import SplineProfile
 
@@ -73,9 +74,10 @@ def _periodic_spline(angles, values, source: str, what: tuple[str, str]):
     span = angles[-1] - angles[0]
     if np.isclose(span, TWO_PI, rtol=0, atol=1e-9):          # the last row repeats the first angle (mod 360)
         if not np.isclose(values[-1], values[0], rtol=1e-9, atol=0):
-            raise ParameterError(value_name, float(values[-1]), f"the first row's value {values[0]!r} at the repeated "
-                                 "angle (a table of one revolution is periodic)", problem="is not periodic: the last row "
-                                 f"repeats the first angle mod 360 deg with another value", reason=source)
+            raise ParameterError(value_name, float(values[-1]), f"the first row's value {values[0]!r} at the "
+                                 "repeated angle (a table of one revolution is periodic)",
+                                 problem="is not periodic: the last row repeats the first angle mod 360 deg with "
+                                         "another value", reason=source)
         angles, values, span = angles[:-1], values[:-1], angles[-2] - angles[0]
     if span > TWO_PI:
         raise ParameterError(angle_name, float(np.degrees(span)), "angles spanning less than 360 deg (one revolution)",
@@ -108,8 +110,9 @@ class LiftTable:
 
     def s(self, theta, derivative: int = 0) -> np.ndarray:
         """The spline's lift (derivative 0) or its theta-derivative 1..3 at cam angles theta (rad)."""
+        derivative = integer("derivative", derivative, "0, 1, 2 or 3", lambda d: 0 <= d <= 3)
         theta = np.asarray(theta, float)
-        return self._spline(self._first + np.mod(theta - self._first, TWO_PI), nu=int(derivative))
+        return self._spline(self._first + np.mod(theta - self._first, TWO_PI), nu=derivative)
 
     @property
     def knots(self) -> np.ndarray:

@@ -92,8 +92,8 @@ class OscillatingFollower:
         x, y = self.P_to_E
         reach = r_b + self.w_b / 2
         if not reach < math.hypot(x, y):
-            raise GeometryError(f"the follower cannot touch a circle of radius {r_b} m about E: r_b + w_b/2 = "
-                                f"{reach} m must be < |E - P| = {math.hypot(x, y)} m")
+            raise ParameterError("r_b", r_b, f"< |E - P| - w_b/2 = {math.hypot(x, y) - self.w_b / 2!r} m",
+                                 reason="a base circle the follower reaches")
         return math.asin(reach / math.hypot(x, y)) - math.atan2(y, x)
 
     def contact_angle(self, q, Theta) -> np.ndarray:
@@ -164,7 +164,8 @@ def _oscillating_root(profile, follower: OscillatingFollower, Theta: np.ndarray,
         F = follower.gap(profile, a, Theta)
         chi = follower.projections(a)[1] + profile.h(follower.contact_angle(a, Theta), 1)
         if not np.all(chi > 0):
-            raise GeometryError("rigid contact: the contact left the bar (chi <= 0) while solving for the follower angle")
+            raise GeometryError("rigid contact: the contact left the bar (chi <= 0) while solving for the "
+                                "follower angle")
         step = F / chi
         a = a - step
         if np.all(np.abs(step) <= 4 * np.finfo(float).eps * math.pi):

@@ -86,7 +86,8 @@ class _SineConstantAcceleration:
         s, c = np.sin(w * t), np.cos(w * t)
         one_minus_cos = 2 * np.sin(w * t / 2) ** 2
         if d == 0:
-            return self.p[k] + self.v[k] * t + A * (c0 * t * t / 2 + c1 * (t / w - s / w ** 2) + c2 * one_minus_cos / w ** 2)
+            integral = c0 * t * t / 2 + c1 * (t / w - s / w ** 2) + c2 * one_minus_cos / w ** 2
+            return self.p[k] + self.v[k] * t + A * integral
         if d == 1:
             return self.v[k] + A * (c0 * t + c1 * one_minus_cos / w + c2 * s / w)
         if d == 2:

@@ -174,7 +174,8 @@ def hermite_coefficients(breaks: np.ndarray, h: np.ndarray, h1: np.ndarray, h2: 
 def locate(breaks: np.ndarray, phi) -> tuple[np.ndarray, np.ndarray]:
     """The piece k holding each phi (reduced into [breaks[0], breaks[0] + 2 pi)) and phi - breaks[k]."""
     phi = np.asarray(phi, float)
-    reduced = breaks[0] + np.mod(phi - breaks[0], TWO_PI)
+    inside = (phi >= breaks[0]) & (phi < breaks[0] + TWO_PI)      # kept as is: a breakpoint stays one
+    reduced = np.where(inside, phi, breaks[0] + np.mod(phi - breaks[0], TWO_PI))
     k = np.clip(np.searchsorted(breaks, reduced, side="right") - 1, 0, breaks.size - 2)
     return k, reduced - breaks[k]
 
@@ -205,7 +206,8 @@ class SplineProfile(_Profile):
         coeffs = _frozen(self.coeffs, "coeffs", "a (K, 6) array of polynomial coefficients", 2)
         _periodic_breaks(breaks, "breaks")
         if coeffs.shape != (breaks.size - 1, 6):
-            raise ParameterError("coeffs", coeffs.shape, f"shape (K, 6) = ({breaks.size - 1}, 6) for {breaks.size} breaks")
+            raise ParameterError("coeffs", coeffs.shape,
+                                 f"shape (K, 6) = ({breaks.size - 1}, 6) for {breaks.size} breaks")
         object.__setattr__(self, "breaks", breaks)
         object.__setattr__(self, "coeffs", coeffs)
         scale = float(np.abs(coeffs[:, 0]).max())
@@ -332,7 +334,8 @@ class ArcProfile(_Profile):
         A flank circle's centre F is R - r_b from E and R - r_n from the nose centre N; the
         tangency with a circle of centre C is on the line from F through C, so the junction's
         outward normal is (C - F)/norm(C - F). Four arcs: nose, flank, base, flank."""
-        r_b, r_n, d, R = (finite(n, v, "a finite length > 0, m") for n, v in (("r_b", r_b), ("r_n", r_n), ("d", d), ("R", R)))
+        lengths = (("r_b", r_b), ("r_n", r_n), ("d", d), ("R", R))
+        r_b, r_n, d, R = (finite(n, v, "a finite length > 0, m") for n, v in lengths)
         nose_angle = finite("nose_angle", nose_angle, "a finite angle, rad")
         for name, value in (("r_b", r_b), ("r_n", r_n), ("d", d)):
             if not value > 0:

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from .._checks import finite, integer, real
+from .._checks import integer, real
 from ..errors import GeometryError, ParameterError
 from .followers import OscillatingFollower, TranslatingFollower
 from .profiles import CONVEXITY_SAMPLES, SplineProfile, hermite_coefficients, locate, quintic_pieces
@@ -124,9 +124,10 @@ def _check_law_on_follower(law, follower, r_b: float) -> None:
         turn = 1 + law.s(theta, 1)
         if not np.all(turn > 0):
             k = int(np.argmin(turn))
-            raise ParameterError("law", float(turn[k]), "1 + s'(theta) > 0 at every cam angle (the contact normal "
-                                 "turning one way)", problem=f"is not a valid flat-faced cam: 1 + s' = {turn[k]:.6g} at "
-                                 f"theta = {math.degrees(theta[k]):.4f} deg (the follower turns back faster than the cam)")
+            raise ParameterError("law", float(turn[k]), "1 + s'(theta) > 0 at every cam angle (the contact "
+                                 "normal turning one way)",
+                                 problem=f"is not a valid flat-faced cam: 1 + s' = {turn[k]:.6g} at theta = "
+                                         f"{math.degrees(theta[k]):.4f} deg (the follower turns back faster than the cam)")
         a = follower.base_angle(r_b) + law.s(theta)
         chi = follower.projections(a)[1] / turn
         if not np.all(chi > 0):

@@ -314,8 +314,16 @@ class ArcProfile(_Profile):
         return self.angles
 
     def block(self) -> np.ndarray:
-        """``[K, a_0..a_K, rho_0..rho_{K-1}, cx_0..cx_{K-1}, cy_0..cy_{K-1}]`` (float64)."""
-        return np.concatenate([[self.rho.size * 1.0], self.angles, self.rho, self.cx, self.cy])
+        """``[K, a_0..a_K, rho_0..rho_{K-1}, cx_0..cx_{K-1}, cy_0..cy_{K-1}]`` (float64), with an
+        even K: a cam of an odd number of arcs has its longest arc given as two halves of the
+        same circle, since the junction indicator of the generated kernels alternates its sign
+        from arc to arc (derive.profile.JunctionFunction), which needs an even count to close."""
+        angles, rho, cx, cy = self.angles, self.rho, self.cx, self.cy
+        if rho.size % 2:
+            k = int(np.argmax(np.diff(angles)))
+            angles = np.insert(angles, k + 1, 0.5 * (angles[k] + angles[k + 1]))
+            rho, cx, cy = (np.insert(v, k, v[k]) for v in (rho, cx, cy))
+        return np.concatenate([[rho.size * 1.0], angles, rho, cx, cy])
 
     @classmethod
     def from_block(cls, block) -> "ArcProfile":

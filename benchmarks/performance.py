@@ -33,6 +33,7 @@ import sys
 import time
 
 import floor
+import profile_cost
 from perf.cases import DOCS, IMG, Config, cases
 from perf.engine_costs import floor_section
 from perf.figures import plot_case, plot_floor, plot_sweeps
@@ -66,12 +67,13 @@ def main(argv=None) -> int:
     for case in cases():
         results.append(step(case.key, measure_case, case, cfg, peers))
         plot_case(results[-1], IMG / f"perf_{case.key}.png")
+    profiles = step("profile cost", profile_cost.measure)
     starts = step("start-up", start_times, cfg)
     sw = step("sweeps", sweep_timing, cfg) if cfg.sweeps else None
     if sw is not None:
         plot_sweeps(sw, IMG)
     parts = {"peers": peers, "load": (load0, os.getloadavg()[0]), "elapsed": time.perf_counter() - t_start,
-             "floor": fs, "starts": starts, "results": results, "sweeps": sw}
+             "floor": fs, "starts": starts, "results": results, "sweeps": sw, "profiles": profiles}
     text = write_report(parts, cfg)
     (DOCS / "performance.md").write_text(text + "\n")
     print(text)

@@ -59,15 +59,24 @@ _ARCS = '''
 @numba.njit(cache=True)
 def profile(n, phi, p, offset):
     """h^(n)(phi), the n-th derivative of the cam's support function (m; phi in rad): the
-    circular arc holding phi (derive.profile_code), h = rho_k + cx_k cos(phi) + cy_k sin(phi)."""
+    circular arc holding phi (derive.profile_code), h = rho_k + cx_k cos(phi) + cy_k sin(phi).
+    The derivatives turn (cos, sin) a quarter turn each, so every call takes the sine and cosine
+    of phi itself (one pair for all the calls of a kernel, once the compiler has inlined them)."""
     k, x = _piece(phi, p, offset)
     K = int(p[offset])
     base = offset + K + 2
-    shift = 0.5 * pi * n
-    value = p[base + K + k] * cos(phi + shift) + p[base + 2 * K + k] * sin(phi + shift)
-    if n == 0:
-        value += p[base + k]
-    return value
+    cx = p[base + K + k]
+    cy = p[base + 2 * K + k]
+    c = cos(phi)
+    s = sin(phi)
+    turn = n % 4
+    if turn == 0:
+        return p[base + k] + cx * c + cy * s if n == 0 else cx * c + cy * s
+    if turn == 1:
+        return cy * c - cx * s
+    if turn == 2:
+        return -(cx * c + cy * s)
+    return cx * s - cy * c
 '''
 
 _JUNCTION = '''

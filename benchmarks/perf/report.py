@@ -10,6 +10,7 @@ import numba
 import numpy as np
 
 import floor
+import profile_cost
 import sweep_stop
 
 from .cases import ATOL_PER_RTOL, EVERY, MAIN, REFERENCE_RTOL, RIG, SCIPY, Config
@@ -301,4 +302,6 @@ def write_report(parts: dict, cfg: Config) -> str:
     lines = header(cfg, parts["peers"], parts["load"], parts["elapsed"]) + floor_lines(parts["floor"]) + \
         start_lines(parts["starts"]) + ratio_lines(parts["results"], parts["peers"]) + target_lines(parts["results"], parts["peers"]) + \
         scene_lines(parts["results"]) + sweep_lines(parts["sweeps"], cfg)
+    if parts.get("profiles"):
+        lines += ["", profile_cost.report(parts["profiles"])]
     return "\n".join(lines)

@@ -113,11 +113,13 @@ def same_switches(expected, got, dt: float = 1e-12):
 
 def test_the_circle_of_arcs_impacts_as_the_paper_scene_until_the_motion_s_sensitivity_parts_them():
     rig = camdyn.example_rig()
-    paper = camdyn.simulate(rig, camdyn.Scene(), speed_rpm=RPM_IMPACTING, revolutions=4)
-    arcs = camdyn.simulate(rig.replace(profile=circle_as_arcs(rig)), camdyn.Scene(profile="arcs"),
-                           speed_rpm=RPM_IMPACTING, revolutions=4)
-    # measured: the first 32 contact switches agree to 2.3e-13 s; then the difference grows about
-    # 100-fold every 0.1 s (a sensitive, impacting motion), so only the start is compared
+    run = dict(speed_rpm=RPM_IMPACTING, revolutions=4, rtol=1e-10, atol=1e-13)
+    paper = camdyn.simulate(rig, camdyn.Scene(), **run)
+    arcs = camdyn.simulate(rig.replace(profile=circle_as_arcs(rig)), camdyn.Scene(profile="arcs"), **run)
+    # measured at this rtol: the first 24 contact switches agree to 6.5e-14 s (at the default rtol 1e-8,
+    # to 2.2e-12 s: the junction restarts change the steps, the difference is integration error); later
+    # the difference grows about 100-fold every 0.1 s (a sensitive, impacting motion): only the start
+    # is compared
     same_switches(list(paper.switches)[:20], [s for s in arcs.switches if s.surface != "junction"][:20])
 
 

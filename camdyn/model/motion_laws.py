@@ -233,7 +233,7 @@ def rise_dwell_return(lift: float, angles, law: str = "cycloidal", return_law: s
                               ("return angle", back, "> 0"), ("dwell angle", rest, ">= 0")):
         if not math.isfinite(a) or a < 0 or (smallest == "> 0" and a == 0):
             raise ParameterError("angles", angles, f"rise, dwell, return, dwell angles: finite, rise and "
-                                 f"return > 0, dwells >= 0 (rad)", problem=f"has the {name} {a!r}")
+                                 "return > 0, dwells >= 0 (rad)", problem=f"has the {name} {a!r}")
     segments = [Segment(law, rise, lift)]
     if top > 0:
         segments.append(Segment("dwell", top))

@@ -232,7 +232,7 @@ def rise_dwell_return(lift: float, angles, law: str = "cycloidal", return_law: s
     for name, a, smallest in (("rise angle", rise, "> 0"), ("dwell angle", top, ">= 0"),
                               ("return angle", back, "> 0"), ("dwell angle", rest, ">= 0")):
         if not math.isfinite(a) or a < 0 or (smallest == "> 0" and a == 0):
-            raise ParameterError("angles", angles, f"rise, dwell, return, dwell angles: finite, rise and "
+            raise ParameterError("angles", angles, "rise, dwell, return, dwell angles: finite, rise and "
                                  "return > 0, dwells >= 0 (rad)", problem=f"has the {name} {a!r}")
     segments = [Segment(law, rise, lift)]
     if top > 0:

@@ -149,8 +149,12 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
                  _single(fields.spring_potential(), S.to_plain(energy.spring_potential_printed())),
                  "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33.", "tuple"),
     ]
-    if spec.profile != "eccentric":  # no closed form of the rigid contact angle on another cam
-        return static
+    if spec.profile != "eccentric":  # no closed form of the rigid contact angle on another cam:
+        # the runtime solves it (camdyn.model.followers) and reads the spring's moment here
+        return static + [Function("spring_moment", ("alpha", "p"), (), ("spring_moment",),
+                                  _single(laws.spring_force(S.alpha_s) * S.d_x),
+                                  "The spring's moment F_s d_x about P at the follower angle alpha (Eq. 11).",
+                                  "tuple")]
     a_i = S.to_plain(geometry.rigid_contact_angle(S.Theta))
     a_i_th = a_i.diff(S.Theta_s)
     spring_moment = laws.spring_force(S.alpha_s).subs(S.alpha_s, a_i) * S.d_x

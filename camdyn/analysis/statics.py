@@ -10,6 +10,7 @@ from scipy.optimize import brentq
 
 from . import signal
 from ..model.cam import RPM, CamMotion, ConstantSpeed
+from ..model.followers import follower_of_rig, rigid_contact
 from ..errors import GeometryError, ParameterError
 from ..model.model import ANGLE_LIMIT, Equilibrium, Model, solve_equilibrium, static_parameters
 from ..runs.result import Result
@@ -17,15 +18,36 @@ from ..model.rig import Rig
 from ..model.scene import Scene
 
 
-def _static_scene(contact: str) -> Scene:
+def _static_scene(contact: str, rig: Rig | None = None) -> Scene:
+    """The undamped, frictionless scene of a contact law on the rig's cam family."""
     if contact not in ("line", "point"):
         raise ParameterError("contact", contact, "'line' or 'point'")
-    return Scene(contact=contact, damping="none", friction="none")
+    profile = "eccentric" if rig is None or rig.profile_data is None else rig.profile_data[0]
+    return Scene(contact=contact, damping="none", friction="none", profile=profile)
+
+
+def rigid_kinematics(rig: Rig, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(alpha_i, alpha_i'', F_s d_x) at the cam angles ``theta``: the follower angle in rigid
+    contact, its second derivative in Theta (1/rad) and the spring's moment there (N m).  The
+    paper's circle: Eq. 29's closed form (the generated ``rigid_contact``, after the reach check);
+    any other cam: the root of the gap (camdyn.model.followers.rigid_contact, Newton) and the
+    generated ``spring_moment``."""
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    K = _static_scene("line", rig).kernels()
+    p = static_parameters(rig, K)
+    if rig.profile is None:
+        if np.any(np.array([K.reach(th, p) for th in theta]) <= 0):
+            raise GeometryError("the follower cannot reach the cam at some cam angle (|PG_c| < r_c + w_b/2)")
+        alpha_i, _, curvature, spring_moment = np.array([K.rigid_contact(th, p) for th in theta]).T
+        return alpha_i, curvature, spring_moment
+    contact = rigid_contact(rig.profile, follower_of_rig(rig), theta)
+    spring_moment = np.array([K.spring_moment(a, p) for a in contact.q])
+    return contact.q, contact.q_ddot, spring_moment
 
 
 def static_equilibrium(rig: Rig, contact: str = "line") -> Equilibrium:
     """alpha*, psi_i*, psi_j*, chi*, the contact stiffness and vartheta (Eqs. 16-18, 23)."""
-    scene = _static_scene(contact)
+    scene = _static_scene(contact, rig)
     if contact == "line":
         rig.require("l_lambda", why="line contact (Eq. 13)")
     return solve_equilibrium(rig, scene.kernels())
@@ -89,12 +111,8 @@ def sliding_mode(model: Model, t: float, alpha: float, alpha_dot: float) -> int:
 
 def rigid_contact_angle(rig: Rig, theta, contact: str = "line") -> np.ndarray:
     """alpha_i(Theta): the follower angle if it stayed in rigid contact (Eq. 29, misprint 10)."""
-    K = _static_scene(contact).kernels()
-    p = static_parameters(rig, K)
     theta = np.asarray(theta, dtype=float)
-    if np.any(np.vectorize(lambda th: K.reach(th, p))(theta) <= 0):
-        raise GeometryError("the follower cannot reach the cam at some of these cam angles")
-    return np.vectorize(lambda th: K.rigid_contact(th, p)[0], otypes=[float])(theta)
+    return rigid_kinematics(rig, theta.ravel())[0].reshape(theta.shape)
 
 
 def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: int = 3600) -> float:
@@ -108,13 +126,8 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     scales F_n, as long as chi > mu w_b / 2, so it does not move the loss speed.
     Returns inf when no cam angle decelerates the follower (e = 0).
     """
-    K = _static_scene("line").kernels()
-    p = static_parameters(rig, K)
     thetas = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
-    margin = np.array([K.reach(th, p) for th in thetas])
-    if np.any(margin <= 0):
-        raise GeometryError("the follower cannot reach the cam at some cam angle (|PG_c| < r_c + w_b/2)")
-    alpha_i, _, curvature, spring_moment = np.array([K.rigid_contact(th, p) for th in thetas]).T
+    alpha_i, curvature, spring_moment = rigid_kinematics(rig, thetas)
     if np.any(np.abs(alpha_i) > ANGLE_LIMIT):
         raise GeometryError("in rigid contact the follower would pass 90 degrees over a revolution")
     if np.any(spring_moment <= 0):
@@ -124,7 +137,7 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
         return math.inf
 
     def ratio(th):
-        _, _, c, m = K.rigid_contact(th, p)
+        _, c, m = (float(x[0]) for x in rigid_kinematics(rig, th))
         return m / (-rig.I_Pb * c) if c < 0 else math.inf
 
     i = int(np.argmin(np.where(pulling, spring_moment / (-rig.I_Pb * np.where(pulling, curvature, -1)), np.inf)))
@@ -154,12 +167,10 @@ def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 200
     loss = contact_loss_speed(rig)
     if not math.isfinite(loss) or loss == 0:
         return 0.0
-    scene = scene or Scene(contact="line", damping="D", friction="coulomb")
-    K = _static_scene(scene.contact).kernels()
-    p = static_parameters(rig, K)
+    scene = scene or Scene(contact="line", damping="D", friction="coulomb", profile=_static_scene("line", rig).profile)
     omega = loss * RPM
     theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
-    _, _, curvature, spring = np.array([K.rigid_contact(th, p) for th in theta]).T
+    _, curvature, spring = rigid_kinematics(rig, theta)
     M = rig.I_Pb * curvature * omega ** 2 + spring
     k, h = int(np.argmin(M)), theta[1] - theta[0]
     M2 = (M[k - 1] - 2 * M[k] + M[(k + 1) % samples]) / h ** 2
@@ -181,6 +192,9 @@ def energy_balance_peak(rig: Rig, speed_rpm: float, xi: float, *, potential: str
         raise ParameterError("xi", xi, "0 <= xi <= 1 (coefficient of restitution)")
     if potential not in ("printed", "consistent"):
         raise ParameterError("potential", potential, "'printed' or 'consistent'")
+    if rig.profile is not None:
+        raise GeometryError("Section 5's energy balance is written for the eccentric circle (the impact speed "
+                            "e Omega_c): it has no meaning for the rig's cam profile")
     eq = static_equilibrium(rig, contact)
     K = _static_scene(contact).kernels()
     p = static_parameters(rig, K)

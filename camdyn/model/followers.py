@@ -27,7 +27,8 @@ import numpy as np
 from .._checks import finite
 from ..errors import GeometryError, ParameterError
 
-__all__ = ["TranslatingFollower", "OscillatingFollower", "RigidContact", "rigid_contact"]
+__all__ = ["TranslatingFollower", "OscillatingFollower", "RigidContact", "rigid_contact", "follower_of_rig",
+           "rig_on_cam"]
 
 
 @dataclass(frozen=True)
@@ -172,3 +173,31 @@ def _oscillating_root(profile, follower: OscillatingFollower, Theta: np.ndarray,
             return a
     raise GeometryError(f"rigid contact: Newton's method did not converge in {iterations} steps "
                         f"(largest step {np.max(np.abs(step)):.3g} rad)")
+
+
+def _cam_of(rig):
+    """The rig's cam: its profile, or the paper's circle (r_c, e)."""
+    from .profiles import EccentricCircle
+    return rig.profile if rig.profile is not None else EccentricCircle(rig.r_c, rig.e)
+
+
+def follower_of_rig(rig) -> OscillatingFollower:
+    """The rig's oscillating follower: E - P from its 0-state (Eq. 5 for any cam: the bar's surface
+    touches the cam's support line of normal angle phi0 = 3 pi/2 - alpha0 - theta0 at chi0, so
+    E - P = (chi0 - h'(phi0)) u0 + (w_b/2 + h(phi0)) n0; derive.geometry.P_to_E_general)."""
+    cam, a0 = _cam_of(rig), rig.alpha0
+    phi0 = 1.5 * math.pi - a0 - rig.theta0
+    along, across = rig.chi0 - float(cam.h(phi0, 1)), rig.w_b / 2 + float(cam.h(phi0))
+    u0, n0 = (math.cos(a0), -math.sin(a0)), (math.sin(a0), math.cos(a0))
+    return OscillatingFollower((along * u0[0] + across * n0[0], along * u0[1] + across * n0[1]), rig.w_b)
+
+
+def rig_on_cam(rig, profile, *, follower: OscillatingFollower | None = None, theta0: float | None = None):
+    """``rig`` with the cam ``profile`` (:mod:`camdyn.model.profiles`), its pivot where ``follower``
+    puts it (default: where it is on the rig's present cam, :func:`follower_of_rig`), and its
+    0-state (Eq. 5) re-stated on the new cam: at the cam angle ``theta0`` (default the rig's) the
+    follower in rigid contact, alpha0 its angle and chi0 its moment arm there."""
+    follower = follower or follower_of_rig(rig)
+    theta0 = rig.theta0 if theta0 is None else finite("theta0", theta0, "a finite cam angle, rad")
+    contact = rigid_contact(profile, follower, np.array([theta0]))
+    return rig.replace(profile=profile, theta0=theta0, alpha0=float(contact.q[0]), chi0=float(contact.on_face[0]))

@@ -233,3 +233,31 @@ def test_a_cycloidal_cam_grazes_just_below_its_inverse_kinematics_jump_speed():
     # the compliant, damped contact lets go a little before the rigid one (measured 539.32 against
     # 539.77 rev/min, -0.08 %); the bound, 0.5 %, is many times the compliance's (Omega/vartheta)^2
     assert -5e-3 < grazing[0] / loss - 1 < 0
+
+
+def test_the_cli_runs_a_cam_from_a_table_of_lifts(tmp_path, capsys):
+    from camdyn.cli import main
+    from camdyn.model.motion_laws import rise_dwell_return
+
+    deg = math.pi / 180
+    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg))
+    theta = np.arange(0.0, 360.0, 2.0)
+    table = tmp_path / "cam.csv"
+    table.write_text("theta_deg, lift_deg\n" + "".join(f"{a:g}, {math.degrees(s)!r}\n"
+                                                       for a, s in zip(theta, law.s(theta * deg))))
+    args = ["simulate", "--cam", str(table), "--speed-rpm", "400", "--revolutions", "1"]
+    assert main(args + ["--base-radius-mm", "25"]) == 0
+    out = capsys.readouterr().out
+    assert "_spline: SUCCESS" in out and "alpha_r: rms" in out and "nan" not in out
+    assert main(args) != 0                      # a table of lifts needs its base circle
+    assert "--base-radius-mm" in capsys.readouterr().err
+
+
+def test_the_rigid_contact_angle_output_is_solved_on_any_cam():
+    rig = cycloidal_cam_rig()
+    run = camdyn.simulate(rig, camdyn.Scene(profile="spline"), speed_rpm=300, revolutions=1)
+    alpha_i = run.outputs["alpha_i"]
+    assert np.all(np.isfinite(alpha_i))
+    # over the turn the rigid follower rises by the law's lift, 0.05 rad, and comes back (Newton on the
+    # gap to 4 ulp of pi; the spline cam matches the law to 1e-12 of the lift)
+    assert abs((alpha_i.max() - alpha_i.min()) - 0.05) < 1e-9

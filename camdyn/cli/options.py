@@ -18,7 +18,7 @@ def _rig(args):
     from ..model.presets import available, load_rig
 
     try:
-        return load_rig(args.rig)
+        return _on_cam(load_rig(args.rig), args)
     except ParameterError as exc:  # not a preset and not a .toml path
         if exc.name != "name":
             raise
@@ -28,6 +28,22 @@ def _rig(args):
         raise UsageError(f"--rig {args.rig}: no shipped rig of that name"
                          + (f" (did you mean {close[0]!r}?)" if close else "")
                          + f"; shipped rigs: {', '.join(available())}, or a rig file ending in .toml") from None
+
+
+def _on_cam(rig, args):
+    """The rig on the cam of --cam (a table of lifts or radii, camdyn.model.cam_tables), its pivot
+    kept where it is and its 0-state re-stated on that cam (camdyn.model.followers.rig_on_cam)."""
+    path = getattr(args, "cam", None)
+    if path is None:
+        return rig
+    from ..model.cam_tables import RadiusTable, cam_from_table, read_cam_table
+    from ..model.followers import follower_of_rig, rig_on_cam
+
+    if isinstance(read_cam_table(path), RadiusTable):
+        return rig_on_cam(rig, cam_from_table(path))
+    if args.base_radius_mm is None:
+        raise UsageError(f"--cam {path} is a table of lifts: give the cam's base circle with --base-radius-mm")
+    return rig_on_cam(rig, cam_from_table(path, follower_of_rig(rig), r_b=args.base_radius_mm / 1000))
 
 
 def _cam(args):
@@ -50,7 +66,8 @@ def _scene(args, motion: str = "constant"):
                  sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
                  damping_sign=getattr(args, "damping_sign", "dissipative"),
                  damping_switch=getattr(args, "damping_switch", "episode"),
-                 follower=getattr(args, "follower", "dynamic"))
+                 follower=getattr(args, "follower", "dynamic"),
+                 profile="eccentric" if getattr(args, "cam", None) is None else "spline")
 
 
 def _options():
@@ -64,6 +81,12 @@ def _add_physics(p, contact: bool = True, full: bool = True):
     g = p.add_argument_group("rig and scene")
     g.add_argument("--rig", default="example", help="shipped rig name (see 'camdyn scenes') or a .toml rig file "
                                                     "(default: example)")
+    g.add_argument("--cam", type=Path, default=None, metavar="FILE",
+                   help="the cam as a table (CSV or TOML): lifts of the follower (theta_deg with lift_deg or "
+                        "lift_rad) or the cam's radii (phi_deg with h_mm or h_m); the rig's follower keeps its "
+                        "pivot (default: the rig's eccentric circle)")
+    g.add_argument("--base-radius-mm", type=float, default=None, dest="base_radius_mm", metavar="MM",
+                   help="base circle of a --cam table of lifts, mm")
     if contact:
         g.add_argument("--contact", default="line", choices=opts["contact"], help="contact law (default: line)")
     g.add_argument("--damping", default="D", choices=opts["damping"], help="damping model, Eqs. 24-28 (default: D)")

@@ -21,6 +21,7 @@ from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
 from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
+from .followers import follower_of_rig, rigid_contact
 from .scene import Scene, variational_kernels
 
 _DERIVED = EQUILIBRIUM_NAMES  # computed here, not given by the rig
@@ -237,7 +238,19 @@ class Model:
         K = self.kernels
         compiled = backend == "compiled"
         kern = compiled_kernels(K) if compiled else python_kernels(K, self.cam if self.scene.motion == "user" else None)
-        return outputs_on_samples(kern, compiled, modes, t, alpha, alpha_dot, self.p, len(K.OUTPUTS))
+        values = outputs_on_samples(kern, compiled, modes, t, alpha, alpha_dot, self.p, len(K.OUTPUTS))
+        return self._with_rigid_contact(t, values)
+
+    def _with_rigid_contact(self, t, values: np.ndarray) -> np.ndarray:
+        """On a cam other than the circle the generated ``outputs`` has no closed form of alpha_i
+        (Eq. 29): it is the root of the gap at the cam angle Theta(t), solved here
+        (camdyn.model.followers.rigid_contact) into row OUT_ALPHA_I."""
+        if self.rig.profile is None:
+            return values
+        theta = self.cam_state(np.asarray(t, dtype=float))[0]
+        values[self.kernels.OUT_ALPHA_I] = rigid_contact(self.rig.profile, follower_of_rig(self.rig),
+                                                         np.asarray(theta, dtype=float)).q
+        return values
 
     @cached_property
     def fastest_rate(self) -> "Rate":
@@ -302,6 +315,7 @@ class Model:
         """The output quantities (``OUTPUTS``) in mode m at one state, by name."""
         out = np.empty(len(self.kernels.OUTPUTS))
         self.kernels.outputs(m, t, alpha, alpha_dot, self.p, *self._extra(t), out)
+        out = self._with_rigid_contact(np.array([t]), out[:, None])[:, 0]
         return dict(zip(self.kernels.OUTPUTS, map(float, out)))
 
     def static_state(self) -> np.ndarray:

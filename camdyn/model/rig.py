@@ -62,21 +62,14 @@ _UNIT_WORDS = {"1": "dimensionless"}
 
 
 @dataclass(frozen=True)
-class Parameter:
-    """One rig parameter's specification, read from ``camdyn.vocabulary.parameters`` (where it
-    is declared once, beside the SymPy symbol the derivation makes of it).
+class Parameter(RigParameter):
+    """One rig parameter's specification: its declaration in ``camdyn.vocabulary.parameters``
+    (where it is declared once, beside the SymPy symbol the derivation makes of it; the same
+    fields), with the unit in words, and what the rig's validation and messages need of it.
 
     ``rules``: the :class:`~camdyn.vocabulary.parameters.Rule` s its value must satisfy, in order;
     a rule may compare with a parameter declared before it (``e < r_c``).
     """
-
-    name: str
-    unit: str
-    description: str
-    required: bool
-    ref: str
-    rules: tuple[Rule, ...] = ()
-    neutral: float | None = None
 
     @classmethod
     def declared(cls, row: RigParameter) -> Parameter:

@@ -23,21 +23,9 @@ from ..errors import SceneError
 
 @dataclass(frozen=True)
 class Scene(SceneSpec):
-    """Physics of one study.
-
-    Its options (the vocabulary is :class:`camdyn.vocabulary.SceneSpec`)::
-
-        contact:  "line" (Eq. 13) or "point" (Eq. 34)
-        damping:  "none" or "A".."E" (Eqs. 24-28)
-        friction: "none", "coulomb" (model I) or "tanh" (model II)
-        motion:   "constant", "oscillating" or "user" (Section 7)
-        model:    "nonlinear", "linear_paper" (Eqs. 36-38 as printed) or "linear_exact"
-        sliding_velocity: "kinematic" (derived) or "printed" (misprint 8; Figs. 12-15)
-        damping_sign:     "dissipative" (derived) or "printed" (misprint 2; B and D only)
-        damping_switch:   "episode" (Sec. 3.4: the impact law from contact to maximum compression,
-                          then the viscous law until separation) or "memoryless" (D and E only)
-        follower: "dynamic" (the hybrid model) or "quasistatic" (the quasi-static contact orbit,
-                  :mod:`camdyn.runs.quasistatic`: no integration, for a follower that never leaves the cam)
+    """Physics of one study: the options of :class:`camdyn.vocabulary.SceneSpec` (contact, damping,
+    friction, motion, model, the misprint and switch options, follower, profile; see its
+    docstring), validated, with the generated module they select (:meth:`kernels`).
     """
 
     def __post_init__(self):

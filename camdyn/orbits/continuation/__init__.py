@@ -48,8 +48,10 @@ with its test function and locator in one table, :data:`.events.KINDS`):
   is not smooth there (no branch is switched to);
 * ``grazing``: the orbit's largest gap max psi_i (Eq. 6; psi_i < 0 is the contact deflection)
   over n T reaches zero: the follower leaves the cam for the first time.  The gap is the
-  generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period and refined by a
-  parabola through the largest sample and its neighbours.  It has a corner at the event (the
+  generated output ``OUT_PSI_I``, sampled ``GAP_SAMPLES`` times per period, or 16 times per
+  period of the contact's fastest vibration where that is more (``corrector.gap_samples``: a cam
+  whose jerk jumps rings the contact), and refined by a parabola through the largest sample and
+  its neighbours.  It has a corner at the event (the
   contact's deflection before, the flight's height after), so a secant across the bracket
   crawls in from the flat side; but on the contact side (gap < 0) it is smooth, the contact
   orbit continuing through the event: the trials aim at the root of the secant through the

@@ -262,3 +262,18 @@ def test_the_rigid_contact_angle_output_is_solved_on_any_cam():
     # over the turn the rigid follower rises by the law's lift, 0.05 rad, and comes back (Newton on the
     # gap to 4 ulp of pi; the spline cam matches the law to 1e-12 of the lift)
     assert abs((alpha_i.max() - alpha_i.min()) - 0.05) < 1e-9
+
+
+def test_the_mechanism_is_drawn_with_the_follower_s_face_on_the_cam():
+    pytest.importorskip("matplotlib")
+    from camdyn.io import plots
+
+    rig = cycloidal_cam_rig()
+    fig = plots.mechanism(rig, theta=230 * math.pi / 180)
+    ax = fig.axes[0]
+    outline, face, contact = ax.patches[0].get_xy(), ax.lines[2].get_xydata(), ax.lines[4].get_xydata()[0]
+    # the contact point is on the cam's outline (721 points of c(phi), ~0.25 mm apart on a 28 mm cam:
+    # within half that of one of them) and on the follower's face line (to rounding)
+    assert np.min(np.hypot(*(outline - contact).T)) < 0.15
+    (x0, y0), (x1, y1) = face
+    assert abs((x1 - x0) * (contact[1] - y0) - (y1 - y0) * (contact[0] - x0)) / math.hypot(x1 - x0, y1 - y0) < 1e-9

@@ -14,6 +14,7 @@ without it, and a call says how to install it.
                         over a brute-force bifurcation diagram
 * :func:`contact_map`   sliding / impacting regimes over (cam speed, k_s) (Fig. 9)
 * :func:`work_precision` error against run time, one line per solver set-up
+* :func:`mechanism`     the cam (any profile) turned to a cam angle, and the follower touching it (Fig. 1)
 
 :func:`poincare_section` (no matplotlib) samples a run once per cam period; :func:`style` gives
 the same look to figures you build yourself.
@@ -583,4 +584,39 @@ def work_precision(records, *, ax=None, title: str | None = None, error_label: s
         ax.legend(loc="best")
         if title:
             ax.set_title(title)
+    return fig
+
+
+def mechanism(rig, theta: float | None = None, *, ax=None, title: str | None = None):
+    """The cam (its profile turned to the cam angle ``theta``, rad; default the rig's theta0) and
+    the oscillating follower in rigid contact with it (Fig. 1): the bar from the pivot P along the
+    follower angle, its cam-side face, the contact point.  Any cam: the paper's circle or the rig's
+    profile (camdyn.model.profiles), drawn from its support function (contact points c(phi))."""
+    from ..model.followers import cam_of, follower_of_rig, rigid_contact
+
+    cam, follower = cam_of(rig), follower_of_rig(rig)
+    theta = rig.theta0 if theta is None else float(theta)
+    fig, axes = _figure(ax, figsize=(4.8, 4.0))
+    ax = axes[0]
+    body = cam.contact_point(np.linspace(0.0, 2 * math.pi, 721))
+    c, s = math.cos(theta), math.sin(theta)
+    x, y = c * body[:, 0] - s * body[:, 1], s * body[:, 0] + c * body[:, 1]
+    ax.fill(x * 1e3, y * 1e3, color="0.85", edgecolor="0.2", lw=1.0)
+    ax.plot([0], [0], "k+", ms=8)
+    contact = rigid_contact(cam, follower, np.array([theta]))
+    a, chi = float(contact.q[0]), float(contact.on_face[0])
+    u, n = np.array([math.cos(a), -math.sin(a)]), np.array([math.sin(a), math.cos(a)])
+    P = -np.asarray(follower.P_to_E)
+    reach = max(chi * 1.3, np.abs(body).max() * 2.5)
+    face = np.array([P + t * u + rig.w_b / 2 * n for t in (0.0, reach)])
+    axis = np.array([P, P + reach * u])
+    ax.plot(axis[:, 0] * 1e3, axis[:, 1] * 1e3, color="C0", lw=0.8, ls="--")
+    ax.plot(face[:, 0] * 1e3, face[:, 1] * 1e3, color="C0", lw=2.0)
+    ax.plot([P[0] * 1e3], [P[1] * 1e3], "o", color="C0")
+    O = P + chi * u + rig.w_b / 2 * n
+    ax.plot([O[0] * 1e3], [O[1] * 1e3], "o", color="C3", ms=4)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title or f"cam at {math.degrees(theta) % 360:.0f} deg, follower at {math.degrees(a):.2f} deg")
     return fig

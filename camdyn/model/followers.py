@@ -175,7 +175,7 @@ def _oscillating_root(profile, follower: OscillatingFollower, Theta: np.ndarray,
                         f"(largest step {np.max(np.abs(step)):.3g} rad)")
 
 
-def _cam_of(rig):
+def cam_of(rig):
     """The rig's cam: its profile, or the paper's circle (r_c, e)."""
     from .profiles import EccentricCircle
     return rig.profile if rig.profile is not None else EccentricCircle(rig.r_c, rig.e)
@@ -185,7 +185,7 @@ def follower_of_rig(rig) -> OscillatingFollower:
     """The rig's oscillating follower: E - P from its 0-state (Eq. 5 for any cam: the bar's surface
     touches the cam's support line of normal angle phi0 = 3 pi/2 - alpha0 - theta0 at chi0, so
     E - P = (chi0 - h'(phi0)) u0 + (w_b/2 + h(phi0)) n0; derive.geometry.P_to_E_general)."""
-    cam, a0 = _cam_of(rig), rig.alpha0
+    cam, a0 = cam_of(rig), rig.alpha0
     phi0 = 1.5 * math.pi - a0 - rig.theta0
     along, across = rig.chi0 - float(cam.h(phi0, 1)), rig.w_b / 2 + float(cam.h(phi0))
     u0, n0 = (math.cos(a0), -math.sin(a0)), (math.sin(a0), math.cos(a0))

@@ -69,10 +69,15 @@ class SlidingRun:
     rtol: float = 1e-8
     atol: float = 1e-12
     interior_points: int = 3
+    on_cam: bool = False        # the cycloidal cam of benchmarks/profile_cost.py (a spline), not the circle
 
     def model(self) -> Model:
         rig = camdyn.example_rig()
         scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
+        if self.on_cam:
+            from profile_cost import cycloidal_cam_rig
+            rig, scene = cycloidal_cam_rig(), camdyn.Scene(contact="line", damping="D", friction="coulomb",
+                                                           profile="spline")
         return Model(rig, scene, camdyn.ConstantSpeed(self.speed_rpm))
 
     def t_eval(self) -> np.ndarray:

@@ -68,12 +68,15 @@ def main(argv=None) -> int:
         results.append(step(case.key, measure_case, case, cfg, peers))
         plot_case(results[-1], IMG / f"perf_{case.key}.png")
     profiles = step("profile cost", profile_cost.measure)
+    cam_floor = step("floor on a cam", floor.measure, floor.SlidingRun(speed_rpm=profile_cost.CAM_FLOOR_RPM,
+                                                                       on_cam=True), cfg.floor_rounds // 2)
     starts = step("start-up", start_times, cfg)
     sw = step("sweeps", sweep_timing, cfg) if cfg.sweeps else None
     if sw is not None:
         plot_sweeps(sw, IMG)
     parts = {"peers": peers, "load": (load0, os.getloadavg()[0]), "elapsed": time.perf_counter() - t_start,
-             "floor": fs, "starts": starts, "results": results, "sweeps": sw, "profiles": profiles}
+             "floor": fs, "starts": starts, "results": results, "sweeps": sw, "profiles": profiles,
+             "cam_floor": cam_floor}
     text = write_report(parts, cfg)
     (DOCS / "performance.md").write_text(text + "\n")
     print(text)

@@ -43,6 +43,22 @@ def circle_spline(rig, pieces: int) -> SplineProfile:
     return SplineProfile.hermite(phi, *(circle.h(phi, d) for d in range(3)))
 
 
+def cycloidal_cam_rig():
+    """The example rig's follower on a cycloidal rise-dwell-return cam (0.05 rad of lift,
+    100/80/100/80 degrees, base circle 25 mm), at rest on its first dwell (140 degrees)."""
+    from camdyn.model.followers import follower_of_rig, rig_on_cam
+    from camdyn.model.motion_laws import rise_dwell_return
+    from camdyn.model.synthesis import cam_from_law
+
+    rig, deg = camdyn.example_rig(), math.pi / 180
+    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
+    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=140 * deg)
+
+
+#: the floor run on the cam: 0.8 x its jump speed (539.8 rev/min), in permanent contact
+CAM_FLOOR_RPM = 432.0
+
+
 def cases(rig) -> dict[str, tuple]:
     """label -> (rig, scene) for each measured profile."""
     arcs = ArcProfile.circular_arc_cam(r_b=0.022, r_n=0.008, d=0.018, R=0.06)
@@ -70,7 +86,7 @@ def measure() -> dict[str, float]:
     return {label: min(t) / CALLS * 1e9 for label, t in times.items()}
 
 
-def report(ns: dict[str, float]) -> str:
+def report(ns: dict[str, float], floor_on_cam=None) -> str:
     base = next(iter(ns.values()))
     rows = [f"| {label} | {v:.1f} | {v / base:.2f} |" for label, v in ns.items()]
     worst = max(v / base for v in list(ns.values())[1:])
@@ -84,7 +100,14 @@ def report(ns: dict[str, float]) -> str:
         f"rounds; load average {os.getloadavg()[0]:.2f}.",
         "",
         "| profile | ns per call | x the circle |", "|---|---|---|", *rows, "",
-        f"Issue 27's target, at most 1.5 x the circle's: {verdict} (worst {worst:.2f} x)."])
+        f"Issue 27's target, at most 1.5 x the circle's: {verdict} (worst {worst:.2f} x)."]
+        + ([] if floor_on_cam is None else [
+            "", f"The floor comparison on that cam (`benchmarks/floor.py`'s run on the cycloidal cam of "
+                f"`benchmarks/profile_cost.py`, {CAM_FLOOR_RPM:g} rev/min, permanent contact, spline scene): "
+                f"engine / floor, the same work, **{floor_on_cam.ratio_median:.2f}** (median of rounds; best/best "
+                f"{floor_on_cam.ratio_best:.2f}); the engine as it runs / floor: {floor_on_cam.default_ratio:.2f}; "
+                f"RHS {floor_on_cam.rhs_ns:.1f} ns per call; max |alpha_engine - alpha_floor| "
+                f"{floor_on_cam.max_alpha_diff:.1e} rad."]))
 
 
 def main() -> int:

@@ -94,7 +94,22 @@ def cases() -> list[Case]:
         Case("oscillating", "oscillating cam, Theta_p = pi, 40 rev/min, D, tanh",
              dict(damping="D", friction="tanh", motion="oscillating"), {}, camdyn.Oscillating(math.pi, 40.0),
              0.3, "alpha"),
+        cycloidal_cam_case(),
     ]
+
+
+def cycloidal_cam_case() -> Case:
+    """A cam that is not a circle (issue 27): the example rig's follower on a cycloidal
+    rise-dwell-return cam (0.05 rad of lift, 100/80/100/80 degrees, base circle 25 mm; a spline of
+    h through the profile evaluator), from rest on its dwell, at 0.8 x its jump speed."""
+    from profile_cost import cycloidal_cam_rig
+
+    on_cam = cycloidal_cam_rig()
+    speed = round(0.8 * camdyn.contact_loss_speed(on_cam))
+    changes = {name: getattr(on_cam, name) for name in ("profile", "theta0", "alpha0", "chi0")}
+    return Case("cycloidal_cam", f"cycloidal rise-dwell-return cam (spline), line 1.6 mm, D, {speed} rev/min",
+                dict(damping="D", friction="coulomb", profile="spline"), changes, camdyn.ConstantSpeed(speed),
+                0.2, "alpha")
 
 
 class Sample(NamedTuple):

@@ -303,5 +303,5 @@ def write_report(parts: dict, cfg: Config) -> str:
         start_lines(parts["starts"]) + ratio_lines(parts["results"], parts["peers"]) + target_lines(parts["results"], parts["peers"]) + \
         scene_lines(parts["results"]) + sweep_lines(parts["sweeps"], cfg)
     if parts.get("profiles"):
-        lines += ["", profile_cost.report(parts["profiles"])]
+        lines += ["", profile_cost.report(parts["profiles"], parts.get("cam_floor"))]
     return "\n".join(lines)

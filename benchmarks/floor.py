@@ -59,6 +59,22 @@ N_STAGES, N_EXTRA, EXPONENT = _M.n_stages, _M.n_extra, _M.exponent
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0   # SciPy's step-size controller
 
 
+def cycloidal_cam_rig():
+    """The example rig's follower on a cycloidal rise-dwell-return cam (0.05 rad of lift,
+    100/80/100/80 degrees, base circle 25 mm), at rest on its first dwell (140 degrees)."""
+    from camdyn.model.followers import follower_of_rig, rig_on_cam
+    from camdyn.model.motion_laws import rise_dwell_return
+    from camdyn.model.synthesis import cam_from_law
+
+    rig, deg = camdyn.example_rig(), math.pi / 180
+    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
+    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=140 * deg)
+
+
+#: the floor run on the cam: 0.8 x its jump speed (539.8 rev/min), in permanent contact
+CAM_FLOOR_RPM = 432.0
+
+
 @dataclass(frozen=True)
 class SlidingRun:
     """The benchmark run (see the module docstring)."""
@@ -69,13 +85,12 @@ class SlidingRun:
     rtol: float = 1e-8
     atol: float = 1e-12
     interior_points: int = 3
-    on_cam: bool = False        # the cycloidal cam of benchmarks/profile_cost.py (a spline), not the circle
+    on_cam: bool = False        # the cycloidal cam of cycloidal_cam_rig (a spline), not the circle
 
     def model(self) -> Model:
         rig = camdyn.example_rig()
         scene = camdyn.Scene(contact="line", damping="D", friction="coulomb")
         if self.on_cam:
-            from profile_cost import cycloidal_cam_rig
             rig, scene = cycloidal_cam_rig(), camdyn.Scene(contact="line", damping="D", friction="coulomb",
                                                            profile="spline")
         return Model(rig, scene, camdyn.ConstantSpeed(self.speed_rpm))

@@ -22,7 +22,7 @@ from camdyn.engine.kernels import compiled_kernels
 from camdyn.model.profiles import ArcProfile, EccentricCircle, SplineProfile
 
 sys.path.insert(0, os.path.dirname(__file__))
-from floor import interleaved  # noqa: E402
+from floor import CAM_FLOOR_RPM, interleaved  # noqa: E402
 
 SPEED_RPM = 600
 CALLS = 200_000
@@ -41,22 +41,6 @@ def circle_spline(rig, pieces: int) -> SplineProfile:
     circle = EccentricCircle(rig.r_c, rig.e)
     phi = np.linspace(0.0, 2 * math.pi, pieces + 1)
     return SplineProfile.hermite(phi, *(circle.h(phi, d) for d in range(3)))
-
-
-def cycloidal_cam_rig():
-    """The example rig's follower on a cycloidal rise-dwell-return cam (0.05 rad of lift,
-    100/80/100/80 degrees, base circle 25 mm), at rest on its first dwell (140 degrees)."""
-    from camdyn.model.followers import follower_of_rig, rig_on_cam
-    from camdyn.model.motion_laws import rise_dwell_return
-    from camdyn.model.synthesis import cam_from_law
-
-    rig, deg = camdyn.example_rig(), math.pi / 180
-    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
-    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=140 * deg)
-
-
-#: the floor run on the cam: 0.8 x its jump speed (539.8 rev/min), in permanent contact
-CAM_FLOOR_RPM = 432.0
 
 
 def cases(rig) -> dict[str, tuple]:

@@ -102,7 +102,7 @@ def cycloidal_cam_case() -> Case:
     """A cam that is not a circle (issue 27): the example rig's follower on a cycloidal
     rise-dwell-return cam (0.05 rad of lift, 100/80/100/80 degrees, base circle 25 mm; a spline of
     h through the profile evaluator), from rest on its dwell, at 0.8 x its jump speed."""
-    from profile_cost import cycloidal_cam_rig
+    from floor import cycloidal_cam_rig
 
     on_cam = cycloidal_cam_rig()
     speed = round(0.8 * camdyn.contact_loss_speed(on_cam))

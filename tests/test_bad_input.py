@@ -155,3 +155,11 @@ def test_the_zero_one_test_says_what_is_wrong_with_a_series(series, says):
 def test_an_object_that_is_not_a_number_is_not_called_one():
     message = str(ParameterError("model", camdyn.ConstantSpeed(100.0), "a periodic cam motion"))
     assert "is not valid: must be a periodic cam motion" in message and "real number" not in message
+
+
+@pytest.mark.parametrize("y0", ["", "0 0", [1.0, [2.0, 3.0]], object()])
+def test_a_start_state_that_is_not_two_numbers_is_a_parameter_error(y0):
+    """Found by the hostile-arguments test above (hypothesis drew y0=''): NumPy's own ValueError
+    escaped from the conversion instead of the error that names y0."""
+    with pytest.raises(camdyn.ParameterError, match="y0"):
+        camdyn.simulate(camdyn.example_rig(), camdyn.Scene(), speed_rpm=300, revolutions=0.01, y0=y0)

@@ -117,7 +117,10 @@ class RunRequest:
         if not isinstance(self.options, SolverOptions):
             raise ParameterError("options", self.options, "a camdyn.engine.SolverOptions")
         if self.y0 is not None:
-            y = np.asarray(self.y0, dtype=float)
+            try:
+                y = np.asarray(self.y0, dtype=float)
+            except (TypeError, ValueError):  # a string, a ragged list...
+                y = np.full(1, np.nan)
             if y.shape != (2,) or not np.all(np.isfinite(y)):
                 raise ParameterError("y0", self.y0, "two finite numbers (alpha rad, alpha_dot rad/s)")
             object.__setattr__(self, "y0", (float(y[0]), float(y[1])))

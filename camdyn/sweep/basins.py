@@ -154,7 +154,7 @@ class LabelAttractors:
             ds = ds.assign_coords(attractor_id=("attractor_id", np.arange(len(table), dtype=np.int32),
                                                 {"units": "1", "long_name": "id of an attractor (the values of "
                                                                             "attractor)"}))
-            ds = ds.assign(self._table_variables(table, spec))
+            ds = ds.assign(self._table_variables(table, spec, ds.sizes["cycle"]))
             if self.confirm:
                 ds = ds.assign(_confirmations(table, spec, self.tol))
         return ds
@@ -193,8 +193,8 @@ class LabelAttractors:
             codes[index] = match
         return codes, table
 
-    def _table_variables(self, table: list[dict], spec: SweepSpec) -> dict:
-        width = max(1, max(a["period"] for a in table))
+    def _table_variables(self, table: list[dict], spec: SweepSpec, width: int) -> dict:
+        """The table along ``attractor_id``; the cycles along the map's ``cycle`` (``width`` long)."""
         cycles = np.full((2, len(table), width), np.nan)
         for i, a in enumerate(table):
             cycles[:, i, :a["period"]] = a["cycle"]

@@ -27,7 +27,7 @@ import numpy as np
 import camdyn
 from camdyn.model.presets import load_rig
 from camdyn.sweep import process_pool
-from camdyn.sweep.basins import attractor_table
+from camdyn.sweep.attractors import attractor_table
 
 SPEED_RPM = 125.0
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")

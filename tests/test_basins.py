@@ -21,7 +21,7 @@ import camdyn
 from camdyn.errors import ParameterError
 from camdyn.model.cam import ConstantSpeed
 from camdyn.sweep import api as S
-from camdyn.sweep.basins import (CHAOTIC, NO_RUN, NOT_SETTLED, AttractorSection, LabelAttractors, attractor_table,
+from camdyn.sweep.attractors import (CHAOTIC, NO_RUN, NOT_SETTLED, AttractorSection, LabelAttractors, attractor_table,
                                  basins)
 from camdyn.sweep.spec import OUTCOME_CODES, SweepSpec
 
@@ -156,3 +156,53 @@ def test_bistable_map_holds_both_attractors(tmp_path):
     saved = S.load_sweep(out)
     assert np.array_equal(saved["attractor"].values, codes)
     assert saved["attractor_alpha"].attrs["units"] == "rad"
+
+
+def test_a_chaotic_start_is_judged_by_its_lyapunov_exponent():
+    """196 rev/min, tests/test_chaos.py's chaotic case: two runs 1e-9 rad apart separate by
+    e^0.62 per revolution there, lambda_1 ~ 0.62 * 196 / 60 = 2.0 1/s.  60 revolutions do not
+    settle, and lambda_1 over 60 more is positive by more than 3 standard errors (measured:
+    2.2 +- 0.3 and 2.5 +- 0.3 1/s from the two starts)."""
+    ds = basins(RIG, SCENE, alpha=[A_STAR, A_STAR + 0.1], alpha_dot=[0.0], speed_rpm=196.0, revolutions=60,
+                lyapunov_revolutions=60, progress=False)
+    assert (ds["stop_period"].values == 0).all()
+    assert (ds["attractor"].values == CHAOTIC).all()
+    # e^0.62 per revolution (median of 10 starts, range 0.39-1.04: tests/test_chaos.py) in 1/s
+    assert (ds["lyapunov"].values > 0.39 * 196 / 60 / 2).all() and (ds["lyapunov"].values < 1.04 * 196 / 60 * 2).all()
+    assert ds.attrs["attractors"] == 0 and "attractor_period" not in ds
+
+
+def test_attractors_at_different_speeds_are_different():
+    """A (speed, initial condition) map: the same section point at two speeds is two attractors,
+    each with its speed in the table."""
+    import xarray as xr
+
+    axes = {"speed_rpm": np.array([120.0, 125.0]), "alpha_start": np.array([0.3]),
+            "alpha_dot_start": np.array([0.0, 1.0])}
+    spec = SweepSpec(RIG, SCENE, axes, AttractorSection(), {}, 1)
+    dims = tuple(axes)
+    ds = xr.Dataset({"outcome": (dims, np.zeros((2, 1, 2), dtype=np.int32)),
+                     "stop_period": (dims, np.ones((2, 1, 2))),
+                     "cycle_alpha": (dims + ("cycle",), np.full((2, 1, 2, 1), 0.4)),
+                     "cycle_alpha_dot": (dims + ("cycle",), np.full((2, 1, 2, 1), -0.5)),
+                     "lyapunov": (dims, np.full((2, 1, 2), np.nan)),
+                     "lyapunov_se": (dims, np.full((2, 1, 2), np.nan))}, coords=axes)
+    out = LabelAttractors(confirm=False)(ds, spec)
+    assert out["attractor"].values.ravel().tolist() == [0, 0, 1, 1]
+    assert out["attractor_speed_rpm"].values.tolist() == [120.0, 125.0]
+    assert out["attractor_speed_rpm"].attrs["units"] == "rev/min"
+
+
+def test_the_basins_command_prints_the_attractor_table(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    from camdyn.cli.app import main
+
+    nc, png = tmp_path / "b.nc", tmp_path / "b.png"
+    assert main(["--no-progress", "basins", "--rig", "reference-experiment", "--speed-rpm", "125",
+                 "--from-equilibrium", "--alpha", "0,0.2", "--alpha-dot", "0", "--no-confirm",
+                 "--netcdf", str(nc), "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "2 starts, 2 attractors" in out and "attractor 1: P1" in out
+    assert nc.is_file() and png.is_file()
+    assert main(["--no-progress", "sweep", "--resume", str(nc)]) == 0      # a finished map reads back
+    assert "2 attractors" in capsys.readouterr().out

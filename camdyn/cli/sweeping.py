@@ -73,6 +73,10 @@ def _sweep_report(ds, args, sweeps, out) -> int:
     INVALID, as --skip-invalid asked, is not a failure)."""
     import numpy as np
 
+    if "attractor" in ds:          # a basin map (camdyn basins), resumed
+        from .basins import basins_report
+
+        return basins_report(ds, args)
     rig, scene = sweeps.rig_of(ds.attrs), sweeps.scene_of(ds.attrs)
     names = _outcome_names(ds)
     codes = {name: code for code, name in names.items()}

@@ -558,12 +558,12 @@ def _without_skipped(speeds, ks, codes, loss_curve):
     return speeds, ks, codes, loss_curve
 
 
-#: colours of the basin map's verdicts (camdyn.sweep.basins.VERDICTS); attractors take tab10's
+#: colours of the basin map's verdicts (camdyn.sweep.attractors.VERDICTS); attractors take tab10's
 _VERDICT_COLOURS = {"chaotic": "#222222", "not_settled": "#9e9e9e", "no_run": "#ffffff"}
 
 
 def basin_map(ds, *, speed_rpm: float | None = None, ax=None, title: str | None = None):
-    """The basin map of :func:`camdyn.sweep.basins.basins` over the starts (alpha_start,
+    """The basin map of :func:`camdyn.sweep.attractors.basins` over the starts (alpha_start,
     alpha_dot_start), each start coloured by the attractor it reaches (chaotic, not settled and
     no run in black, grey and white), each attractor's section points marked with a star
     (labelled with its id, period and share of the map).  With a speed axis, ``speed_rpm`` picks
@@ -572,14 +572,19 @@ def basin_map(ds, *, speed_rpm: float | None = None, ax=None, title: str | None 
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
-    from ..sweep.basins import VERDICTS
+    from ..sweep.attractors import VERDICTS
 
     if "speed_rpm" in ds.dims:
         if speed_rpm is None and ds.sizes["speed_rpm"] > 1:
             raise ValueError(f"the map has {ds.sizes['speed_rpm']} speeds: give speed_rpm= (one of "
                              f"{ds['speed_rpm'].values.tolist()})")
         ds = ds.sel(speed_rpm=speed_rpm, method="nearest") if speed_rpm is not None else ds.isel(speed_rpm=0)
-    codes = ds["attractor"].squeeze().transpose("alpha_dot_start", "alpha_start").values
+    codes = ds["attractor"]
+    for dim in set(codes.dims) - {"alpha_start", "alpha_dot_start"}:
+        if codes.sizes[dim] > 1:
+            raise ValueError(f"the map has {codes.sizes[dim]} values of {dim}: draw one (ds.isel({dim}=...))")
+        codes = codes.isel({dim: 0})
+    codes = codes.transpose("alpha_dot_start", "alpha_start").values
     n = int(ds.attrs.get("attractors", 0))
     ids = [i for i in range(n) if np.any(codes == i)]
     palette = [_tab10(k) for k in range(max(n, 1))]

@@ -63,8 +63,13 @@ from ..model.scene import Scene
 from ..runs.stopping import StopWhenPeriodic
 from .spec import OUTCOME_CODES, STATE_NAMES, SweepSpec, _interrupted
 
-#: the codes of ``attractor`` that are not an attractor's id
-CHAOTIC, NOT_SETTLED, NO_RUN = -1, -2, -3
+#: ``attractor`` of a start that did not settle and whose lambda_1 is positive by ``chaos_se`` standard errors
+CHAOTIC = -1
+#: ``attractor`` of a start that did not settle within the revolutions, with no chaos verdict
+NOT_SETTLED = -2
+#: ``attractor`` of a start whose run did not succeed (its ``outcome`` and ``message`` say why)
+NO_RUN = -3
+#: the codes of ``attractor`` that are not an attractor's id, by name (its ``flag_meanings``)
 VERDICTS = {"chaotic": CHAOTIC, "not_settled": NOT_SETTLED, "no_run": NO_RUN}
 
 

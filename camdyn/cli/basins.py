@@ -1,12 +1,10 @@
 """``camdyn basins``: the attractor each start (alpha, alpha_dot) reaches (camdyn.sweep.attractors)."""
 from __future__ import annotations
 
-import sys
-
-from .common import EXIT_INCOMPLETE, EXIT_OK, UsageError, _check_outputs, _parse_values, _save_figure
+from .common import _check_outputs, _parse_values
 from .options import _add_file, _add_physics, _add_solver, _backend, _rig, _scene, _solver_options
 from .parser import add_command
-from .sweeping import _executor, _sweep_interrupted, _sweep_module, _sweep_progress
+from .sweeping import _executor, _sweep_interrupted, _sweep_module, _sweep_progress, basins_report
 
 
 def cmd_basins(args) -> int:
@@ -32,31 +30,6 @@ def cmd_basins(args) -> int:
     if args.out:
         print(f"  wrote {args.out}")
     return basins_report(ds, args)
-
-
-def basins_report(ds, args) -> int:
-    """Print the attractor table, plot the map; exit 3 if a start's run did not succeed."""
-    from ..sweep.attractors import NO_RUN, attractor_table
-
-    print(f"basin map of {ds.attrs['scene']} on rig {ds.attrs['rig']!r}: {ds.attrs['points']} starts, "
-          f"{ds.attrs['attractors']} attractors (told apart to {ds.attrs['attractor_tol']:g} rad)")
-    for row in attractor_table(ds):
-        if isinstance(row["id"], int):
-            where = "".join(f", {k} {row[k]:g}" for k in ("speed_rpm",) if k in row)
-            check = (f", shooting: {row['orbit']}, |mu| max {row['multiplier']:.3g}"
-                     f"{'' if row['confirmed'] else ' (NOT confirmed)'}" if "confirmed" in row else "")
-            print(f"  attractor {row['id']}: P{row['period']}{where}, section alpha {row['alpha']:.6g} rad, "
-                  f"alpha_dot {row['alpha_dot']:.6g} rad/s; {row['points']} starts{check}")
-        else:
-            print(f"  {row['id'].replace('_', ' ')}: {row['points']} starts")
-    if getattr(args, "plot", None):
-        from .common import _plot_modules
-
-        speeds = ds["speed_rpm"].values if "speed_rpm" in ds.dims else [None]
-        if len(speeds) > 1:
-            print("  the plot shows the first speed of the map", file=sys.stderr)
-        _save_figure(_plot_modules().basin_map(ds, speed_rpm=speeds[0]), args.plot)
-    return EXIT_INCOMPLETE if (ds["attractor"].values == NO_RUN).any() else EXIT_OK
 
 
 def add_basins(sub) -> None:

@@ -39,6 +39,7 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=100, help="starts per axis (default 100)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--no-figure", action="store_true")
+    parser.add_argument("--keep", metavar="FILE.nc", help="write the map to FILE.nc (default: a temporary file)")
     args = parser.parse_args()
     warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
     rig = load_rig("reference-experiment")
@@ -50,7 +51,7 @@ def main() -> None:
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp, process_pool(args.workers) as pool:
         ds = camdyn.basins(rig, SCENE, alpha=alpha, alpha_dot=alpha_dot, speed_rpm=SPEED_RPM, executor=pool,
-                           out=Path(tmp) / "basins.nc", progress=False)
+                           out=args.keep or Path(tmp) / "basins.nc", overwrite=True, progress=False)
     wall = time.perf_counter() - t0
     load1 = os.getloadavg()
     print(f"{args.n} x {args.n} basin map at {SPEED_RPM:g} rev/min: {wall:.1f} s wall on {args.workers} workers "

@@ -112,6 +112,23 @@ def test_attractors_are_labelled_by_period_and_section_points():
     assert [r["id"] for r in rows] == [0, 1, 2, "chaotic", "not_settled", "no_run"]
 
 
+def test_a_cycle_is_reduced_to_its_minimal_period_within_tol():
+    """Seen on the 100 x 100 map at 125 rev/min (benchmarks/basins.py, before this reduction): 10
+    of 10,000 runs stopped with stop_period 2 at the flight orbit (largest multiplier modulus
+    0.63), labelled a P2 attractor whose first section point was 3e-11 rad from the P1 one and
+    whose shooting orbit had multipliers of modulus 0.39 = 0.63^2: the P1 orbit counted twice.
+    Within the map's tol such a cycle is the P1 attractor."""
+    rows = [(OK, 1, [0.30], [-0.50], NAN, NAN),
+            (OK, 2, [0.30 + 1e-7, 0.30 - 1e-7], [-0.50, -0.50 + 1e-7], NAN, NAN),      # P1 within tol
+            (OK, 2, [0.30 + 4e-6, 0.30 - 4e-6], [-0.50, -0.50], NAN, NAN),             # a true P2
+            (OK, 4, [0.2, 0.3, 0.2 + 1e-8, 0.3 + 1e-8], [0.1, 0.2, 0.1, 0.2], NAN, NAN)]  # a P2 as P4
+    ds, spec = _synthetic(rows + [(FAILED, 0, [], [], NAN, NAN)] * 4)
+    out = LabelAttractors(confirm=False)(ds, spec)
+    assert out["attractor"].values.ravel().tolist()[:4] == [0, 0, 1, 2]
+    assert out["attractor_period"].values.tolist() == [1, 2, 2]
+    assert out["attractor_alpha"].values[2, :2].tolist() == [0.2, 0.3]
+
+
 def test_the_measure_keeps_the_cycle_from_its_smallest_alpha():
     class Fake:
         ok, t = True, np.arange(10.0)

@@ -26,7 +26,8 @@ What a point reached (:class:`AttractorSection`, in the worker):
 * **no run**: the run did not succeed (its ``outcome`` says why).
 
 Labelling (:class:`LabelAttractors`, the sweep's ``finish``: it runs again on resume, so a
-resumed map is labelled as an uninterrupted one): periodic points at the same values of the
+resumed map is labelled as an uninterrupted one): a point's cycle is first reduced to its
+minimal period within ``tol`` (below); periodic points at the same values of the
 non-state axes (the speed, rig parameters) are one attractor when their periods are equal and
 their section cycles match as sets: every point of each within ``tol`` (rad) in alpha and
 ``tol Omega_c`` (rad/s, Omega_c the cam's angular speed) in alpha_dot of a point of the other.
@@ -185,8 +186,9 @@ class LabelAttractors:
                 codes[index] = CHAOTIC if chaotic else NOT_SETTLED
                 continue
             group = tuple(where[k] for k in others)
-            cycle = (alpha[index, :p], alpha_dot[index, :p])
             omega = _omega(spec, index)
+            cycle = _minimal_cycle(alpha[index, :p], alpha_dot[index, :p], self.tol, self.tol * omega)
+            p = cycle[0].size
             ids = found.setdefault(group, [])
             match = next((i for i in ids if table[i]["period"] == p
                           and _same_cycle(table[i]["cycle"], cycle, self.tol, self.tol * omega)), None)
@@ -226,6 +228,22 @@ def _omega(spec: SweepSpec, index: int) -> float:
     speed = spec.values(index).get("speed_rpm")
     period = 60.0 / speed if speed is not None else spec.settings["cam"].period
     return 2 * math.pi / period
+
+
+def _minimal_cycle(alpha: np.ndarray, alpha_dot: np.ndarray, tol_alpha: float, tol_rate: float):
+    """The cycle of a run's p section points at its minimal period within the map's tolerances:
+    its first q points for the least divisor q of p with every point within them of the point q
+    later, rotated to start at the smallest alpha.  (The stop's period is minimal within its own,
+    tighter threshold: a run still converging to a P1 orbit along a complex pair of multipliers can
+    pass for a P2 cycle there; at the map's tol it is the P1 orbit.)"""
+    p = alpha.size
+    for q in range(1, p):
+        if p % q == 0 and np.all(np.abs(alpha - np.roll(alpha, -q)) <= tol_alpha) \
+                and np.all(np.abs(alpha_dot - np.roll(alpha_dot, -q)) <= tol_rate):
+            alpha, alpha_dot = alpha[:q], alpha_dot[:q]
+            break
+    first = int(np.argmin(alpha))
+    return np.roll(alpha, -first), np.roll(alpha_dot, -first)
 
 
 def _same_cycle(a, b, tol_alpha: float, tol_rate: float) -> bool:

@@ -35,7 +35,11 @@ Sweeps at scale lose nothing:
 
 A measure is a picklable callable ``measure(result) -> dict``: each value a number or a
 ``(dim, 1-D array)`` pair (see :class:`Summary`, :class:`PoincareSection`); numbers are
-stored as floats.  Its optional ``variables`` (name -> (long_name, units)) label the file.
+stored as floats.  Its optional ``variables`` (name -> (long_name, units)) label the file.  A
+measure whose ``wants_inputs`` is True is called ``measure(result, inputs)``, ``inputs`` the
+point's rig, scene, cam and request (:class:`camdyn.sweep.spec.PointInputs`), to run more of it.
+The grid may hold the initial state (``alpha_start``, ``alpha_dot_start``): maps of initial
+conditions, as :func:`camdyn.sweep.attractors.basins` draws basins of attraction with them.
 :func:`bifurcation` (Poincare section of alpha once per revolution against speed) and
 :func:`contact_loss_map` (k_s against cam speed, as in the paper's Fig. 9) are sweeps.
 """

@@ -51,6 +51,7 @@ _EXPORTS = {
     "ContinuationOutcome": "camdyn.orbits.continuation",
     "zero_one_test": "camdyn.analysis.chaos01",
     "StopWhenPeriodic": "camdyn.runs.stopping",
+    "basins": "camdyn.sweep.attractors",
     "Span": "camdyn.runs.request",
     "SolverOptions": "camdyn.engine",
     "quasi_static_orbit": "camdyn.runs.quasistatic",

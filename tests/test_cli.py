@@ -166,7 +166,8 @@ def test_scenes_lists_generated_scenes(capsys):
     assert "friction" in data["options"]
 
 
-COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "lyapunov", "sweep", "continue",
+COMMANDS = ["simulate", "spectrum", "equilibrium", "natural-frequency", "contact-loss", "lyapunov", "sweep", "basins",
+            "continue",
             "regenerate", "reproduce", "scenes"]
 
 

@@ -45,6 +45,7 @@ MODULES = [
     "analysis.chaos01",
     "analysis.signal",
     "sweep.api",
+    "sweep.attractors",
     "io.files",
     "io.metadata",
     "io.plots",

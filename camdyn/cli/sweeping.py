@@ -73,6 +73,8 @@ def _sweep_report(ds, args, sweeps, out) -> int:
     INVALID, as --skip-invalid asked, is not a failure)."""
     import numpy as np
 
+    if "attractor" in ds:          # a basin map (camdyn basins), resumed
+        return basins_report(ds, args)
     rig, scene = sweeps.rig_of(ds.attrs), sweeps.scene_of(ds.attrs)
     names = _outcome_names(ds)
     codes = {name: code for code, name in names.items()}
@@ -123,3 +125,26 @@ def _sweep_plot(ds, rig, scene, regimes):
     ran = regimes != "skipped"
     return plots.bifurcation(speeds[ran], ds["alpha_section"].values[ran], relative_to=alpha_star,
                              contact_loss_rpm=contact_loss_speed(rig), title=f"{title}: revolutions {span}")
+
+
+def basins_report(ds, args) -> int:
+    """Print the attractor table, plot the map; exit 3 if a start's run did not succeed."""
+    from ..sweep.attractors import NO_RUN, attractor_table
+
+    print(f"basin map of {ds.attrs['scene']} on rig {ds.attrs['rig']!r}: {ds.attrs['points']} starts, "
+          f"{ds.attrs['attractors']} attractors (told apart to {ds.attrs['attractor_tol']:g} rad)")
+    for row in attractor_table(ds):
+        if isinstance(row["id"], int):
+            where = "".join(f", {k} {row[k]:g}" for k in ("speed_rpm",) if k in row)
+            check = (f", shooting: {row['orbit']}, |mu| max {row['multiplier']:.3g}"
+                     f"{'' if row['confirmed'] else ' (NOT confirmed)'}" if "confirmed" in row else "")
+            print(f"  attractor {row['id']}: P{row['period']}{where}, section alpha {row['alpha']:.6g} rad, "
+                  f"alpha_dot {row['alpha_dot']:.6g} rad/s; {row['points']} starts{check}")
+        else:
+            print(f"  {row['id'].replace('_', ' ')}: {row['points']} starts")
+    if getattr(args, "plot", None):
+        speeds = ds["speed_rpm"].values if "speed_rpm" in ds.dims else [None]
+        if len(speeds) > 1:
+            print("  the plot shows the first speed of the map", file=sys.stderr)
+        _save_figure(_plot_modules().basin_map(ds, speed_rpm=speeds[0]), args.plot)
+    return EXIT_INCOMPLETE if (ds["attractor"].values == NO_RUN).any() else EXIT_OK

@@ -13,6 +13,7 @@ without it, and a call says how to install it.
 * :func:`branches`      continued branches (stable solid, unstable dashed) and their events,
                         over a brute-force bifurcation diagram
 * :func:`contact_map`   sliding / impacting regimes over (cam speed, k_s) (Fig. 9)
+* :func:`basin_map`     basins of attraction over the starts (alpha, alpha_dot), attractors marked
 * :func:`work_precision` error against run time, one line per solver set-up
 * :func:`mechanism`     the cam (any profile) turned to a cam angle, and the follower touching it (Fig. 1)
 
@@ -31,7 +32,7 @@ from .metadata import units as _units
 
 __all__ = ["PAPER_STYLE", "QUANTITIES", "MIN_FONT_PT", "REGIME_CODES", "style", "run_title", "time_history",
            "overview", "spectrum", "whole_period_samples", "poincare_section", "poincare", "bifurcation",
-           "branches", "contact_map", "work_precision"]
+           "branches", "contact_map", "basin_map", "work_precision"]
 
 #: rcParams of the paper-like look: thin lines, inward ticks on all sides, no frame on legends.
 PAPER_STYLE = {
@@ -556,6 +557,65 @@ def _without_skipped(speeds, ks, codes, loss_curve):
         inside = (lk >= ks.min()) & (lk <= ks.max())
         loss_curve = (ls[inside], lk[inside])
     return speeds, ks, codes, loss_curve
+
+
+#: colours of the basin map's verdicts (camdyn.sweep.attractors.VERDICTS); attractors take tab10's
+_VERDICT_COLOURS = {"chaotic": "#222222", "not_settled": "#9e9e9e", "no_run": "#ffffff"}
+
+
+def basin_map(ds, *, speed_rpm: float | None = None, ax=None, title: str | None = None):
+    """The basin map of :func:`camdyn.sweep.attractors.basins` over the starts (alpha_start,
+    alpha_dot_start), each start coloured by the attractor it reaches (chaotic, not settled and
+    no run in black, grey and white), each attractor's section points marked with a star
+    (labelled with its id, period and share of the map).  With a speed axis, ``speed_rpm`` picks
+    the speed drawn (the nearest on the grid)."""
+    _pyplot()
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    from ..sweep.attractors import VERDICTS
+
+    if "speed_rpm" in ds.dims:
+        if speed_rpm is None and ds.sizes["speed_rpm"] > 1:
+            raise ValueError(f"the map has {ds.sizes['speed_rpm']} speeds: give speed_rpm= (one of "
+                             f"{ds['speed_rpm'].values.tolist()})")
+        ds = ds.sel(speed_rpm=speed_rpm, method="nearest") if speed_rpm is not None else ds.isel(speed_rpm=0)
+    codes = ds["attractor"]
+    for dim in set(codes.dims) - {"alpha_start", "alpha_dot_start"}:
+        if codes.sizes[dim] > 1:
+            raise ValueError(f"the map has {codes.sizes[dim]} values of {dim}: draw one (ds.isel({dim}=...))")
+        codes = codes.isel({dim: 0})
+    codes = codes.transpose("alpha_dot_start", "alpha_start").values
+    n = int(ds.attrs.get("attractors", 0))
+    ids = [i for i in range(n) if np.any(codes == i)]
+    palette = [_tab10(k) for k in range(max(n, 1))]
+    colours = [_VERDICT_COLOURS[name] for name in VERDICTS][::-1] + palette  # codes -3 .. n - 1
+    with _style():
+        fig, (ax,) = _figure(ax, figsize=(5.6, 4.2))
+        bounds = np.arange(-3, max(n, 1) + 1) - 0.5
+        ax.pcolormesh(ds["alpha_start"].values, ds["alpha_dot_start"].values, codes, cmap=ListedColormap(colours),
+                      norm=BoundaryNorm(bounds, len(colours)), shading="nearest")
+        handles = []
+        for i in ids:
+            share = 100.0 * np.mean(codes == i)
+            p = int(ds["attractor_period"].values[i])
+            a, ad = ds["attractor_alpha"].values[i, :p], ds["attractor_alpha_dot"].values[i, :p]
+            handles.append(ax.plot(a, ad, "*", ms=11, mfc=palette[i], mec="k", mew=0.8,
+                                   label=f"attractor {i}: P{p}, {share:.0f} % of starts")[0])
+        handles += [Patch(facecolor=_VERDICT_COLOURS[name], edgecolor="0.5", label=name.replace("_", " "))
+                    for name, code in VERDICTS.items() if np.any(codes == code)]
+        ax.grid(False)
+        ax.set(xlabel=r"$\alpha$ at the start, $t = 0$ (rad)", ylabel=r"$\dot\alpha$ at the start (rad/s)")
+        ax.legend(handles=handles, loc="upper right", frameon=True, framealpha=0.85, fontsize=MIN_FONT_PT)
+        if title:
+            ax.set_title(title)
+    return fig
+
+
+def _tab10(k: int):
+    from matplotlib import colormaps
+
+    return colormaps["tab10"](k % 10)
 
 
 def work_precision(records, *, ax=None, title: str | None = None, error_label: str = "error"):

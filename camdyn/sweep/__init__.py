@@ -1,5 +1,6 @@
 """Parameter sweeps on any concurrent.futures.Executor: the API (api), what a sweep runs (spec),
-its checks before any work (check), running its chunks (dispatch) and storing them (store)."""
+its checks before any work (check), running its chunks (dispatch) and storing them (store); basin
+maps of initial conditions as sweeps (attractors)."""
 from __future__ import annotations
 
 from .._lazy import lazy
@@ -7,6 +8,8 @@ from .._lazy import lazy
 #: public name -> the module (relative to this package) that defines it; loaded on first use
 _EXPORTS = {
     'ALL_CODES': '.api',
+    'attractor_table': '.attractors',
+    'basins': '.attractors',
     'InvalidGridError': '.api',
     'NotASweepError': '.api',
     'PoincareSection': '.api',

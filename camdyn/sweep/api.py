@@ -35,7 +35,11 @@ Sweeps at scale lose nothing:
 
 A measure is a picklable callable ``measure(result) -> dict``: each value a number or a
 ``(dim, 1-D array)`` pair (see :class:`Summary`, :class:`PoincareSection`); numbers are
-stored as floats.  Its optional ``variables`` (name -> (long_name, units)) label the file.
+stored as floats.  Its optional ``variables`` (name -> (long_name, units)) label the file.  A
+measure whose ``wants_inputs`` is True is called ``measure(result, inputs)``, ``inputs`` the
+point's rig, scene, cam and request (:class:`camdyn.sweep.spec.PointInputs`), to run more of it.
+The grid may hold the initial state (``alpha_start``, ``alpha_dot_start``): maps of initial
+conditions, as :func:`camdyn.sweep.attractors.basins` draws basins of attraction with them.
 :func:`bifurcation` (Poincare section of alpha once per revolution against speed) and
 :func:`contact_loss_map` (k_s against cam speed, as in the paper's Fig. 9) are sweeps.
 """
@@ -62,7 +66,7 @@ from ..runs.request import DEFAULT_BACKEND
 from ..runs.stopping import StopWhenPeriodic
 from .check import InvalidGridError, check_by_running, check_grid, check_settings
 from .dispatch import Dispatch, chunks_of, process_pool, run_serial, worker_count
-from .spec import ALL_CODES, ERROR, INVALID, NOT_RUN, OUTCOME_CODES, SweepSpec, chunk_of, grid_axes
+from .spec import ALL_CODES, ERROR, INVALID, NOT_RUN, OUTCOME_CODES, STATE_NAMES, SweepSpec, chunk_of, grid_axes
 from .store import (FolderStore, MemoryStore, NotASweepError, StoreError, assemble, check_out, done_mask, load_sweep,
                     parts_folder, refuse_if_in_use, rig_of, scene_of, stop_summary)
 
@@ -139,8 +143,10 @@ def sweep(rig: Rig, scene: Scene, grid: Mapping[str, Sequence[float]], measure: 
     rig, scene : camdyn.Rig, camdyn.Scene
         The base rig (each point replaces the grid's rig parameters) and the physics.
     grid : mapping of str to 1-D sequence of float
-        ``speed_rpm`` and/or rig parameters (SI), each with its values; the points are the
-        outer product, and the Dataset's dimensions follow this order.
+        ``speed_rpm``, rig parameters (SI) and/or the initial state ``alpha_start`` (rad),
+        ``alpha_dot_start`` (rad/s) -- each point's ``y0``; a component without an axis comes
+        from ``y0=`` -- each with its values; the points are the outer product, and the
+        Dataset's dimensions follow this order.
     measure : callable, optional
         ``measure(result) -> dict`` (picklable); default :class:`Summary`.
     executor : concurrent.futures.Executor, optional
@@ -235,6 +241,11 @@ def settings_of(out) -> tuple[dict, dict[str, np.ndarray]]:
 def _spec(rig, scene, grid, measure, samples_per_revolution, kwargs: dict, finish=None) -> SweepSpec:
     axes = grid_axes(rig, grid)
     kwargs = dict(kwargs)
+    state = [name for name in STATE_NAMES if name in axes]
+    if state and len(state) < len(STATE_NAMES) and kwargs.get("y0") is None:
+        missing = next(name for name in STATE_NAMES if name not in axes)
+        raise ParameterError("y0", None, f"(alpha rad, alpha_dot rad/s) for the start's {missing.replace('_start', '')},"
+                             f" which has no grid axis {missing!r}")
     if not callable(measure):
         raise ParameterError("measure", measure, "a callable measure(result) -> dict")
     if samples_per_revolution is not None:

@@ -27,7 +27,7 @@ from ..errors import CamdynError, ParameterError
 from ..model.cam import ConstantSpeed
 from ..runs.request import Span
 from ..runs.simulation import checked_model, run
-from .spec import CAM_NAMES, SweepSpec
+from .spec import CAM_NAMES, STATE_NAMES, SweepSpec
 
 #: lines of an InvalidGridError's message at the most (its ``invalid`` lists every point)
 MAX_LINES = 50
@@ -76,7 +76,7 @@ def check_by_running(spec: SweepSpec, index: int) -> None:
 def check_grid(spec: SweepSpec) -> tuple[dict[int, str], list[str]]:
     """({flat index: reason} of every invalid point, the lines listing them, grouped)."""
     names = spec.names
-    rig_at = [k for k, n in enumerate(names) if n not in CAM_NAMES]
+    rig_at = [k for k, n in enumerate(names) if n not in CAM_NAMES and n not in STATE_NAMES]
     cam_at = next((k for k, n in enumerate(names) if n in CAM_NAMES), None)
     cams = _cams(spec, cam_at)
     valid_cams = [c for c in cams.values() if not isinstance(c, str)]

@@ -14,7 +14,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
@@ -26,8 +26,10 @@ from ..outcome import Outcome
 from ..runs.request import RunRequest, loose_keywords, run_request
 from ..runs.simulation import run
 
-#: grid names that are not rig parameters
+#: grid names that are not rig parameters: the cam's speed, and the initial state (alpha rad,
+#: alpha_dot rad/s at t_start: each point's ``y0``, for maps of initial conditions such as basins)
 CAM_NAMES = ("speed_rpm",)
+STATE_NAMES = ("alpha_start", "alpha_dot_start")
 #: outcome codes of a point: the engine's outcomes by their position in camdyn.Outcome, and
 #: three of the sweep's own, negative so that a new engine outcome never shifts them
 OUTCOME_CODES = {o.name: i for i, o in enumerate(Outcome)}
@@ -107,12 +109,20 @@ class SweepSpec:
         return dataclasses.replace(self.request, span=span)
 
     def inputs(self, index: int):
-        """(rig, cam, request) of one point; the rig, cam and request validate themselves."""
+        """(rig, cam, request) of one point; the rig, cam and request validate themselves.  A point
+        with an initial-state axis (:data:`STATE_NAMES`) starts there: its request's ``y0`` is the
+        point's (alpha_start, alpha_dot_start), a component without an axis taken from ``y0=``."""
         values = self.values(index)
         speed = values.pop("speed_rpm", None)
+        state = {name: values.pop(name) for name in STATE_NAMES if name in values}
         rig = self.rig.replace(**values) if values else self.rig
         cam = ConstantSpeed(speed) if speed is not None else self.settings["cam"]
-        return rig, cam, self.request_at(cam)
+        request = self.request_at(cam)
+        if state:
+            base = request.y0 or (math.nan, math.nan)
+            y0 = tuple(state.get(name, b) for name, b in zip(STATE_NAMES, base))
+            request = dataclasses.replace(request, y0=y0)
+        return rig, cam, request
 
 
 def grid_axes(rig: Rig, grid: Mapping[str, Sequence[float]]) -> dict[str, np.ndarray]:
@@ -122,8 +132,9 @@ def grid_axes(rig: Rig, grid: Mapping[str, Sequence[float]]) -> dict[str, np.nda
     out = {}
     known = set(rig.to_dict()) - {"name", "description"}
     for name, values in grid.items():
-        if name not in CAM_NAMES and name not in known:
-            raise ParameterError("grid", name, f"speed_rpm or a rig parameter ({', '.join(sorted(known))})")
+        if name not in CAM_NAMES and name not in STATE_NAMES and name not in known:
+            raise ParameterError("grid", name, f"speed_rpm, {', '.join(STATE_NAMES)} (the initial state) or a rig "
+                                 f"parameter ({', '.join(sorted(known))})")
         try:
             arr = np.asarray(values, dtype=float)
         except (TypeError, ValueError):
@@ -157,12 +168,27 @@ def run_chunk(spec: SweepSpec, indices: Sequence[int], attempt: int = 0) -> Chun
     return chunk_of(indices, rows)
 
 
+class PointInputs(NamedTuple):
+    """What one point ran: given to a measure whose ``wants_inputs`` is True, as
+    ``measure(result, inputs)`` (e.g. to run more of the same point, as the basins' Lyapunov
+    verdict does)."""
+
+    rig: Rig
+    scene: Scene
+    cam: object
+    request: RunRequest
+
+
 def run_point(spec: SweepSpec, index: int) -> tuple[int, str, dict]:
     """(outcome code, message, measured values) of one point; an exception becomes ERROR."""
     try:
         rig, cam, request = spec.inputs(index)
         result = run(rig, spec.scene, cam, request)
-        values = measured(spec.measure(result), spec.names)
+        if getattr(spec.measure, "wants_inputs", False):
+            raw = spec.measure(result, PointInputs(rig, spec.scene, cam, request))
+        else:
+            raw = spec.measure(result)
+        values = measured(raw, spec.names)
     except Exception as exc:  # a failing point never sinks the sweep: it is recorded
         if _interrupted(exc):
             raise KeyboardInterrupt from exc

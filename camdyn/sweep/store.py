@@ -467,6 +467,8 @@ def variable_attributes(spec: SweepSpec) -> dict[str, dict]:
                        "flag_meanings": " ".join(ALL_CODES)},
            "message": {"long_name": "why the point's run did not succeed (empty on success)"}}
     out.update({p.name: {"units": _unit(p.unit), "long_name": p.description} for p in PARAMETERS})
+    out["alpha_start"] = {"units": "rad", "long_name": "follower angle alpha at the run's start (its y0)"}
+    out["alpha_dot_start"] = {"units": "rad/s", "long_name": "follower rate alpha_dot at the run's start (its y0)"}
     out["revolutions_run"] = {"units": "1", "long_name": "cam revolutions integrated (fewer than requested where "
                                                          "the run stopped once periodic: see stop_period)"}
     out["stop_period"] = {"units": "1", "long_name": "minimal period (revolutions) of the cycle the run converged to "

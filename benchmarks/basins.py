@@ -1,0 +1,71 @@
+"""A 100 x 100 basin map timed (issue 29): the bistable speed of the 16 mm experiment rig.
+
+    python benchmarks/basins.py                 # 100 x 100, writes docs/img/basins_125rpm.png
+    python benchmarks/basins.py --n 20          # a smaller map (a smoke run)
+
+The map: ``camdyn.basins`` on the ``reference-experiment`` preset (line contact 16 mm, damping D,
+Coulomb friction, the experiment's k_s) at 125 rev/min, between the flight orbit's fold (116.2
+rev/min) and the contact orbit's grazing (130 rev/min), where both coexist (docs/reproduction.md,
+Figs. 7-8); starts alpha in alpha* + [0, 0.5] rad, alpha_dot in [-3, 3] rad/s at t = 0; each run
+at most 200 revolutions, stopped once periodic (camdyn.StopWhenPeriodic() defaults), default
+tolerances (rtol 1e-8, atol 1e-12); on ``process_pool(workers)``, streamed to a file in a
+temporary folder; the attractors confirmed by shooting (included in the time).  Prints the
+wall time, the cores and the load average before and after, the attractor table and the
+revolutions integrated; the figure goes to docs/img/.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import camdyn
+from camdyn.model.presets import load_rig
+from camdyn.sweep import process_pool
+from camdyn.sweep.attractors import attractor_table
+
+SPEED_RPM = 125.0
+SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
+IMG = Path(__file__).resolve().parent.parent / "docs" / "img" / "basins_125rpm.png"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=100, help="starts per axis (default 100)")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--no-figure", action="store_true")
+    parser.add_argument("--keep", metavar="FILE.nc", help="write the map to FILE.nc (default: a temporary file)")
+    args = parser.parse_args()
+    warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
+    rig = load_rig("reference-experiment")
+    a_star = camdyn.static_equilibrium(rig).alpha
+    camdyn.simulate(rig, SCENE, speed_rpm=SPEED_RPM, revolutions=1)   # the compiled loop loaded before timing
+    alpha = a_star + np.linspace(0.0, 0.5, args.n)
+    alpha_dot = np.linspace(-3.0, 3.0, args.n)
+    load0 = os.getloadavg()
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp, process_pool(args.workers) as pool:
+        ds = camdyn.basins(rig, SCENE, alpha=alpha, alpha_dot=alpha_dot, speed_rpm=SPEED_RPM, executor=pool,
+                           out=args.keep or Path(tmp) / "basins.nc", overwrite=True, progress=False)
+    wall = time.perf_counter() - t0
+    load1 = os.getloadavg()
+    print(f"{args.n} x {args.n} basin map at {SPEED_RPM:g} rev/min: {wall:.1f} s wall on {args.workers} workers "
+          f"({os.cpu_count()} cores; load average {load0[0]:.2f} before, {load1[0]:.2f} after)")
+    print(f"revolutions integrated: {ds.attrs['revolutions_run_total']:.0f} of {ds.attrs['revolutions_requested_total']:.0f};"
+          f" {wall / ds.attrs['points'] * 1e3:.1f} ms per point")
+    for row in attractor_table(ds):
+        print(row)
+    if not args.no_figure:
+        from camdyn.io import plots
+        fig = plots.basin_map(ds, title=f"basins at {SPEED_RPM:g} rev/min, reference-experiment, damping D")
+        fig.savefig(IMG)
+        print(f"wrote {IMG}")
+
+
+if __name__ == "__main__":
+    main()

@@ -30,60 +30,47 @@ from . import symbols as S
 MAX_ORDER = 4
 
 
-class SupportFunction(sp.Function):
-    """h^(n)(phi), the n-th derivative of the cam's support function (n a non-negative integer).
-
-    ``SupportFunction(n, phi).diff(phi)`` is ``SupportFunction(n + 1, phi) * dphi``: the chain
-    rule runs through any argument, so the vector loop's time derivatives and the Jacobians
-    need nothing special.  Printed in generated code as a call of the scene's evaluator.
-    """
+class _Derivatives(sp.Function):
+    """f^(n)(phi), the n-th derivative (n an integer, 0 <= n <= ``max_order``) of a function of the
+    cam's profile, evaluated by the scene's evaluator: unevaluated in SymPy, where d/dphi raises n,
+    so the chain rule runs through any argument (the loop's time derivatives, the Jacobians)."""
 
     nargs = 2
     is_real = True
+    max_order = 0
 
     @classmethod
     def eval(cls, n, phi):
-        if not (n.is_Integer and n >= 0):
-            raise ValueError(f"SupportFunction: the derivative order must be an integer >= 0, got {n}")
-        if n > MAX_ORDER:
-            raise ValueError(f"SupportFunction: a kernel needs h^({n}); the evaluators give up to h^({MAX_ORDER})")
+        if not (n.is_Integer and 0 <= n <= cls.max_order):
+            raise ValueError(f"{cls.__name__}: a kernel needs the derivative of order {n}; the evaluators give "
+                             f"the orders 0 to {cls.max_order}")
         return None  # unevaluated: the profile is data of the rig
 
     def fdiff(self, argindex=2):
         if argindex != 2:
             raise sp.ArgumentIndexError(self, argindex)
         n, phi = self.args
-        return SupportFunction(n + 1, phi)
+        return type(self)(n + 1, phi)
 
     @property
     def order(self) -> int:
         return int(self.args[0])
 
 
-class JunctionFunction(sp.Function):
+class SupportFunction(_Derivatives):
+    """h^(n)(phi), the n-th derivative of the cam's support function.  Printed in generated code
+    as a call of the scene's evaluator ``profile``."""
+
+    max_order = MAX_ORDER
+
+
+class JunctionFunction(_Derivatives):
     """j^(n)(phi): the junction indicator of a cam of circular arcs (its n-th derivative), zero
     at each junction of two arcs, where the curvature jumps, and of alternating sign between
     them: (-1)^k sin(pi (phi - a_k) / (a_(k+1) - a_k)) on arc k (an even number of arcs).
     Its zeros are the automaton's surface ``junction`` (derive.automaton)."""
 
-    nargs = 2
-    is_real = True
-
-    @classmethod
-    def eval(cls, n, phi):
-        if not (n.is_Integer and 0 <= n <= 2):
-            raise ValueError(f"JunctionFunction: the derivative order must be 0, 1 or 2, got {n}")
-        return None
-
-    def fdiff(self, argindex=2):
-        if argindex != 2:
-            raise sp.ArgumentIndexError(self, argindex)
-        n, phi = self.args
-        return JunctionFunction(n + 1, phi)
-
-    @property
-    def order(self) -> int:
-        return int(self.args[0])
+    max_order = 2
 
 
 def junction(phi: sp.Expr) -> sp.Expr:

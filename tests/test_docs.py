@@ -27,6 +27,7 @@ MODULES = [
     "model.motion_laws",
     "model.followers",
     "model.synthesis",
+    "model.cam_files",
     "model.cam_tables",
     "runs.simulation",
     "runs.request",

@@ -277,3 +277,48 @@ def test_the_mechanism_is_drawn_with_the_follower_s_face_on_the_cam():
     assert np.min(np.hypot(*(outline - contact).T)) < 0.15
     (x0, y0), (x1, y1) = face
     assert abs((x1 - x0) * (contact[1] - y0) - (y1 - y0) * (contact[0] - x0)) / math.hypot(x1 - x0, y1 - y0) < 1e-9
+
+
+# --- a rig file that names its cam -------------------------------------------------------------
+def _rig_file(tmp_path, cam: str):
+    path = tmp_path / "rig.toml"
+    camdyn.example_rig().to_toml(path)
+    path.write_text(path.read_text() + "\n[cam]\n" + cam)
+    return path
+
+
+def test_a_rig_file_names_its_cam_by_its_law_and_writes_it_back_exactly(tmp_path):
+    path = _rig_file(tmp_path, 'law = "cycloidal"\nlift_rad = 0.05\nangles_deg = [100, 80, 100, 80]\n'
+                               "base_radius_mm = 25.0\ntheta0_deg = 140\n")
+    rig = camdyn.Rig.from_toml(path)
+    expected = cycloidal_cam_rig()   # the same law and follower, in Python (theta0 there: the rig's)
+    assert rig.profile_data == expected.profile_data
+    assert rig.theta0 == pytest.approx(140 * math.pi / 180, abs=1e-15)
+    rig.to_toml(tmp_path / "back.toml")
+    again = camdyn.Rig.from_toml(tmp_path / "back.toml")
+    assert again == rig and again.profile_data == rig.profile_data    # [cam] kind + block, floats by repr
+
+
+def test_a_rig_file_with_a_cam_runs_from_the_command_line(tmp_path, capsys):
+    from camdyn.cli import main
+
+    path = _rig_file(tmp_path, "arcs = { r_b_mm = 22, r_n_mm = 8, d_mm = 18, R_mm = 60 }\n")
+    assert main(["simulate", "--rig", str(path), "--contact", "point", "--speed-rpm", "200",
+                 "--revolutions", "1"]) == 0
+    assert "_arcs: SUCCESS" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("cam, says", [
+    ('law = "cycloidal"\nlift_rad = 0.05\nangles_deg = [100, 80, 100, 70]\nbase_radius_mm = 25.0\n', "2 pi"),
+    ('law = "cycloidal"\ntable = "lifts.csv"\n', "exactly one of"),
+    ('arcs = { r_b_mm = 22, r_n_mm = 8, d_mm = 18, R_mm = 60, colour = 1 }\n', "colour"),
+    ('table = "missing.csv"\nbase_radius_mm = 25\n', "missing.csv"),
+    ('kind = "spline"\nblock = [1.0, 2.0]\n', "block"),
+])
+def test_a_bad_cam_table_in_a_rig_file_names_the_file_and_the_problem(tmp_path, cam, says):
+    path = _rig_file(tmp_path, cam)
+    from camdyn.errors import RigFileError
+
+    with pytest.raises(RigFileError) as info:
+        camdyn.Rig.from_toml(path)
+    assert str(path) in str(info.value) and says in str(info.value)

@@ -67,7 +67,18 @@ def _scene(args, motion: str = "constant"):
                  damping_sign=getattr(args, "damping_sign", "dissipative"),
                  damping_switch=getattr(args, "damping_switch", "episode"),
                  follower=getattr(args, "follower", "dynamic"),
-                 profile="eccentric" if getattr(args, "cam", None) is None else "spline")
+                 profile=_profile(args))
+
+
+def _profile(args) -> str:
+    """The scene's cam family: a spline for --cam, else the --rig file's [cam] (camdyn.model.cam_files)."""
+    if getattr(args, "cam", None) is not None:
+        return "spline"
+    rig = getattr(args, "rig", "example")
+    if not str(rig).endswith(".toml"):
+        return "eccentric"
+    from ..model.cam_files import file_family
+    return file_family(rig)
 
 
 def _options():

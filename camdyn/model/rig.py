@@ -272,7 +272,8 @@ class Rig:
 
     @classmethod
     def from_toml(cls, path: str | os.PathLike[str]) -> Rig:
-        """Read a rig file: top-level ``name`` and ``description``, SI numbers in ``[parameters]``."""
+        """Read a rig file: top-level ``name`` and ``description``, SI numbers in ``[parameters]``,
+        and, for a cam that is not the paper's circle, a ``[cam]`` table (:mod:`camdyn.model.cam_files`)."""
         source = os.fspath(path)
         try:
             with open(path, "rb") as f:
@@ -284,18 +285,23 @@ class Rig:
         for key in doc:
             if key in _BY_NAME:
                 raise RigFileError(source, f"parameter {key!r} must be inside the [parameters] table", key=key)
-        _check_names(doc, source, (*_TEXT_FIELDS, "parameters"), what="top-level key")
+        _check_names(doc, source, (*_TEXT_FIELDS, "parameters", "cam"), what="top-level key")
         params = doc.get("parameters")
         if not isinstance(params, dict):
             problem = "missing [parameters] table" if params is None else "'parameters' must be a table"
             raise RigFileError(source, problem, key="parameters")
         _check_names(params, source, _BY_NAME)
         values = {**params, **{k: doc[k] for k in _TEXT_FIELDS if k in doc}}
-        return cls.from_dict({**values, "origin": f"file {Path(path).resolve()}"}, source=source)
+        rig = cls.from_dict({**values, "origin": f"file {Path(path).resolve()}"}, source=source)
+        if "cam" not in doc:
+            return rig
+        from .cam_files import rig_with_cam
+        return rig_with_cam(rig, doc["cam"], source, Path(path).parent)
 
     def to_toml(self, path: str | os.PathLike[str]) -> None:
         """Write the rig file read by :meth:`from_toml` (floats written with ``repr``, so the
-        round trip is exact); parameters not given are left out."""
+        round trip is exact); parameters not given are left out; a cam profile as its data
+        (``[cam]`` with ``kind`` and ``block``)."""
         lines = [
             "# camdyn rig file: SI units (see camdyn.model.rig.PARAMETERS)",
             f"name = {_toml_string(self.name)}",
@@ -307,6 +313,9 @@ class Rig:
             value = getattr(self, p.name)
             if value is not None:
                 lines.append(p.toml_line(value))
+        if self.profile is not None:
+            from .cam_files import cam_lines
+            lines += cam_lines(self.profile)
         Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 

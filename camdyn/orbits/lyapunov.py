@@ -33,6 +33,8 @@ import numpy as np
 
 from ..model.cam import CamMotion, periodic_cam
 from ..engine import SolverOptions
+from ..engine.domain import Domain
+from ..engine.driver import integrate
 from ..errors import ParameterError
 from .._checks import integer
 from ..model.model import Model
@@ -41,7 +43,8 @@ from ..model.scene import Scene
 from .section_map import DEFAULT_OPTIONS, MapFailure, warm_up
 from .tangent import TangentSettings, tangent
 
-__all__ = ["lyapunov_exponents", "spectrum", "LyapunovExponents", "LyapunovSettings"]
+__all__ = ["lyapunov_exponents", "spectrum", "largest_by_differences", "LyapunovExponents", "LyapunovSettings",
+           "DifferenceEstimate"]
 
 
 @dataclass(frozen=True)
@@ -138,3 +141,76 @@ def lyapunov_exponents(rig: Rig, scene: Scene, cam: CamMotion | None = None, *, 
     if not isinstance(settings, LyapunovSettings):
         raise ParameterError("settings", settings, "a camdyn.orbits.lyapunov.LyapunovSettings")
     return spectrum(Model(rig, scene, periodic_cam(cam, speed_rpm)), settings, y0, options, backend)
+
+
+# --- the largest exponent without a Jacobian: two neighbouring runs ----------------------------
+#: the neighbour's distance, in the state scaled to radians, (alpha, alpha_dot / Omega_c): far
+#: above the runs' own error at DEFAULT_OPTIONS (rtol 1e-10: ~1e-11 rad), far below the motion's
+#: size (1e-2 rad); the estimate is repeated at 10 times it, and the two must agree
+DELTA = 1e-7
+
+
+@dataclass(frozen=True)
+class DifferenceEstimate:
+    """lambda_1 (1/s) by two neighbouring runs (:func:`largest_by_differences`) at the distance
+    ``delta`` and at 10 ``delta``: ``largest`` (the first), its batch means' ``standard_error``,
+    ``at_ten_delta`` and ``delta_difference`` = largest - at_ten_delta (what the finite distance
+    changes: the estimate's error from the method, beside the statistical one)."""
+
+    largest: float
+    standard_error: float
+    at_ten_delta: float
+    revolutions: int
+    transient: int
+    period: float
+    delta: float
+
+    @property
+    def delta_difference(self) -> float:
+        return self.largest - self.at_ten_delta
+
+
+def largest_by_differences(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=None,
+                           options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled",
+                           delta: float = DELTA) -> DifferenceEstimate:
+    """lambda_1 of ``model``'s run by Benettin's two-trajectory method: every cam period a
+    neighbour at the distance ``delta`` (scaled state (alpha, alpha_dot / Omega_c), rad) runs
+    beside the run, the log of its distance's growth is summed, and it is put back at ``delta``
+    along its new direction.  No Jacobian: for the damping laws whose tangent dynamics cannot
+    pass first contact (C, E: c ~ |psi_i|^(1/4), an unbounded d(alpha_ddot)/d(alpha) at psi_i = 0),
+    and as a check of :func:`spectrum` where both work.  Two neighbours run, at ``delta`` and at
+    10 ``delta``, so that the distance's effect on the estimate is measured, not assumed."""
+    T = model.period
+    if not (math.isfinite(T) and T > 0):
+        raise ParameterError("cam", None, "a periodic cam motion (a nonzero speed, or a period)",
+                             problem=f"{model.cam!r} has no period")
+    scale = np.array([1.0, 2 * math.pi / T])            # alpha_dot / Omega_c is in rad
+    x, mode = _start(model, settings.transient, y0, options, backend)
+    domain = Domain(model)
+    neighbours = [np.array([delta, 0.0]), np.array([10 * delta, 0.0])]
+    logs = np.empty((settings.revolutions, 2))
+    for k in range(settings.revolutions):
+        t0 = ((settings.transient + k) % 2) * T        # the kernels' period is 2 T
+        x_next, mode_next = _revolution(model, (t0, t0 + T), x, mode, options, backend)
+        for j, (d, size) in enumerate(zip(neighbours, (delta, 10 * delta))):
+            start = x + d * scale
+            m = mode if mode is not None and domain.surface_crossed(mode, t0, *map(float, start)) < 0 else None
+            apart = (_revolution(model, (t0, t0 + T), start, m, options, backend)[0] - x_next) / scale
+            grown = float(np.hypot(*apart))
+            logs[k, j] = math.log(grown / size)
+            neighbours[j] = apart * (size / grown)
+        x, mode = x_next, mode_next
+    time = settings.revolutions * T
+    estimates = logs.sum(axis=0) / time
+    batch = logs[:, 0].reshape(settings.batches, -1).sum(axis=1) / (time / settings.batches)
+    return DifferenceEstimate(float(estimates[0]), float(batch.std(ddof=1) / math.sqrt(settings.batches)),
+                              float(estimates[1]), settings.revolutions, settings.transient, T, delta)
+
+
+def _revolution(model: Model, span, x, mode, options, backend) -> tuple[np.ndarray, int]:
+    """The state and mode one cam period on (raises MapFailure when the run fails)."""
+    tr = integrate(model, span, np.asarray(x, dtype=float), np.array([span[1]]), options, mode=mode, backend=backend)
+    if not tr.outcome.ok or tr.t.size != 1:
+        raise MapFailure(f"the run from {tuple(map(float, x))} over a period failed: {tr.outcome.message}",
+                         tr.outcome)
+    return tr.y[:2, -1].copy(), int(tr.end_mode)

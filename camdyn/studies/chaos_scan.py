@@ -129,7 +129,7 @@ def judged(r: dict) -> dict:
     """Each stage-2 run's class as the verdicts read it: by the largest Lyapunov exponent where
     there is one (chaotic: aperiodic; regular: periodic, its periodicity class if that is
     periodic, else "P (λ1 < 0)"; undecided: neither), by the periodicity class where there is
-    none (damping C and E: no tangent dynamics)."""
+    none (an older result without one: damping C and E had no exponent before the two-run estimate)."""
     out = {}
     for key, c in r["classes"].items():
         ly = r.get("lyapunov", {}).get(key, {}).get("chaos", "n/a")
@@ -272,7 +272,7 @@ def _stage2_lines(st2: list[dict], speeds) -> list[str]:
         if r.get("lyapunov"):
             lines.append("")
             lines.append("The same runs judged by the largest Lyapunov exponent (as in fig4-5: *ch* chaotic, *reg* "
-                         "regular, *?* undecided at 3 standard errors, *n/a* no tangent dynamics):")
+                         "regular, *?* undecided at 3 standard errors; for C and E λ1 by two neighbouring runs):")
             lines.append("")
             ly_rows = [[f"model {d}"] + [_LY_SHORT.get(r["lyapunov"][f"{d}{sp:g}"]["chaos"], "?") for sp in speeds]
                        + [fmt(r["onsets_lyapunov"][d]) if r["onsets_lyapunov"][d] else "none"] for d in MODELS]

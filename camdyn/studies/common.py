@@ -354,23 +354,30 @@ CONFIDENCE_SE = 3.0
 def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revolutions: int, batches: int) -> dict:
     """The largest Lyapunov exponent (camdyn.orbits.lyapunov) of the impacting rig's run from the
     static equilibrium, over ``revolutions`` after ``transient`` (the window of
-    :func:`impact_run`'s class), and the verdict it gives: *chaotic* where it is positive by CONFIDENCE_SE standard errors,
-    *regular* where it is negative by as many, else *undecided*; *n/a* where the tangent
-    dynamics cannot be integrated (damping C and E: their impact law's Jacobian is unbounded at
-    first contact, camdyn.orbits.tangent), with the reason."""
-    from camdyn.orbits.lyapunov import LyapunovSettings, lyapunov_exponents
+    :func:`impact_run`'s class), and the verdict it gives: *chaotic* where it is positive by
+    CONFIDENCE_SE standard errors, *regular* where it is negative by as many, else *undecided*.
+    From the tangent dynamics where they can be integrated (``method`` "variational"); where they
+    cannot (damping C and E: their impact law's Jacobian is unbounded at first contact,
+    camdyn.orbits.tangent), from two neighbouring runs (``method`` "differences",
+    camdyn.orbits.lyapunov.largest_by_differences), whose distance's effect on the exponent must
+    then be below one standard error, else the verdict is *undecided*."""
+    from camdyn.model.model import Model
+    from camdyn.orbits.lyapunov import LyapunovSettings, largest_by_differences, lyapunov_exponents
     from camdyn.orbits.tangent import TangentFailure
 
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
     settings = LyapunovSettings(revolutions=revolutions, transient=transient, batches=batches)
     try:
         ly = lyapunov_exponents(rig, scene, speed_rpm=speed_rpm, settings=settings)
-    except TangentFailure as failure:
-        return {"lyapunov": None, "lyapunov_se": None, "chaos": "n/a", "chaos_reason": str(failure)}
-    lam, se = ly.largest, float(ly.standard_error[0])
-    verdict = ("chaotic" if lam > CONFIDENCE_SE * se else "regular" if lam < -CONFIDENCE_SE * se
-               else "undecided")
-    return {"lyapunov": lam, "lyapunov_se": se, "lyapunov_per_rev": lam * ly.period, "chaos": verdict}
+        lam, se, period, method, settled = ly.largest, float(ly.standard_error[0]), ly.period, "variational", True
+    except TangentFailure:
+        d = largest_by_differences(Model(rig, scene, camdyn.ConstantSpeed(speed_rpm)), settings)
+        lam, se, period, method = d.largest, d.standard_error, d.period, "differences"
+        settled = abs(d.delta_difference) <= se
+    verdict = ("undecided" if not settled else "chaotic" if lam > CONFIDENCE_SE * se
+               else "regular" if lam < -CONFIDENCE_SE * se else "undecided")
+    return {"lyapunov": lam, "lyapunov_se": se, "lyapunov_per_rev": lam * period, "chaos": verdict,
+            "lyapunov_method": method}
 
 
 def continuation_start(end_state, from_rpm: float, to_rpm: float) -> tuple[list[float], float]:

@@ -32,9 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.cam import CamMotion, periodic_cam
-from ..engine import SolverOptions
-from ..engine.domain import Domain
-from ..engine.driver import integrate
+from ..engine import Domain, SolverOptions, integrate
 from ..errors import ParameterError
 from .._checks import integer
 from ..model.model import Model
@@ -177,7 +175,7 @@ def largest_by_differences(model: Model, settings: LyapunovSettings = LyapunovSe
     neighbour at the distance ``delta`` (scaled state (alpha, alpha_dot / Omega_c), rad) runs
     beside the run, the log of its distance's growth is summed, and it is put back at ``delta``
     along its new direction.  No Jacobian: for the damping laws whose tangent dynamics cannot
-    pass first contact (C, E: c ~ |psi_i|^(1/4), an unbounded d(alpha_ddot)/d(alpha) at psi_i = 0),
+    pass first contact (C, E: ``c ~ abs(psi_i)^(1/4)``, an unbounded d(alpha_ddot)/d(alpha) at psi_i = 0),
     and as a check of :func:`spectrum` where both work.  Two neighbours run, at ``delta`` and at
     10 ``delta``, so that the distance's effect on the estimate is measured, not assumed."""
     T = model.period

@@ -60,15 +60,9 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0   # SciPy's step-size controller
 
 
 def cycloidal_cam_rig():
-    """The example rig's follower on a cycloidal rise-dwell-return cam (0.05 rad of lift,
-    100/80/100/80 degrees, base circle 25 mm), at rest on its first dwell (140 degrees)."""
-    from camdyn.model.followers import follower_of_rig, rig_on_cam
-    from camdyn.model.motion_laws import rise_dwell_return
-    from camdyn.model.synthesis import cam_from_law
-
-    rig, deg = camdyn.example_rig(), math.pi / 180
-    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
-    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=140 * deg)
+    """The cycloidal cam of camdyn's presets, at rest on its first dwell (140 degrees)."""
+    from camdyn.model.presets import cam_example_rig
+    return cam_example_rig(theta0=140 * math.pi / 180)
 
 
 #: the floor run on the cam: 0.8 x its jump speed (539.8 rev/min), in permanent contact

@@ -14,6 +14,8 @@ import functools
 import sys
 import warnings
 
+from pathlib import Path
+
 import numpy as np
 
 import camdyn
@@ -22,14 +24,9 @@ from camdyn.engine import SolverOptions
 from camdyn.orbits.derivatives import finite_differences
 from camdyn.orbits.tangent import variational
 
-BASE = camdyn.example_rig()
-RIGS = {
-    "soft spring": (BASE.replace(k_s=500.0), camdyn.Scene(damping="B", friction="coulomb")),
-    "soft, light damping": (BASE.replace(k_s=500.0, zeta_D=1e-3), camdyn.Scene(damping="D", friction="none")),
-    "small preload": (BASE.replace(L_us=0.1175), camdyn.Scene(damping="B", friction="coulomb")),
-    "large eccentricity": (BASE.replace(e=0.2 * BASE.r_c), camdyn.Scene(damping="B", friction="coulomb")),
-    "point contact": (BASE, camdyn.Scene(contact="point", damping="B", friction="coulomb")),
-}
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from registry import SMALL_MARGIN as RIGS  # noqa: E402  (the rigs of tests/test_derivatives.py, defined once)
+
 TIGHT = SolverOptions(rtol=1e-12, atol=1e-15)
 
 

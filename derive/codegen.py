@@ -37,7 +37,7 @@ from .profile_code import PROFILE_BLOCK, evaluator_source
 from .automaton import Automaton
 from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
-from camdyn.vocabulary import CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSITION, SceneSpec
+from camdyn.vocabulary import ECCENTRIC, CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSITION, SceneSpec
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
@@ -615,7 +615,7 @@ def _profile_parts(L: "_Layout") -> tuple[list[str], list[str], list[str]]:
     """A scene on a cam other than the circle: the imports, data and code its modules add for
     the profile evaluator (derive.profile_code); nothing for the paper's circle."""
     family = L.mod.spec.profile
-    if family == "eccentric":
+    if family == ECCENTRIC:
         return [], [], []
     data = ["# --- the cam's profile (derive.profile_code): its data follows PARAMS in p ---",
             f"PROFILE = {family!r}", f"PROFILE_OFFSET = {len(L.params)}"]
@@ -626,7 +626,7 @@ def _scene_source(L: _Layout) -> str:
     """The text of a scene's module (``scene_<slug>``)."""
     spec, A = L.mod.spec, L.mod.automaton
     companion = variational_name(spec) if L.mod.variational else None
-    pack, inputs = _pack_code(L.params, L.constants, spec.profile != "eccentric")
+    pack, inputs = _pack_code(L.params, L.constants, spec.profile != ECCENTRIC)
     extra_imports, extra_data, extra_code = _profile_parts(L)
     data = ["SCENE = " + repr(spec.derived_options()), f"SLUG = {spec.slug!r}",
             "#: the companion module of the variational kernels, beside this one (None: the scene has none)",

@@ -27,7 +27,7 @@ B = follower_frame(alpha)
 SLIDING_VELOCITY_FORMS = vocabulary.SLIDING_VELOCITY_FORMS
 
 
-ECCENTRIC = "eccentric"  # the paper's cam (vocabulary.PROFILES[0])
+ECCENTRIC = vocabulary.ECCENTRIC  # the paper's cam
 
 
 @lru_cache(maxsize=None)

@@ -40,7 +40,7 @@ from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
 from .graph import Definition, quantity
-from camdyn.vocabulary import CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError, SceneSpec
+from camdyn.vocabulary import ECCENTRIC, CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError, SceneSpec
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
 
@@ -137,7 +137,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
     contact angle (Eq. 29) and the spring's potentials."""
     M = S.to_plain(equilibrium.static_moment(spec.contact, spec.profile))
     psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap(spec.profile))
-    radius = S.r_c if spec.profile == "eccentric" else S.to_plain(
+    radius = S.r_c if spec.profile == ECCENTRIC else S.to_plain(
         equilibrium.at_rest(geometry.curvature_radius()))
     static = [
         Function("static_moment", ("alpha", "p"), (), ("M", "dM_dalpha", "psi_i", "psi_j", "k_lambda"),
@@ -149,7 +149,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
                  _single(fields.spring_potential(), S.to_plain(energy.spring_potential_printed())),
                  "Spring potential of Eq. 10's moment, and (k_s/2) L^2 of Eq. 33.", "tuple"),
     ]
-    if spec.profile != "eccentric":  # no closed form of the rigid contact angle on another cam:
+    if spec.profile != ECCENTRIC:  # no closed form of the rigid contact angle on another cam:
         # the runtime solves it (camdyn.model.followers) and reads the spring's moment here
         return static + [Function("spring_moment", ("alpha", "p"), (), ("spring_moment",),
                                   _single(laws.spring_force(S.alpha_s) * S.d_x),

@@ -35,3 +35,15 @@ SCENES = sorted(generated.SCENES)
 METHODS = list(_METHODS)
 #: every backend of camdyn.simulate: the hard cases run on each (issue 5)
 BACKENDS = list(_BACKENDS)
+
+#: rigs with a small contact margin (issue 25), (rig, scene): a soft spring with impact damping B; a
+#: soft spring, lightly damped D, no friction; a small preload (L_us 2 % shorter: the spring's
+#: compression at the 0-state nearly halved); a large eccentricity (e = 0.2 r_c); the example rig with
+#: a point (Hertz) contact.  tests/test_derivatives.py and benchmarks/small_margin_multipliers.py.
+SMALL_MARGIN = {
+    "soft spring": (RIG.replace(k_s=500.0), camdyn.Scene(damping="B", friction="coulomb")),
+    "soft, light damping": (RIG.replace(k_s=500.0, zeta_D=1e-3), camdyn.Scene(damping="D", friction="none")),
+    "small preload": (RIG.replace(L_us=0.1175), camdyn.Scene(damping="B", friction="coulomb")),
+    "large eccentricity": (RIG.replace(e=0.2 * RIG.r_c), camdyn.Scene(damping="B", friction="coulomb")),
+    "point contact": (RIG, camdyn.Scene(contact="point", damping="B", friction="coulomb")),
+}

@@ -28,6 +28,7 @@ from camdyn.engine.config import SolverOptions
 from camdyn.orbits.shooting import OrbitOutcome
 from camdyn.orbits.section_map import DEFAULT_OPTIONS, MapDerivative, MapFailure, MapValue
 from camdyn.orbits.tangent import variational
+from registry import SMALL_MARGIN
 
 RTOL = DEFAULT_OPTIONS.rtol
 
@@ -195,17 +196,6 @@ def test_a_step_outside_the_start_modes_domain_is_shrunk_without_a_run():
 
 
 # ------------------------------------------------------------------ rigs with a small contact margin
-BASE = camdyn.example_rig()
-#: (rig, scene): a soft spring with impact damping B; a soft spring, lightly damped D, no friction;
-#: a small preload (L_us 2 % shorter: the spring's compression at the 0-state nearly halved); a large
-#: eccentricity (e = 0.2 r_c); the example rig with a point (Hertz) contact
-SMALL_MARGIN = {
-    "soft spring": (BASE.replace(k_s=500.0), camdyn.Scene(damping="B", friction="coulomb")),
-    "soft, light damping": (BASE.replace(k_s=500.0, zeta_D=1e-3), camdyn.Scene(damping="D", friction="none")),
-    "small preload": (BASE.replace(L_us=0.1175), camdyn.Scene(damping="B", friction="coulomb")),
-    "large eccentricity": (BASE.replace(e=0.2 * BASE.r_c), camdyn.Scene(damping="B", friction="coulomb")),
-    "point contact": (BASE, camdyn.Scene(contact="point", damping="B", friction="coulomb")),
-}
 TIGHT = SolverOptions(rtol=1e-12, atol=1e-15)
 #: the multipliers of a resolved derivative against the tight reference: the resolved difference's
 #: tolerance rtol^(1/2) = 1e-5 (scaled) bounds the Jacobian's error, and the multipliers of a 2 x 2
@@ -247,7 +237,7 @@ def test_an_orbit_says_which_provider_gave_its_multipliers():
     orbit = camdyn.periodic_orbit(rig, scene, speed_rpm=0.9 * contact_loss_speed(rig))
     assert orbit.jacobian_provider == "variational" and np.all(np.isnan(orbit.difference_steps))
     assert orbit.jacobian_note.startswith("finite differences unresolved")
-    impacting = camdyn.periodic_orbit(BASE, camdyn.Scene(damping="D", friction="coulomb"), speed_rpm=1500.0)
+    impacting = camdyn.periodic_orbit(camdyn.example_rig(), camdyn.Scene(damping="D", friction="coulomb"), speed_rpm=1500.0)
     assert impacting.jacobian_provider == "finite_differences" and np.all(impacting.difference_steps > 0)
     assert impacting.jacobian_note == ""
 

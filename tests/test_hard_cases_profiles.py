@@ -12,10 +12,9 @@ import pytest
 
 import camdyn
 from camdyn.analysis.statics import contact_loss_speed, static_equilibrium
-from camdyn.model.followers import follower_of_rig, rig_on_cam
-from camdyn.model.motion_laws import rise_dwell_return
+from camdyn.model.followers import rig_on_cam
+from camdyn.model.presets import cam_example_rig
 from camdyn.model.profiles import ArcProfile
-from camdyn.model.synthesis import cam_from_law
 from registry import METHODS
 
 DEG = math.pi / 180
@@ -32,12 +31,9 @@ def _quiet():
 @pytest.fixture(scope="module")
 def cam_rig():
     """The example rig's follower on a cycloidal rise-dwell-return cam (0.05 rad of lift, rise and
-    return over 100 degrees, dwells of 80, base circle 25 mm), at rest on the first dwell (140 deg):
-    a start with no kinematic jolt."""
-    rig = camdyn.example_rig()
-    law = rise_dwell_return(0.05, (100 * DEG, 80 * DEG, 100 * DEG, 80 * DEG), law="cycloidal")
-    cam = cam_from_law(law, follower_of_rig(rig), r_b=0.025)
-    return rig_on_cam(rig, cam, theta0=140 * DEG)
+    return over 100 degrees, dwells of 80, base circle 25 mm: camdyn.model.presets.cam_example_rig),
+    at rest on the first dwell (140 deg): a start with no kinematic jolt."""
+    return cam_example_rig(theta0=140 * DEG)
 
 
 @pytest.fixture(scope="module")

@@ -207,16 +207,9 @@ def test_the_jump_speed_on_the_circle_as_arcs_is_the_paper_s_inverse_kinematics(
 
 
 def cycloidal_cam_rig():
-    """The example rig on a cycloidal rise-dwell-return cam (0.05 rad of follower lift, rise and
-    return over 100 degrees, dwells of 80), base circle 25 mm, its pivot where it is."""
-    from camdyn.model.followers import follower_of_rig, rig_on_cam
-    from camdyn.model.motion_laws import rise_dwell_return
-    from camdyn.model.synthesis import cam_from_law
-
-    rig = camdyn.example_rig()
-    deg = math.pi / 180
-    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
-    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025))
+    """The example rig on a cycloidal rise-dwell-return cam (camdyn.model.presets.cam_example_rig)."""
+    from camdyn.model.presets import cam_example_rig
+    return cam_example_rig()
 
 
 def test_a_cycloidal_cam_grazes_just_below_its_inverse_kinematics_jump_speed():

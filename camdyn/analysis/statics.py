@@ -16,13 +16,14 @@ from ..model.model import ANGLE_LIMIT, Equilibrium, Model, solve_equilibrium, st
 from ..runs.result import Result
 from ..model.rig import Rig
 from ..model.scene import Scene
+from ..vocabulary import ECCENTRIC
 
 
 def _static_scene(contact: str, rig: Rig | None = None) -> Scene:
     """The undamped, frictionless scene of a contact law on the rig's cam family."""
     if contact not in ("line", "point"):
         raise ParameterError("contact", contact, "'line' or 'point'")
-    profile = "eccentric" if rig is None or rig.profile_data is None else rig.profile_data[0]
+    profile = ECCENTRIC if rig is None or rig.profile_data is None else rig.profile_data[0]
     return Scene(contact=contact, damping="none", friction="none", profile=profile)
 
 

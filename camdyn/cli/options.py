@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from .common import UsageError, _plot_modules
+from ..vocabulary import ECCENTRIC
 
 
 # --------------------------------------------------------------------------- rig, cam, scene
@@ -76,7 +77,7 @@ def _profile(args) -> str:
         return "spline"
     rig = getattr(args, "rig", "example")
     if not str(rig).endswith(".toml"):
-        return "eccentric"
+        return ECCENTRIC
     from ..model.cam_files import file_family
     return file_family(rig)
 

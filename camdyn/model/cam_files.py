@@ -33,6 +33,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import CamdynError, RigFileError
+from ..vocabulary import ECCENTRIC
 
 #: the keys each form takes (``theta0_deg`` besides, for all but the block)
 FORMS = {"table": ("table", "base_radius_mm"), "law": ("law", "lift_rad", "angles_deg", "base_radius_mm"),
@@ -74,8 +75,8 @@ def file_family(path) -> str:
         with open(path, "rb") as f:
             cam = tomllib.load(f).get("cam")
     except (OSError, ValueError):
-        return "eccentric"
-    return family(cam) if isinstance(cam, Mapping) else "eccentric"
+        return ECCENTRIC
+    return family(cam) if isinstance(cam, Mapping) else ECCENTRIC
 
 
 def _form(cam: Mapping, source: str) -> str:

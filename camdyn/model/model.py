@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
 from ..vocabulary.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
-from ..vocabulary import JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
+from ..vocabulary import ECCENTRIC, JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
 from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
@@ -114,10 +114,10 @@ def _check_profile(rig: Rig, scene: Scene) -> None:
     """The scene's cam family must be the rig's: the paper's circle needs no profile, any other
     family the rig's ``profile`` of that family."""
     kind = None if rig.profile_data is None else rig.profile_data[0]
-    if scene.profile == "eccentric" and kind is not None:
+    if scene.profile == ECCENTRIC and kind is not None:
         raise SceneError(f"the rig's cam is a {kind!r} profile but the scene is the paper's eccentric circle: "
                          f"use Scene(..., profile={kind!r})")
-    if scene.profile != "eccentric" and kind != scene.profile:
+    if scene.profile != ECCENTRIC and kind != scene.profile:
         raise SceneError(f"the scene's cam is a {scene.profile!r} profile but the rig has "
                          f"{'none (the eccentric circle)' if kind is None else repr(kind)}: give the rig a "
                          f"profile of that family (Rig(..., profile=...), camdyn.model.profiles)")

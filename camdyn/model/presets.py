@@ -43,6 +43,22 @@ def example_rig() -> Rig:
     return load_rig("example")
 
 
+def cam_example_rig(theta0: float | None = None) -> Rig:
+    """The example rig's follower on a cycloidal rise-dwell-return cam: 0.05 rad of follower lift,
+    rise and return over 100 degrees, dwells of 80, base circle 25 mm, its pivot where the example
+    rig has it (docs/model-editing.md, "A new cam"); the 0-state at the cam angle ``theta0`` (rad,
+    default the example rig's).  Use it with ``Scene(profile="spline")``."""
+    import math
+
+    from .followers import follower_of_rig, rig_on_cam
+    from .motion_laws import rise_dwell_return
+    from .synthesis import cam_from_law
+
+    rig, deg = example_rig(), math.pi / 180
+    law = rise_dwell_return(0.05, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
+    return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=theta0)
+
+
 def preset_files() -> list[Path]:
     """The shipped rig files, as files on disk (the package's data folder)."""
     folder = Path(str(resources.files("camdyn.model.data")))

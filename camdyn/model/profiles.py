@@ -33,6 +33,7 @@ import numpy as np
 
 from .._checks import finite, integer
 from ..errors import ParameterError
+from ..vocabulary import ECCENTRIC
 
 __all__ = ["EccentricCircle", "SplineProfile", "ArcProfile", "check_convex", "CONVEXITY_SAMPLES",
            "JUNCTION_RTOL", "profile_from_block", "hermite_coefficients", "quintic_pieces", "locate"]
@@ -98,7 +99,7 @@ class EccentricCircle(_Profile):
 
     r_c: float
     e: float
-    kind = "eccentric"
+    kind = ECCENTRIC
 
     def __post_init__(self):
         r_c = finite("r_c", self.r_c, "a finite cam radius > 0, m")

@@ -16,7 +16,8 @@ DAMPING_SWITCHES = ("episode", "memoryless")            # Sec. 3.4, models D and
 FOLLOWERS = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
 #: the cam's shape: the paper's eccentric circle (Eq. 3-4), or a convex cam given by its support
 #: function h(phi) (docs/model-editing.md, "a new cam"): a periodic piecewise quintic, or circular arcs
-PROFILES = ("eccentric", "spline", "arcs")
+ECCENTRIC = "eccentric"
+PROFILES = (ECCENTRIC, "spline", "arcs")
 
 OPTIONS: dict[str, tuple[str, ...]] = {
     "contact": CONTACT_LAWS,
@@ -89,7 +90,7 @@ class SceneSpec:
     damping_sign: str = "dissipative"
     damping_switch: str = "episode"
     follower: str = "dynamic"
-    profile: str = "eccentric"
+    profile: str = ECCENTRIC
 
     def __post_init__(self):
         for f in fields(self):
@@ -158,7 +159,7 @@ def combination_problem(spec: SceneSpec) -> str:
         if spec.damping in ("B", "C"):
             return (f"model={spec.model!r} needs a constant damping coefficient: damping 'none', 'A', "
                     "or the viscous part of 'D'/'E'")
-    if spec.profile != "eccentric":
+    if spec.profile != ECCENTRIC:
         if spec.model != "nonlinear":
             return f"profile={spec.profile!r} needs model='nonlinear' (the linear models are the paper's, Section 8)"
         if spec.sliding_velocity != "kinematic":

@@ -105,7 +105,11 @@ def _phases(spec: SceneSpec) -> tuple[str | None, ...]:
 
 
 def _slips(spec: SceneSpec, stick: bool) -> tuple[str | None, ...]:
-    if spec.friction != "coulomb":
+    """Coulomb friction's discrete states: the sliding directions, and stuck (the non-linear model).
+    None for a translating follower: its face's friction acts across the ideal guide and does no
+    work on its coordinate (derive.translating), so its direction changes no field, only the
+    outputs, which take the sign of v_r itself."""
+    if spec.friction != "coulomb" or spec.follower == "translating":
         return (None,)
     return ("fwd", "bwd", "stick") if stick and spec.model == "nonlinear" else ("fwd", "bwd")
 
@@ -163,6 +167,7 @@ def build(spec: SceneSpec) -> Automaton:
     if spec.model != "nonlinear":  # sliding contact throughout; the friction sign fixed at the start
         surfaces = ("slip",) if coulomb else ()
         return Automaton(all_modes, surfaces, {}, _entering(spec), ())
+    coulomb = coulomb and spec.follower != "translating"  # (see _slips)
     surfaces = ("gap", "gap_rate") + (("slip", "slip_rate_fwd", "slip_rate_bwd") if coulomb else ())
     transitions = [Transition("free", "gap", -1, _entering(spec))]
     for mode in all_modes[1:]:

@@ -37,7 +37,8 @@ from .profile_code import PROFILE_BLOCK, evaluator_source
 from .automaton import Automaton
 from .fields import Kernel
 from .scenes import Case, Function, SceneModule, build
-from camdyn.vocabulary import ECCENTRIC, CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSITION, SceneSpec
+from camdyn.vocabulary import (ECCENTRIC, CONTINUATION_PARAMETERS, OUTPUTS, SURFACES, TRANSITION, SceneSpec, outputs_of,
+                               state_names)
 
 #: Canonical order of everything a kernel may read from the parameter vector p.
 PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVED_NAMES + S.CAM_NAMES
@@ -47,6 +48,8 @@ ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
         "s": "surface index: a position in SURFACES (SURFACE_<NAME> constants)",
         "t": "time (s)", "alpha": "follower angle alpha (rad, clockwise)",
         "alpha_dot": "follower angular velocity (rad/s)", "Theta": "cam angle (rad)",
+        "y": "the translating follower's face: its distance from the cam's centre E along the guide (m)",
+        "y_dot": "the translating follower's velocity along its guide (m/s)",
         "p": "parameter vector, laid out as PARAMS (SI units); build it with pack()",
         "cam": "(Theta, Theta_dot, Theta_ddot) of the user's cam motion at t (rad, rad/s, rad/s^2)",
         "out": "a float64 array the results are written into (length: the number of results)"}
@@ -56,11 +59,20 @@ RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
                 "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "V_s": "J", "V_s_printed": "J",
-                **{name: unit for name, (unit, _) in OUTPUTS.items()},
-                **{f"dalpha_ddot_d{n}": f"rad/s^2 per {UNITS[n]}" for n in CONTINUATION_PARAMETERS}}
-#: the prefix of field_sensitivity's result names (the parameter's name follows)
-SENSITIVITY_PREFIX = "dalpha_ddot_d"
-_STATE = {"t": S.t_s, "alpha": S.alpha_s, "alpha_dot": S.alpha_dot, "Theta": S.Theta_s}
+                "y_ddot": "m/s^2", "dy_ddot_dy": "1/s^2", "dy_ddot_dy_dot": "1/s", "dh_dy": "surface unit/m",
+                "dh_dy_dot": "surface unit s/m", "F": "N", "dF_dy": "N/m", "y_i": "m", "dy_i_dTheta": "m/rad",
+                "d2y_i_dTheta2": "m/rad^2", "spring_force": "N",
+                **{name: unit for f in S.COORDINATES for name, (unit, _) in outputs_of(f).items()},
+                **{f"d{q.name}_ddot_d{n}": f"{q.unit}/s^2 per {UNITS[n]}" for n in CONTINUATION_PARAMETERS
+                   for q in S.COORDINATES.values()}}
+#: the infix of field_sensitivity's result names d<q>_ddot_d<parameter> (the parameter's name follows)
+SENSITIVITY_INFIX = "_ddot_d"
+_STATE = {"t": S.t_s, "alpha": S.alpha_s, "alpha_dot": S.alpha_dot, "y": S.y_s, "y_dot": S.y_dot, "Theta": S.Theta_s}
+
+
+def sensitivity_parameter(result: str) -> str:
+    """The continuation parameter of a field_sensitivity result name d<q>_ddot_d<parameter>."""
+    return result.split(SENSITIVITY_INFIX, 1)[1]
 
 
 class _Scalar(PythonCodePrinter):
@@ -314,7 +326,7 @@ class _Writer:
             return [f"return {code[0]}"]
         if style == "fill":
             target = [constant_name("OUT", n) if self.f.name == "outputs" else
-                      constant_name("SENS", n[len(SENSITIVITY_PREFIX):]) if self.f.name == "field_sensitivity"
+                      constant_name("SENS", sensitivity_parameter(n)) if self.f.name == "field_sensitivity"
                       else str(i) for i, n in enumerate(self.f.results)]
             return [f"out[{t}] = {c}" for t, c in zip(target, code)] + ["return"]
         if style == "numpy":
@@ -527,7 +539,7 @@ def variational_name(spec: SceneSpec) -> str:
 def _arguments_doc(spec: SceneSpec, p: str) -> list[str]:
     args = {**ARGS, "p": p}
     return ["Arguments of every kernel, in this order where it takes them:"] + [
-        f"    {a}: {args[a]}" for a in ("m", "s", "t", "alpha", "alpha_dot", "p", "cam", "out")
+        f"    {a}: {args[a]}" for a in ("m", "s", "t", *state_names(spec.follower), "p", "cam", "out")
         if a != "cam" or spec.motion == "user"]
 
 
@@ -634,8 +646,9 @@ def _scene_source(L: _Layout) -> str:
             "UNITS = " + repr({n: UNITS.get(n, _constant_unit(n) if _is_constant(n) else None)
                                for n in L.params + [i for i in inputs if i not in L.params]})]
     data += _automaton_code(A)
-    data += ["# --- output quantities (camdyn.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(tuple(OUTPUTS))]
-    data += _index_constants("OUT", OUTPUTS) + extra_data
+    outputs = tuple(outputs_of(spec.follower))
+    data += ["# --- output quantities (camdyn.vocabulary.OUTPUTS) ---", "OUTPUTS = " + repr(outputs)]
+    data += _index_constants("OUT", outputs) + extra_data
     return _module_text(L.header(), _module_doc(spec, A, companion), [_MATH, "", "import numpy"] + extra_imports,
                         data, extra_code + [pack] + L.kernels(L.mod.functions))
 
@@ -647,7 +660,7 @@ def _variational_source(L: _Layout) -> str:
     data += _named("MODES", "MODE", [m.name for m in A.modes]) + _named("SURFACES", "SURFACE", A.surfaces)
     sensitivity = next((f.results for f in L.mod.variational if f.name == "field_sensitivity"), None)
     if sensitivity is not None:
-        names = tuple(n[len(SENSITIVITY_PREFIX):] for n in sensitivity)
+        names = tuple(sensitivity_parameter(n) for n in sensitivity)
         data += ["# --- continuation parameters of field_sensitivity (vocabulary.CONTINUATION_PARAMETERS) ---",
                  "SENSITIVITY = " + repr(names)] + _index_constants("SENS", names)
     extra_imports, extra_data, extra_code = _profile_parts(L)

@@ -15,12 +15,14 @@ from types import SimpleNamespace
 import sympy as sp
 from sympy.physics.vector import Point, Vector
 
-from . import laws
+from . import laws, translating
 from camdyn import vocabulary
 from . import symbols as S
+from .profile import as_eccentric
 from .graph import Definition, flatten, quantity, substitutions
 from .geometry import (N, E_to_Gc, E_to_Oc_general, P_to_Ob, curvature_radius, follower_frame, psi_i_conditioned,
                        psi_i_general, psi_j_conditioned, psi_j_general)
+from .profile import h
 from .symbols import Theta, alpha, t
 
 B = follower_frame(alpha)
@@ -28,18 +30,32 @@ SLIDING_VELOCITY_FORMS = vocabulary.SLIDING_VELOCITY_FORMS
 
 
 ECCENTRIC = vocabulary.ECCENTRIC  # the paper's cam
+OSCILLATING, TRANSLATING = vocabulary.FOLLOWERS  # the paper's rocker (Fig. 1); a flat face on a guide
+
+
+def _on_cam(profile: str, expr: sp.Expr) -> sp.Expr:
+    """A translating follower's expression, written with the support function h, on the scene's cam:
+    the paper's circle as its support function (derive.profile.eccentric_support), any other cam
+    through its evaluator."""
+    return as_eccentric(expr) if profile == ECCENTRIC else expr
 
 
 @lru_cache(maxsize=None)
-def gap(profile: str = ECCENTRIC) -> sp.Expr:
+def gap(profile: str = ECCENTRIC, follower: str = OSCILLATING) -> sp.Expr:
     """psi_i(alpha(t), Theta(t)) (Eq. 6, cancellation-free form); for a cam other than the
-    paper's circle, through its support function (geometry.psi_i_general)."""
+    paper's circle, through its support function (geometry.psi_i_general); for the translating
+    follower y(t) - h(gamma - Theta(t)) (derive.translating)."""
+    if follower == TRANSLATING:
+        return _on_cam(profile, translating.gap())
     return (psi_i_conditioned if profile == ECCENTRIC else psi_i_general)(alpha, Theta)
 
 
 @lru_cache(maxsize=None)
-def psi_j(profile: str = ECCENTRIC) -> sp.Expr:
-    """psi_j (Eq. 7), or geometry.psi_j_general for any other cam."""
+def psi_j(profile: str = ECCENTRIC, follower: str = OSCILLATING) -> sp.Expr:
+    """psi_j (Eq. 7), or geometry.psi_j_general for any other cam; the translating follower's
+    sliding of the contact along its face (derive.translating.psi_j)."""
+    if follower == TRANSLATING:
+        return _on_cam(profile, translating.psi_j())
     return (psi_j_conditioned if profile == ECCENTRIC else psi_j_general)(alpha, Theta)
 
 
@@ -49,15 +65,23 @@ def chi(profile: str = ECCENTRIC) -> sp.Expr:
 
 
 @lru_cache(maxsize=None)
-def gap_rate(profile: str = ECCENTRIC) -> sp.Expr:
+def gap_rate(profile: str = ECCENTRIC, follower: str = OSCILLATING) -> sp.Expr:
     """psi_i_dot (Eq. 8), the time derivative of the gap."""
-    return gap(profile).diff(t)
+    return gap(profile, follower).diff(t)
 
 
 @lru_cache(maxsize=None)
 def psi_j_rate(profile: str = ECCENTRIC) -> sp.Expr:
     """psi_j_dot (Eq. 9)."""
     return psi_j(profile).diff(t)
+
+
+def curvature_radius_at_contact(profile: str, follower: str) -> sp.Expr:
+    """rho = h + h'' at the contact's body angle (the Hertz radius of a point contact on any cam)."""
+    if follower == TRANSLATING:
+        phi = translating.phi_contact()
+        return h(phi) + h(phi, 2)
+    return curvature_radius()
 
 
 def material_point_velocities(profile: str = ECCENTRIC) -> tuple[Vector, Vector]:
@@ -80,7 +104,7 @@ def material_point_velocities(profile: str = ECCENTRIC) -> tuple[Vector, Vector]
 
 
 @lru_cache(maxsize=None)
-def sliding_velocity(form: str = "kinematic", profile: str = ECCENTRIC) -> sp.Expr:
+def sliding_velocity(form: str = "kinematic", profile: str = ECCENTRIC, follower: str = OSCILLATING) -> sp.Expr:
     """v_r, the velocity of the follower relative to the cam along the bar (u).
 
     "kinematic": from the material points' velocities (rigid-body kinematics).
@@ -89,6 +113,8 @@ def sliding_velocity(form: str = "kinematic", profile: str = ECCENTRIC) -> sp.Ex
                  Figs. 12-15 can be reproduced.  The sign convention is the paper's:
                  v_r > 0 for a cam turning clockwise (self-energizing).
     """
+    if follower == TRANSLATING and form == "kinematic":
+        return _on_cam(profile, translating.sliding_velocity())
     if form == "kinematic":
         v_b, v_c = material_point_velocities(profile)
         return sp.simplify((v_b - v_c).dot(B.x))
@@ -109,6 +135,7 @@ class ContactRegime:
     damping_sign: str = "dissipative"
     sliding_velocity: str = "kinematic"
     profile: str = ECCENTRIC        # the cam: vocabulary.PROFILES
+    follower: str = OSCILLATING     # the follower: vocabulary.FOLLOWERS
 
 
 @dataclass(frozen=True)
@@ -127,33 +154,59 @@ Q = SimpleNamespace(**{name: quantity(name) for name in (
     "alpha_ddot")})
 
 
+def spring_force(follower: str = OSCILLATING, profile: str = ECCENTRIC) -> sp.Expr:
+    """F_s: Eq. 11 at alpha(t), or the translating follower's F_p + k_s (y - y0) (derive.translating,
+    y0 on the scene's cam)."""
+    if follower == TRANSLATING:
+        return _on_cam(profile, translating.spring_force())
+    return laws.spring_force(alpha)
+
+
+def contact_mass(follower: str = OSCILLATING) -> sp.Expr:
+    """The follower's inertia reduced to the contact, the mass of the viscous damping laws: I_Pb / chi*^2
+    (Eq. 24), or the translating follower's mass m_f (its contact moves with it, arm 1)."""
+    return S.m_f if follower == TRANSLATING else S.I_Pb / S.chi_star**2
+
+
+def _contact_geometry(regime: ContactRegime) -> list[Definition]:
+    """The gap and its rate (Eqs. 6, 8), psi_j (Eq. 7) and, for the rocker, the moment arm chi (Eq. 2)."""
+    profile, follower = regime.profile, regime.follower
+    defs = [Definition(Q.psi_i, gap(profile, follower), "gap (Eq. 6); contact deflection where negative"),
+            Definition(Q.psi_i_dot, gap_rate(profile, follower), "gap rate (Eq. 8)"),
+            Definition(Q.psi_j, psi_j(profile, follower), "sliding of the contact point along the "
+                       + ("bar (Eq. 7)" if follower == OSCILLATING else "face"))]
+    if follower == OSCILLATING:
+        defs.append(Definition(Q.chi, S.chi0 - Q.psi_j, "moment arm of F_n about P (Eq. 2)"))
+    return defs
+
+
 @lru_cache(maxsize=None)  # pure (ContactRegime is frozen), shared by the scenes of a regime
-def mechanics(regime: ContactRegime | None) -> tuple[Definition, ...]:
+def mechanics(regime: ContactRegime | None, follower: str = OSCILLATING, profile: str = ECCENTRIC
+              ) -> tuple[Definition, ...]:
     """The named quantities of one mode, in the order they are computed: the gap and its rate
     (Eqs. 6, 8), psi_j and the moment arm chi (Eqs. 7, 2), the spring force (Eq. 11), the
     contact stiffness and damping (Eqs. 13/34, 24-28), the normal force (Eq. 12), the sliding
     velocity, the friction coefficient and force.  With no contact (``regime=None``, Eq. 15)
-    only the spring acts.  Expressions are in alpha(t), Theta(t) and earlier quantities."""
-    F_s = Definition(Q.F_s, laws.spring_force(alpha), "spring force (Eq. 11)")
+    only the spring acts (of ``follower`` on the cam ``profile``; in contact the regime's).  Expressions
+    are in alpha(t) (the translating follower's y(t)), Theta(t) and earlier quantities."""
+    if regime is not None:
+        follower, profile = regime.follower, regime.profile
+    F_s = Definition(Q.F_s, spring_force(follower, profile), "spring force (Eq. 11)")
     if regime is None:
         return (F_s,)
-    profile = regime.profile
-    defs = [Definition(Q.psi_i, gap(profile), "gap (Eq. 6); contact deflection where negative"),
-            Definition(Q.psi_i_dot, gap_rate(profile), "gap rate (Eq. 8)"),
-            Definition(Q.psi_j, psi_j(profile), "sliding of the contact point along the bar (Eq. 7)"),
-            Definition(Q.chi, S.chi0 - Q.psi_j, "moment arm of F_n about P (Eq. 2)"),
-            F_s]
+    defs = _contact_geometry(regime) + [F_s]
     if _radius(regime) is Q.rho:
-        defs.append(Definition(Q.rho, curvature_radius(), "the cam's radius of curvature at the contact, h + h''"))
+        defs.append(Definition(Q.rho, curvature_radius_at_contact(profile, follower),
+                               "the cam's radius of curvature at the contact, h + h''"))
     defs += [Definition(Q.k_lambda, laws.contact_stiffness(regime.contact, Q.psi_i, _radius(regime)),
                         "contact stiffness (Eq. 13 line, Eq. 34 point)"),
             Definition(Q.c_lambda, laws.damping_coefficient(regime.damping, regime.phase, _stiffness(regime), Q.psi_i,
-                                                            regime.damping_sign),
+                                                            regime.damping_sign, contact_mass(follower)),
                        f"contact damping, model {regime.damping} (Eqs. 24-28)"),
              Definition(Q.F_n, laws.elastic_force(regime.contact, Q.psi_i, Q.k_lambda, _radius(regime))
                         - Q.c_lambda * Q.psi_i_dot, "normal contact force (Eq. 12)")]
     if regime.friction != "none":
-        defs += [Definition(Q.v_r, sliding_velocity(regime.sliding_velocity, profile),
+        defs += [Definition(Q.v_r, sliding_velocity(regime.sliding_velocity, profile, follower),
                             f"sliding velocity ({regime.sliding_velocity} form)"),
                  Definition(Q.mu, laws.friction_coefficient(regime.friction, Q.v_r, regime.direction),
                             f"friction coefficient ({regime.friction})"),
@@ -189,20 +242,28 @@ def named_forces(regime: ContactRegime | None) -> Forces:
 
 
 @lru_cache(maxsize=None)  # pure (ContactRegime is frozen): a trigsimp, shared by the scenes of a regime
-def acceleration(regime: ContactRegime | None) -> Definition:
-    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free), in the named forces."""
+def acceleration(regime: ContactRegime | None, follower: str = OSCILLATING) -> Definition:
+    """alpha_ddot from I_Pb alpha_ddot = M_P (Eq. 10 in contact, Eq. 15 free), in the named forces;
+    the translating follower's y_ddot from m_f y_ddot = the applied forces along its guide."""
+    follower = regime.follower if regime is not None else follower
+    if follower == TRANSLATING:
+        f = named_forces(regime)
+        return Definition(S.COORDINATES[TRANSLATING].acceleration, translating.force_along_guide(f.F_s, f.F_n, f.F_f)
+                          / S.m_f, "acceleration along the guide (m_f y_ddot = F_n - F_s)" if regime else
+                          "acceleration along the guide, no contact (m_f y_ddot = -F_s)")
     chi_ = S.chi0 if regime is None else Q.chi  # no normal force in free flight: chi does not enter
     moment = sp.expand(sp.trigsimp(moment_about_P(named_forces(regime), chi_)))
     return Definition(Q.alpha_ddot, moment / S.I_Pb,
                       "angular acceleration (Eq. 10)" if regime else "angular acceleration (Eq. 15)")
 
 
-def forces(regime: ContactRegime | None) -> Forces:
+def forces(regime: ContactRegime | None, follower: str = OSCILLATING, profile: str = ECCENTRIC) -> Forces:
     """Forces in a contact regime, or with no contact (``regime=None``, Eq. 15), as functions
     of alpha(t), Theta(t): :func:`mechanics` with every quantity substituted."""
-    flat = substitutions(mechanics(regime))
+    flat = substitutions(mechanics(regime, follower, profile))
     zero = sp.Integer(0)
-    kinematic = sliding_velocity("kinematic", ECCENTRIC if regime is None else regime.profile)
+    follower = regime.follower if regime is not None else follower
+    kinematic = sliding_velocity("kinematic", ECCENTRIC if regime is None else regime.profile, follower)
     return Forces(flat[Q.F_s], flat.get(Q.F_n, zero), flat.get(Q.F_f, zero), flat.get(Q.v_r, kinematic))
 
 
@@ -230,12 +291,15 @@ def moment_about_P(f: Forces, chi_: sp.Expr | None = None, profile: str = ECCENT
     return -total.dot(N.z)
 
 
-def bearing_force_x(f: Forces) -> sp.Expr:
+def bearing_force_x(f: Forces, follower: str = OSCILLATING) -> sp.Expr:
     """N_x (Eq. 35): horizontal force of the bearing at P on the follower.
 
     The follower's centre of gravity P is fixed, so the bearing balances the
-    horizontal components of the applied forces.
+    horizontal components of the applied forces.  The translating follower: the guide's
+    reaction across itself (derive.translating.guide_force).
     """
+    if follower == TRANSLATING:
+        return translating.guide_force(f.F_s, f.F_n, f.F_f)
     total = sum((F for _, F in applied_forces(f)), Vector(0))
     return -total.dot(N.x)
 

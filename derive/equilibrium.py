@@ -12,25 +12,34 @@ from __future__ import annotations
 
 import sympy as sp
 
-from . import dynamics
+from . import dynamics, translating
 from . import symbols as S
-from .symbols import Theta, alpha, t
+from .symbols import Theta, alpha, t, y
 
 
 def at_rest(expr: sp.Expr) -> sp.Expr:
     """Set the cam to Theta0 and every time derivative to zero."""
-    return expr.subs({alpha.diff(t): 0, Theta.diff(t): 0}).subs(Theta, S.theta0)
+    return expr.subs({alpha.diff(t): 0, y.diff(t): 0, Theta.diff(t): 0}).subs(Theta, S.theta0)
 
 
-def static_gap(profile: str = dynamics.ECCENTRIC) -> tuple[sp.Expr, sp.Expr]:
-    """(psi_i*, psi_j*) as functions of alpha: Eqs. 16 and 17."""
-    return at_rest(dynamics.gap(profile)), at_rest(dynamics.psi_j(profile))
+def static_gap(profile: str = dynamics.ECCENTRIC, follower: str = dynamics.OSCILLATING) -> tuple[sp.Expr, sp.Expr]:
+    """(psi_i*, psi_j*) as functions of the follower's coordinate: Eqs. 16 and 17."""
+    return at_rest(dynamics.gap(profile, follower)), at_rest(dynamics.psi_j(profile, follower))
 
 
 def static_moment(contact: str, profile: str = dynamics.ECCENTRIC) -> sp.Expr:
     """M(alpha) at rest, undamped and frictionless: Eq. 18 is M(alpha*) = 0."""
     regime = dynamics.ContactRegime(contact=contact, profile=profile)
     return at_rest(dynamics.moment_about_P(dynamics.forces(regime), profile=profile))
+
+
+def static_load(contact: str, profile: str = dynamics.ECCENTRIC, follower: str = dynamics.OSCILLATING) -> sp.Expr:
+    """The static load at rest whose zero is the equilibrium: the rocker's moment M(alpha) (Eq. 18), or
+    the translating follower's force along its guide, F_n - F_s at Theta0 (undamped, frictionless)."""
+    if follower == dynamics.OSCILLATING:
+        return static_moment(contact, profile)
+    f = dynamics.forces(dynamics.ContactRegime(contact=contact, profile=profile, follower=follower))
+    return at_rest(translating.force_along_guide(f.F_s, f.F_n, f.F_f))
 
 
 def state_jacobian(alpha_ddot: sp.Expr) -> sp.Matrix:

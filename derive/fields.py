@@ -25,12 +25,12 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import dynamics, energy, equilibrium, geometry, laws, linear, profile
+from . import dynamics, energy, equilibrium, geometry, laws, linear, profile, translating
 from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
 from .graph import Definition, derivatives, derivative_symbol, flatten, quantity, used
-from camdyn.vocabulary import CONTINUATION_PARAMETERS, JACOBIAN, OUTPUTS, SURFACE_GRADIENT, SceneSpec
+from camdyn.vocabulary import CONTINUATION_PARAMETERS, JACOBIAN, RIGID_OUTPUT, SURFACE_GRADIENT, SceneSpec, outputs_of
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,12 @@ def regime(spec: SceneSpec, mode: Mode, direction: int | None = None) -> dynamic
     return dynamics.ContactRegime(contact=spec.contact, damping=spec.damping, phase=phase,
                                   friction=spec.friction, direction=direction,
                                   damping_sign=spec.damping_sign, sliding_velocity=spec.sliding_velocity,
-                                  profile=spec.profile)
+                                  profile=spec.profile, follower=spec.follower)
+
+
+def coordinate(spec: SceneSpec) -> S.Coordinate:
+    """The scene's follower coordinate: alpha, or the translating follower's y (derive.symbols)."""
+    return S.COORDINATES[spec.follower]
 
 
 # --- the pieces ---------------------------------------------------------------------------
@@ -94,10 +99,11 @@ V_R_PARTIALS = tuple(quantity(n) for n in ("dv_r_dt", "dv_r_dalpha", "dv_r_dalph
 
 def _slip_partials(spec: SceneSpec) -> tuple[Definition, ...]:
     """v_r and its partial derivatives in t, alpha, alpha_dot (the sliding mode's ingredients)."""
-    v = plain(dynamics.sliding_velocity(spec.sliding_velocity, spec.profile), spec.motion)
+    v = plain(dynamics.sliding_velocity(spec.sliding_velocity, spec.profile, spec.follower), spec.motion)
+    q = coordinate(spec)
     notes = ("dv_r/dt at fixed state", "dv_r/dalpha", "dv_r/dalpha_dot")
     return (Definition(Q.v_r, v, f"sliding velocity ({spec.sliding_velocity} form)"),) + tuple(
-        Definition(sym, v.diff(x), note) for sym, x, note in zip(V_R_PARTIALS, (S.t_s, S.alpha_s, S.alpha_dot), notes))
+        Definition(sym, v.diff(x), note) for sym, x, note in zip(V_R_PARTIALS, (S.t_s, q.plain, q.rate), notes))
 
 
 def _sliding_mode(spec: SceneSpec) -> tuple[Definition, ...]:
@@ -111,7 +117,8 @@ def _sliding_mode(spec: SceneSpec) -> tuple[Definition, ...]:
 def _mechanics(spec: SceneSpec, mode: Mode, direction: int | None = None) -> tuple[Definition, ...]:
     """The named forces of a mode and its (non-linear) alpha_ddot."""
     r = regime(spec, mode, direction)
-    return _plain_all(dynamics.mechanics(r) + (dynamics.acceleration(r),), spec.motion)
+    return _plain_all(dynamics.mechanics(r, spec.follower, spec.profile) + (dynamics.acceleration(r, spec.follower),),
+                      spec.motion)
 
 
 def _linear_field(spec: SceneSpec, mode: Mode) -> Definition:
@@ -132,38 +139,40 @@ def field(spec: SceneSpec, mode: Mode) -> Kernel:
     if spec.model != "nonlinear":
         return Kernel((_linear_field(spec, mode),), (Q.alpha_ddot,))
     defs = _sliding_mode(spec) if mode.slip == "stick" else _mechanics(spec, mode)
-    return Kernel(defs, (Q.alpha_ddot,)).pruned()
+    return Kernel(defs, (coordinate(spec).acceleration,)).pruned()
 
 
 def jacobian(spec: SceneSpec, mode: Mode) -> Kernel:
     """d(alpha_ddot)/d(alpha) and d(alpha_ddot)/d(alpha_dot) of the mode's field (Eqs. 21-22)."""
-    f = field(spec, mode)
-    by_alpha = derivatives(f.definitions, S.alpha_s)
-    by_rate = derivatives(f.definitions, S.alpha_dot)
-    by = {"d_alpha": (S.alpha_s, by_alpha), "d_alpha_dot": (S.alpha_dot, by_rate)}
-    results = tuple(derivative_symbol("alpha_ddot", *by[name]) for name in JACOBIAN)
+    f, q = field(spec, mode), coordinate(spec)
+    by_alpha = derivatives(f.definitions, q.plain)
+    by_rate = derivatives(f.definitions, q.rate)
+    by = {"d_alpha": (q.plain, by_alpha), "d_alpha_dot": (q.rate, by_rate)}  # JACOBIAN's entries, by position
+    results = tuple(derivative_symbol(q.acceleration.name, *by[name]) for name in JACOBIAN)
     return Kernel(f.definitions + by_alpha + by_rate, results).pruned()
 
 
 def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
     """The value of surface ``name`` under the mode's laws (None where it has no meaning)."""
     if name == "gap":
-        return Kernel((Definition(Q.psi_i, plain(dynamics.gap(spec.profile), spec.motion), "gap (Eq. 6)"),),
-                      (Q.psi_i,))
+        return Kernel((Definition(Q.psi_i, plain(dynamics.gap(spec.profile, spec.follower), spec.motion),
+                                  "gap (Eq. 6)"),), (Q.psi_i,))
     if name == "gap_rate":
-        return Kernel((Definition(Q.psi_i_dot, plain(dynamics.gap_rate(spec.profile), spec.motion),
+        return Kernel((Definition(Q.psi_i_dot, plain(dynamics.gap_rate(spec.profile, spec.follower), spec.motion),
                                   "gap rate (Eq. 8)"),),
                       (Q.psi_i_dot,))
     if name == "slip":
         return Kernel(_slip_partials(spec)[:1], (Q.v_r,))
     if name == "junction":
         value = quantity("junction")
-        phi = plain(geometry.phi_contact(), spec.motion)
+        phi = plain(translating.phi_contact() if spec.follower == dynamics.TRANSLATING else geometry.phi_contact(),
+                    spec.motion)
         return Kernel((Definition(value, profile.junction(phi), "the arcs' junction indicator"),), (value,))
     if name in ("slip_rate_fwd", "slip_rate_bwd") and mode.contact:
         side = _mechanics(spec, mode, direction=1 if name == "slip_rate_fwd" else -1)
         v_t, v_a, v_ad = V_R_PARTIALS
-        rate = v_t + v_a * S.alpha_dot + v_ad * Q.alpha_ddot
+        q = coordinate(spec)
+        rate = v_t + v_a * q.rate + v_ad * q.acceleration
         return Kernel(side + _slip_partials(spec)[1:], (rate,)).pruned()
     return None
 
@@ -174,21 +183,30 @@ def continuation_parameters(spec: SceneSpec, modes) -> tuple[str, ...]:
     return tuple(n for n in CONTINUATION_PARAMETERS if S.PARAMS[n].symbol in read)
 
 
-@lru_cache(maxsize=None)
-def _equilibrium_rates(contact: str, profile: str, name: str) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
-    """(quantity, its derivative by parameter ``name``) for the equilibrium's alpha*, chi* and
-    vartheta, where not zero: M(alpha*) = 0 (Eq. 18) gives dalpha*/dq = -M_q / M_alpha (implicit
-    function theorem), chi* = chi0 - psi_j*(alpha*) (Eq. 17) and vartheta = sqrt(-M_alpha / I_Pb)
-    (Eq. 23), all at alpha = alpha*, as the runtime solves them (camdyn.model.model)."""
-    q = S.PARAMS[name].symbol
-    M = S.to_plain(equilibrium.static_moment(contact, profile))
-    psi_j = S.to_plain(equilibrium.static_gap(profile)[1])
-    at = {S.alpha_s: S.alpha_star}
-    M_a = M.diff(S.alpha_s)
-    d_alpha = (-M.diff(q) / M_a).subs(at)
-    d_chi = -(psi_j.diff(S.alpha_s) * d_alpha + psi_j.diff(q)).subs(at)
-    d_vartheta = (-(M_a.diff(q) + M_a.diff(S.alpha_s) * d_alpha) / (2 * S.I_Pb * S.vartheta)).subs(at)
-    rates = ((S.alpha_star, d_alpha), (S.chi_star, d_chi), (S.vartheta, d_vartheta))
+#: the static equilibrium's quantities the kernels read, by follower type: the coordinate at rest, the
+#: rocker's moment arm chi* there, the natural frequency vartheta (vocabulary.EQUILIBRIUM_QUANTITIES)
+_AT_REST = {"oscillating": ("alpha_star", "chi_star"), "translating": ("y_star",)}
+
+
+@lru_cache(maxsize=None)  # shared by the scenes of a contact law, cam and follower
+def _equilibrium_rates(contact: str, profile: str, follower: str, name: str) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
+    """(quantity, its derivative by parameter ``name``) for the equilibrium's q* (alpha* or y*), chi*
+    (the rocker) and vartheta, where not zero: M(q*) = 0 (Eq. 18) gives dq*/dp = -M_p / M_q (implicit
+    function theorem), chi* = chi0 - psi_j*(alpha*) (Eq. 17) and vartheta = sqrt(-M_q / I) (Eq. 23,
+    I = I_Pb or m_f), all at q = q*, as the runtime solves them (camdyn.model.model)."""
+    p = S.PARAMS[name].symbol
+    c = S.COORDINATES[follower]
+    M = S.to_plain(equilibrium.static_load(contact, profile, follower))
+    star = S.PARAMS[_AT_REST[follower][0]].symbol
+    inertia = S.I_Pb if follower == "oscillating" else S.m_f
+    at = {c.plain: star}
+    M_q = M.diff(c.plain)
+    d_q = (-M.diff(p) / M_q).subs(at)
+    d_vartheta = (-(M_q.diff(p) + M_q.diff(c.plain) * d_q) / (2 * inertia * S.vartheta)).subs(at)
+    rates = [(star, d_q), (S.vartheta, d_vartheta)]
+    if follower == "oscillating":
+        psi_j = S.to_plain(equilibrium.static_gap(profile)[1])
+        rates.insert(1, (S.chi_star, -(psi_j.diff(c.plain) * d_q + psi_j.diff(p)).subs(at)))
     return tuple((sym, rate) for sym, rate in rates if rate != 0)
 
 
@@ -198,17 +216,18 @@ def field_sensitivity(spec: SceneSpec, mode: Mode, names: tuple[str, ...]) -> Ke
     and through the static equilibrium's alpha*, chi*, vartheta (:func:`_equilibrium_rates`),
     which the runtime computes from the rig."""
     f = field(spec, mode)
+    acceleration = coordinate(spec).acceleration.name
     defs, results, done = list(f.definitions), [], {}
     for name in names:
         q = S.PARAMS[name].symbol
         direct = derivatives(f.definitions, q)
         defs += direct
-        total = derivative_symbol("alpha_ddot", q, direct)
-        for sym, rate in _equilibrium_rates(spec.contact, spec.profile, name):
+        total = derivative_symbol(acceleration, q, direct)
+        for sym, rate in _equilibrium_rates(spec.contact, spec.profile, spec.follower, name):
             if sym not in done:
                 done[sym] = derivatives(f.definitions, sym)
                 defs += done[sym]
-            part = derivative_symbol("alpha_ddot", sym, done[sym])
+            part = derivative_symbol(acceleration, sym, done[sym])
             if part != 0:
                 rate_symbol = quantity(f"d{sym.name}_d{name}")
                 defs.append(Definition(rate_symbol, rate, f"d({sym.name})/d({name}) of the static equilibrium"))
@@ -232,14 +251,15 @@ def surface_gradient(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
     if h is None:
         return None
     defs = h.definitions + (Definition(SURFACE_VALUE, h.results[0], f"the value of surface {name}"),)
-    by = {x: derivatives(defs, x) for x in (S.alpha_s, S.alpha_dot, S.t_s, S.Theta_s, S.Theta_dot)}
+    q = coordinate(spec)
+    by = {x: derivatives(defs, x) for x in (q.plain, q.rate, S.t_s, S.Theta_s, S.Theta_dot)}
     grad = {x: derivative_symbol(SURFACE_VALUE.name, x, d) for x, d in by.items()}
     d_t = grad[S.t_s]
     if spec.motion == "user":
         if any(sp.sympify(d.expr).has(S.Theta_ddot) for d in defs):
             return None
         d_t = d_t + S.Theta_dot * grad[S.Theta_s] + S.Theta_ddot * grad[S.Theta_dot]
-    results = dict(zip(SURFACE_GRADIENT, (grad[S.alpha_s], grad[S.alpha_dot], d_t)))
+    results = dict(zip(SURFACE_GRADIENT, (grad[q.plain], grad[q.rate], d_t)))
     return Kernel(defs + sum(by.values(), ()), tuple(results[n] for n in SURFACE_GRADIENT)).pruned()
 
 
@@ -248,7 +268,7 @@ def _stuck_friction(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
     (Eq. 10 solved for F_f; F_f / F_n is the equivalent friction coefficient, inside +-mu_m
     while stuck)."""
     stuck = _sliding_mode(spec)[1:]  # the partials and alpha_ddot (v_r is already defined)
-    free_f = plain(dynamics.acceleration(regime(spec, mode, direction=1)).expr, spec.motion)
+    free_f = plain(dynamics.acceleration(regime(spec, mode, direction=1), spec.follower).expr, spec.motion)
     a0, a1 = free_f.subs(Q.F_f, 0), free_f.diff(Q.F_f)
     return stuck + (Definition(Q.F_f, (Q.alpha_ddot - a0) / a1, "friction force that keeps the follower stuck"),)
 
@@ -288,11 +308,18 @@ def spring_potential() -> sp.Expr:
 
 
 @lru_cache(maxsize=None)
-def _energy_terms(contact: str, profile: str):
-    """V_s(alpha), its derivative in the named form d_x F_s, and in contact V_c(psi_i), in
-    plain symbols (psi_i named; a point contact on a cam other than the circle: rho named)."""
+def _energy_terms(contact: str, profile: str, follower: str):
+    """T's inertia, V_s(q), its derivative in the named form (d_x F_s; the translating follower's F_s),
+    and in contact V_c(psi_i), in plain symbols (psi_i named; a point contact on a cam other than the
+    circle: rho named)."""
     radius = Q.rho if contact == "point" and profile != dynamics.ECCENTRIC else S.r_c
-    return spring_potential(), S.d_x * Q.F_s, laws.contact_potential(contact, Q.psi_i, radius)
+    V_c = laws.contact_potential(contact, Q.psi_i, radius)
+    if follower == dynamics.TRANSLATING:
+        V_s = dynamics._on_cam(profile, translating.spring_potential(S.y_s))
+        if sp.expand(V_s.diff(S.y_s) - dynamics._on_cam(profile, translating.spring_force(S.y_s))) != 0:
+            raise RuntimeError("dV_s/dy is not F_s: check derive.translating.spring_potential")
+        return S.m_f, V_s, Q.F_s, V_c
+    return S.I_Pb, spring_potential(), S.d_x * Q.F_s, V_c
 
 
 def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
@@ -305,14 +332,15 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
     else:
         defs = _mechanics(spec, mode)
     geometry_defs = []
-    for sym, expr, note in ((Q.psi_i, dynamics.gap(spec.profile), "gap (Eq. 6)"),
-                            (Q.psi_i_dot, dynamics.gap_rate(spec.profile), "Eq. 8"),
-                            (Q.psi_j, dynamics.psi_j(spec.profile), "Eq. 7")):
+    profile, follower = spec.profile, spec.follower
+    for sym, expr, note in ((Q.psi_i, dynamics.gap(profile, follower), "gap (Eq. 6)"),
+                            (Q.psi_i_dot, dynamics.gap_rate(profile, follower), "Eq. 8"),
+                            (Q.psi_j, dynamics.psi_j(profile, follower), "Eq. 7")):
         if sym not in {d.symbol for d in defs}:
             geometry_defs.append(Definition(sym, plain(expr, spec.motion), note))
     defs = tuple(geometry_defs) + defs
     names = {d.symbol for d in defs}
-    kinematic = plain(dynamics.sliding_velocity("kinematic", spec.profile), spec.motion)
+    kinematic = plain(dynamics.sliding_velocity("kinematic", profile, follower), spec.motion)
     if Q.v_r in names and spec.sliding_velocity == "kinematic":
         v_kin = Q.v_r
     else:
@@ -320,16 +348,21 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
         defs += (Definition(v_kin, kinematic, "relative velocity of the contact points along the bar"),)
     v_r_out = Q.v_r if Q.v_r in names else v_kin
     forces = dynamics.Forces(Q.F_s, Q.F_n if r else zero, Q.F_f if Q.F_f in names else zero, v_r_out)
-    V_s, dV_s, V_c = _energy_terms(spec.contact, spec.profile)
-    E = S.I_Pb * S.alpha_dot**2 / 2 + V_s + (V_c if r else zero)
+    inertia, V_s, dV_s, V_c = _energy_terms(spec.contact, profile, follower)
+    q = coordinate(spec)
+    E = inertia * q.rate**2 / 2 + V_s + (V_c if r else zero)
     if r is None:  # free flight: no contact force, nothing delivered or dissipated
         dE_dt = D_c = D_f = zero
     else:
         F_d = -Q.c_lambda * Q.psi_i_dot  # the damping part of F_n (Eq. 12)
         D_c, D_f = -F_d * Q.psi_i_dot, forces.F_f * v_kin
-        dE_dt = (S.I_Pb * Q.alpha_ddot + dV_s) * S.alpha_dot + V_c.diff(Q.psi_i) * Q.psi_i_dot
-    named = [(quantity("N_x"), plain(dynamics.bearing_force_x(forces), spec.motion), "bearing force (Eq. 35)"),
-             (quantity("alpha_i"), _rigid_contact_output(spec), "follower angle in rigid contact (Eq. 29)"),
+        dE_dt = (inertia * q.acceleration + dV_s) * q.rate + V_c.diff(Q.psi_i) * Q.psi_i_dot
+    outputs_names = tuple(outputs_of(follower))
+    rigid = RIGID_OUTPUT[follower]
+    named = [(quantity("N_x"), plain(dynamics.bearing_force_x(forces, follower), spec.motion),
+              "bearing force (Eq. 35)" if follower == dynamics.OSCILLATING else "the guide's reaction across it"),
+             (quantity(rigid), _rigid_contact_output(spec), "follower angle in rigid contact (Eq. 29)"
+              if follower == dynamics.OSCILLATING else "the follower in rigid contact, h(gamma - Theta)"),
              (quantity("energy"), E, "T + V_s + V_c (Section 5)"),
              (quantity("D_c"), D_c, "power dissipated by contact damping"),
              (quantity("D_f"), D_f, "power dissipated by friction"),
@@ -338,14 +371,16 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
     defs += tuple(Definition(sym, expr, note) for sym, expr, note in named)
     values = {"psi_i": Q.psi_i, "psi_j": Q.psi_j, "psi_i_dot": Q.psi_i_dot, "F_s": Q.F_s, "F_n": forces.F_n,
               "F_f": forces.F_f, "v_r": v_r_out}
-    results = tuple(values.get(name, quantity(name)) for name in OUTPUTS)
+    results = tuple(values.get(name, quantity(name)) for name in outputs_names)
     return Kernel(defs, results).pruned()
 
 
 def _rigid_contact_output(spec: SceneSpec) -> sp.Expr:
     """alpha_i (Eq. 29, misprint 10) on the paper's circle; NaN on any other cam, where the
     rigid contact angle is the root of psi_i(alpha, Theta) = 0, with no closed form (the
-    OUTPUTS entry says so)."""
+    OUTPUTS entry says so).  The translating follower's y_i = h(gamma - Theta) on any cam."""
+    if spec.follower == dynamics.TRANSLATING:
+        return plain(dynamics._on_cam(spec.profile, translating.rigid_coordinate()), spec.motion)
     if spec.profile == dynamics.ECCENTRIC:
         return plain(geometry.rigid_contact_angle(S.Theta), spec.motion)
     return sp.nan

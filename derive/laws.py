@@ -86,9 +86,11 @@ def contact_potential(law: str, psi_i: sp.Expr, radius: sp.Expr = S.r_c) -> sp.E
     return energy.subs(delta, sp.Abs(psi_i))  # even in psi_i: finite on stage overshoot
 
 
-def viscous_coefficient(zeta: sp.Expr) -> sp.Expr:
-    """Eqs. 24, 27b, 28b: c = 2 zeta vartheta I_Pb / chi*^2 (vartheta in rad/s, misprint 4/7)."""
-    return 2 * zeta * S.vartheta * S.I_Pb / S.chi_star**2
+def viscous_coefficient(zeta: sp.Expr, mass: sp.Expr | None = None) -> sp.Expr:
+    """Eqs. 24, 27b, 28b: c = 2 zeta vartheta I_Pb / chi*^2 (vartheta in rad/s, misprint 4/7):
+    2 zeta vartheta times the follower's inertia reduced to the contact, ``mass`` (default the
+    rocker's I_Pb / chi*^2; a translating follower's m_f)."""
+    return 2 * zeta * S.vartheta * (S.I_Pb / S.chi_star**2 if mass is None else mass)
 
 
 def impact_coefficient_k(beta: sp.Expr, k_lambda: sp.Expr, psi_i: sp.Expr, sign: str) -> sp.Expr:
@@ -112,23 +114,24 @@ def impact_coefficient_power(beta: sp.Expr, psi_i: sp.Expr) -> sp.Expr:
 
 
 def damping_coefficient(model: str, phase: str, k_lambda: sp.Expr, psi_i: sp.Expr,
-                        sign: str = "dissipative") -> sp.Expr:
+                        sign: str = "dissipative", mass: sp.Expr | None = None) -> sp.Expr:
     """c_lambda for damping model A-E (Eqs. 24-28) in contact phase ``phase``.
 
     ``phase`` is "loading" (from first contact t_a to maximum compression t_b,
     psi_i_dot < 0) or "unloading" (t_b to separation t_c); only D and E use it.
+    ``mass``: the follower's inertia at the contact of the viscous laws (:func:`viscous_coefficient`).
     """
     if model == "none":
         return sp.Integer(0)
     if model == "A":
-        return viscous_coefficient(S.zeta_A)
+        return viscous_coefficient(S.zeta_A, mass)
     if model == "B":
         return impact_coefficient_k(S.beta_B, k_lambda, psi_i, sign)
     if model == "C":
         return impact_coefficient_power(S.beta_C, psi_i)
     if model in ("D", "E"):
         if phase == "unloading":
-            return viscous_coefficient(S.zeta_D if model == "D" else S.zeta_E)
+            return viscous_coefficient(S.zeta_D if model == "D" else S.zeta_E, mass)
         if phase != "loading":
             raise ValueError(f"damping {model} needs phase 'loading' or 'unloading', got {phase!r}")
         if model == "D":
@@ -147,8 +150,10 @@ def friction_coefficient(model: str, v_r: sp.Expr, direction: int = 0) -> sp.Exp
     if model == "none":
         return sp.Integer(0)
     if model == "coulomb":
+        if direction == 0:  # where friction does no work on the motion (a translating follower's face,
+            return S.mu_m * sp.sign(v_r)  # derive.translating): no direction state, the sign itself
         if direction not in (1, -1):
-            raise ValueError("Coulomb friction needs the sliding direction +1 or -1")
+            raise ValueError("Coulomb friction needs the sliding direction +1 or -1, or 0 for its sign")
         return direction * S.mu_m
     if model == "tanh":
         return S.mu_m * sp.tanh(S.s * v_r)

@@ -100,7 +100,7 @@ def calls(expr) -> set:
     return set(sp.sympify(expr).atoms(SupportFunction))
 
 
-def is_constant_call(call: sp.Expr, state=(S.t_s, S.alpha_s, S.alpha_dot, S.Theta_s, S.Theta_dot,
+def is_constant_call(call: sp.Expr, state=(S.t_s, S.alpha_s, S.alpha_dot, S.y_s, S.y_dot, S.Theta_s, S.Theta_dot,
                                            S.Theta_ddot)) -> bool:
     """Whether a call's angle is made of parameters only (then ``pack()`` computes it once)."""
     return not call.args[1].has(*state)

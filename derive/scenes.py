@@ -35,12 +35,13 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import energy, equilibrium, fields, geometry, laws
+from . import dynamics, energy, equilibrium, fields, geometry, laws, translating
 from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
 from .graph import Definition, quantity
-from camdyn.vocabulary import ECCENTRIC, CAM_STATE, OPTIONS, OUTPUTS, SURFACE_WITH_RATE, SceneOptionError, SceneSpec
+from camdyn.vocabulary import (ECCENTRIC, CAM_STATE, OPTIONS, OUTPUTS, STATIC_LOAD, SURFACE_WITH_RATE, SceneOptionError,
+                               SceneSpec, outputs_of, state_names)
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
 
@@ -85,8 +86,10 @@ class SceneModule:
 
 
 def _state_args(spec: SceneSpec, *dispatch: str, out: bool = False) -> tuple[str, ...]:
+    """A kernel's arguments: ``dispatch``, t, the state (the follower's coordinate and its rate:
+    alpha, alpha_dot or y, y_dot), p, the user's cam state and ``out``."""
     cam = ("cam",) if spec.motion == "user" else ()
-    return dispatch + ("t", "alpha", "alpha_dot", "p") + cam + (("out",) if out else ())
+    return dispatch + ("t",) + state_names(spec.follower) + ("p",) + cam + (("out",) if out else ())
 
 
 def _mode_cases(automaton: Automaton, kernel_of) -> tuple[Case, ...]:
@@ -132,9 +135,39 @@ def _single(*results: sp.Expr) -> tuple[Case, ...]:
     return (Case((), Kernel((), tuple(results))),)
 
 
+def _translating_static_functions(spec: SceneSpec) -> list[Function]:
+    """The translating follower's kernels that do not depend on a run: the static force along the
+    guide at Theta0 (its zero is the equilibrium, as Eqs. 16-18), the follower in rigid contact
+    y_i = h(gamma - Theta) with its derivatives in Theta, and the spring's potential."""
+    F = S.to_plain(equilibrium.static_load(spec.contact, spec.profile, spec.follower))
+    psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap(spec.profile, spec.follower))
+    on_cam = lambda expr: dynamics._on_cam(spec.profile, expr)  # noqa: E731
+    radius = S.r_c if spec.profile == ECCENTRIC else S.to_plain(equilibrium.at_rest(
+        dynamics.curvature_radius_at_contact(spec.profile, spec.follower)))
+    y_i = S.to_plain(on_cam(translating.rigid_coordinate()))
+    y_i_th = y_i.diff(S.Theta_s)
+    name = STATIC_LOAD[spec.follower]
+    return [
+        Function(name, ("y", "p"), (), ("F", "dF_dy", "psi_i", "psi_j", "k_lambda"),
+                 _single(F, F.diff(S.y_s), psi_i_star, psi_j_star,
+                         laws.contact_stiffness(spec.contact, psi_i_star, radius)),
+                 "Static force along the guide at Theta0 (F_n - F_s; its zero is the equilibrium y*), its slope, "
+                 "psi_i*, psi_j* and the contact stiffness k_lambda(psi_i) (Eq. 13 or 34, secant).", "tuple"),
+        Function("rigid_contact", ("Theta", "p"), (), ("y_i", "dy_i_dTheta", "d2y_i_dTheta2", "spring_force"),
+                 _single(y_i, y_i_th, y_i_th.diff(S.Theta_s), S.to_plain(on_cam(translating.spring_force(y_i)))),
+                 "The follower in rigid contact y_i(Theta) = h(gamma - Theta), its derivatives in Theta, and "
+                 "the spring force F_s there.", "tuple"),
+        Function("spring_potential", ("y", "p"), (), ("V_s",),
+                 _single(S.to_plain(on_cam(translating.spring_potential(S.y_s)))),
+                 "The spring's potential F_p (y - y0) + k_s (y - y0)^2 / 2.", "tuple"),
+    ]
+
+
 def _static_functions(spec: SceneSpec) -> list[Function]:
     """Kernels that do not depend on a run: the equilibrium's moment (Eqs. 16-18), the rigid
     contact angle (Eq. 29) and the spring's potentials."""
+    if spec.follower != "oscillating":
+        return _translating_static_functions(spec)
     M = S.to_plain(equilibrium.static_moment(spec.contact, spec.profile))
     psi_i_star, psi_j_star = (S.to_plain(x) for x in equilibrium.static_gap(spec.profile))
     radius = S.r_c if spec.profile == ECCENTRIC else S.to_plain(
@@ -181,10 +214,13 @@ def build(spec: SceneSpec) -> SceneModule:
                                   _single(*(sp.sympify(sub[k]) for k in (S.Theta_s, S.Theta_dot, S.Theta_ddot))),
                                   f"Cam angle and its rates at time t: {spec.motion} motion (Section 7); "
                                   "t may be an array.", "numpy"))
-    functions.append(Function("rhs", _state_args(spec, "m"), ("m",), ("alpha_ddot",),
+    q, q_dot = state_names(spec.follower)
+    functions.append(Function("rhs", _state_args(spec, "m"), ("m",), (f"{q}_ddot",),
                               _mode_cases(A, lambda mode: fields.field(spec, mode)),
                               "Angular acceleration alpha_ddot in mode m: Eq. 10 in contact, Eq. 15 in free "
-                              "flight, the Filippov sliding mode on v_r = 0 for a stuck follower."))
+                              "flight, the Filippov sliding mode on v_r = 0 for a stuck follower." if q == "alpha" else
+                              "Acceleration y_ddot along the guide in mode m: m_f y_ddot = F_n - F_s in contact, "
+                              "-F_s in free flight (derive.translating)."))
     if A.surfaces:
         functions.append(Function("surface", _state_args(spec, "m", "s"), ("m", "s"), ("value",),
                                   _surface_cases(spec, A),
@@ -199,11 +235,11 @@ def build(spec: SceneSpec) -> SceneModule:
                                       "(camdyn.vocabulary); nan for a surface without a rate.",
                                       "separate"))
     functions.append(Function("jacobian", _state_args(spec, "m", out=True), ("m",),
-                              ("dalpha_ddot_dalpha", "dalpha_ddot_dalpha_dot"),
+                              (f"d{q}_ddot_d{q}", f"d{q}_ddot_d{q_dot}"),
                               _mode_cases(A, lambda mode: fields.jacobian(spec, mode)),
-                              "Second row of the state Jacobian in mode m (Eqs. 21-22): out[0] = "
-                              "d(alpha_ddot)/d(alpha), out[1] = d(alpha_ddot)/d(alpha_dot).", "fill"))
-    functions.append(Function("outputs", _state_args(spec, "m", out=True), ("m",), tuple(OUTPUTS),
+                              f"Second row of the state Jacobian in mode m (Eqs. 21-22): out[0] = "
+                              f"d({q}_ddot)/d({q}), out[1] = d({q}_ddot)/d({q_dot}).", "fill"))
+    functions.append(Function("outputs", _state_args(spec, "m", out=True), ("m",), tuple(outputs_of(spec.follower)),
                               _mode_cases(A, lambda mode: fields.outputs(spec, mode)),
                               "The output quantities in mode m: out[OUT_<NAME>] for each name of OUTPUTS.",
                               "fill"))
@@ -218,14 +254,15 @@ def _variational_functions(spec: SceneSpec, A: Automaton) -> tuple[Function, ...
     if spec.model == "nonlinear":
         names = fields.continuation_parameters(spec, A.modes)
         functions.append(Function("field_sensitivity", _state_args(spec, "m", out=True), ("m",),
-                                  tuple(f"dalpha_ddot_d{n}" for n in names),
+                                  tuple(f"d{state_names(spec.follower)[0]}_ddot_d{n}" for n in names),
                                   _mode_cases(A, lambda mode: fields.field_sensitivity(spec, mode, names)),
                                   "Derivatives of alpha_ddot in mode m by the continuation parameters of "
                                   "SENSITIVITY (total: the static equilibrium's alpha*, chi*, vartheta follow "
                                   "them), at a fixed state and time: out[SENS_<NAME>].", "fill"))
     if A.transitions:
+        q, q_dot = state_names(spec.follower)
         functions.append(Function("surface_gradient", _state_args(spec, "m", "s", out=True), ("m", "s"),
-                                  ("dh_dalpha", "dh_dalpha_dot", "dh_dt"), _gradient_cases(spec, A),
+                                  (f"dh_d{q}", f"dh_d{q_dot}", "dh_dt"), _gradient_cases(spec, A),
                                   "Gradient of switching surface s's value h under mode m's laws, for the "
                                   "surfaces m watches: out[GRAD_D_ALPHA] = dh/dalpha, out[GRAD_D_ALPHA_DOT] = "
                                   "dh/dalpha_dot, out[GRAD_D_T] = dh/dt at a fixed state (through Theta(t)); "

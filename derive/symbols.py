@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import sympy as sp
 from sympy.physics.vector import dynamicsymbols
 
-from camdyn.vocabulary import parameters as declared
+from camdyn.vocabulary import names as declared_names, parameters as declared
 
 t = dynamicsymbols._t  # the time symbol dynamicsymbols differentiate with
 
@@ -77,7 +77,12 @@ zeta_D = PARAMS["zeta_D"].symbol
 beta_D = PARAMS["beta_D"].symbol
 zeta_E = PARAMS["zeta_E"].symbol
 beta_E = PARAMS["beta_E"].symbol
+m_f = PARAMS["m_f"].symbol
+gamma = PARAMS["gamma"].symbol
+offset = PARAMS["offset"].symbol
+F_p = PARAMS["F_p"].symbol
 alpha_star = PARAMS["alpha_star"].symbol
+y_star = PARAMS["y_star"].symbol
 chi_star = PARAMS["chi_star"].symbol
 vartheta = PARAMS["vartheta"].symbol
 Omega_c = PARAMS["Omega_c"].symbol
@@ -86,6 +91,8 @@ omega_c = PARAMS["omega_c"].symbol
 
 # --- time functions: the generalized coordinate and the motion input ----------------
 alpha, Theta = dynamicsymbols("alpha Theta", real=True)
+#: the translating follower's coordinate: its face's distance from E along the guide (derive.translating)
+y = dynamicsymbols("y", real=True)
 
 # --- plain symbols that stand for the state and the cam in generated code -----------
 t_s = sp.Symbol("t", real=True)  # plain, real time (dynamicsymbols._t has no assumptions)
@@ -94,10 +101,37 @@ alpha_dot = sp.Symbol("alpha_dot", real=True)
 Theta_s = sp.Symbol("Theta", real=True)
 Theta_dot = sp.Symbol("Theta_dot", real=True)
 Theta_ddot = sp.Symbol("Theta_ddot", real=True)
+y_s = sp.Symbol("y", real=True)
+y_dot = sp.Symbol("y_dot", real=True)
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """A follower's generalized coordinate: its name and unit (camdyn.vocabulary.COORDINATES),
+    its function of time in the derivation, and the plain symbols of it and its rate in generated
+    code (the kernels' arguments); ``acceleration`` is the named quantity the field computes."""
+
+    name: str
+    unit: str
+    function: sp.Expr
+    plain: sp.Symbol
+    rate: sp.Symbol
+
+    @property
+    def acceleration(self) -> sp.Symbol:
+        return sp.Symbol(f"{self.name}_ddot", real=True)
+
+
+#: the coordinate of each follower type (the scene option ``follower``; its name and unit are the
+#: vocabulary's, camdyn.vocabulary.COORDINATES)
+_TIME_FUNCTIONS = {"alpha": (alpha, alpha_s, alpha_dot), "y": (y, y_s, y_dot)}
+COORDINATES = {follower: Coordinate(name, unit, *_TIME_FUNCTIONS[name])
+               for follower, (name, unit, _) in declared_names.COORDINATES.items()}
 
 
 def to_plain(expr: sp.Expr) -> sp.Expr:
-    """Replace alpha(t), Theta(t) and their derivatives by plain symbols.
+    """Replace alpha(t) (or the translating follower's y(t)), Theta(t) and their derivatives by plain
+    symbols.
 
     Higher derivatives first, so that d/dt alpha(t) is not mangled into
     d/dt alpha_s.  alpha_ddot never appears: the equations of motion are
@@ -108,5 +142,6 @@ def to_plain(expr: sp.Expr) -> sp.Expr:
             Theta.diff(t, 2): Theta_ddot,
             Theta.diff(t): Theta_dot,
             alpha.diff(t): alpha_dot,
+            y.diff(t): y_dot,
         }
-    ).subs({Theta: Theta_s, alpha: alpha_s}).subs(t, t_s)
+    ).subs({Theta: Theta_s, alpha: alpha_s, y: y_s}).subs(t, t_s)

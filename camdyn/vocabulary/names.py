@@ -55,14 +55,49 @@ OUTPUTS: dict[str, tuple[str, str]] = {
     "F_n": ("N", "normal contact force (Eq. 12)"),
     "F_f": ("N", "friction force F_f = mu F_n"),
     "v_r": ("m/s", "sliding velocity used by the friction law"),
-    "N_x": ("N", "horizontal bearing force at the pivot (Eq. 35)"),
+    "N_x": ("N", "horizontal bearing force at the pivot (Eq. 35); the translating follower: the guide's "
+                 "reaction across it"),
     "alpha_i": ("rad", "follower angle in rigid contact (Eq. 29)"),
     "energy": ("J", "mechanical energy T + V_s + V_c (Section 5)"),
     "P_in": ("W", "power delivered by the cam drive"),
     "D_c": ("W", "power dissipated by contact damping"),
     "D_f": ("W", "power dissipated by friction"),
 }
-#: the continuous state, in order: as a reset writes it to ``out``, as the engine samples it
+#: the follower's coordinate, by follower type (the scene option ``follower``): its name, unit and
+#: meaning; the state is the coordinate and its rate, (name, name + "_dot"), the kernels' arguments
+COORDINATES: dict[str, tuple[str, str, str]] = {
+    "oscillating": ("alpha", "rad", "follower angle alpha, clockwise from the horizontal (Fig. 1)"),
+    "translating": ("y", "m", "the face's distance y from the cam's centre E along the guide"),
+}
+#: the generated kernel of the static load at the cam angle theta0 (Eqs. 16-18), by follower type:
+#: the moment about P, or the force along the guide; each returns (load, its derivative by the
+#: coordinate, psi_i, psi_j, k_lambda)
+STATIC_LOAD = {"oscillating": "static_moment", "translating": "static_force"}
+
+
+def state_names(follower: str) -> tuple[str, str]:
+    """The names of the state of a follower type: its coordinate and the coordinate's rate."""
+    name = COORDINATES[follower][0]
+    return name, name + "_dot"
+
+
+#: the output of the follower's coordinate in rigid contact (Eq. 29), by follower type
+RIGID_OUTPUT = {"oscillating": "alpha_i", "translating": "y_i"}
+
+
+def outputs_of(follower: str) -> dict[str, tuple[str, str]]:
+    """The OUTPUTS of a follower type, in their order: the translating follower's rigid-contact
+    coordinate is y_i (m) where the oscillating follower's is alpha_i (rad)."""
+    if follower == "oscillating":
+        return dict(OUTPUTS)
+    return {(RIGID_OUTPUT[follower] if k == "alpha_i" else k):
+            (("m", "the follower's position in rigid contact, y = h(gamma - Theta)") if k == "alpha_i" else v)
+            for k, v in OUTPUTS.items()}
+
+
+#: the continuous state, in order: as a reset writes it to ``out``, as the engine samples it: the
+#: follower's coordinate (alpha; y for the translating follower, COORDINATES) and its rate; the
+#: index constants are positions, whatever the follower
 STATE = ("alpha", "alpha_dot")
 STATE_ALPHA, STATE_ALPHA_DOT = range(len(STATE))
 #: the entries the generated ``jacobian`` kernel writes to ``out``, in order: the partial

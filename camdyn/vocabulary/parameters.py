@@ -22,7 +22,7 @@ import operator
 from dataclasses import dataclass
 from typing import Union
 
-__all__ = ["Rule", "Constant", "RigParameter", "RIG_PARAMETERS", "EQUILIBRIUM_QUANTITIES", "CAM_CONSTANTS",
+__all__ = ["Rule", "Constant", "RigParameter", "FOLLOWER_TYPES", "RIG_PARAMETERS", "EQUILIBRIUM_QUANTITIES", "CAM_CONSTANTS",
            "RIG_NAMES", "EQUILIBRIUM_NAMES", "CAM_NAMES"]
 
 #: the comparisons a rule may make; ``abs<``: |x| < bound, ``abs<=``: |x| <= bound
@@ -81,6 +81,10 @@ class RigParameter:
     """One rig parameter: ``required`` ones every scene reads; the others (None: not given)
     only the scenes whose laws use them, which demand them by name.
 
+    ``follower``: the follower type the parameter belongs to (``"oscillating"``: the paper's
+    rocker, ``"translating"``: the flat face on a guide), or ``""`` for both; ``required`` holds
+    for the rigs of that type, and a rig of the other type may not give it.
+
     ``neutral``: for a constant that a model edit adds to one of the paper's laws (a cubic
     spring coefficient), the value that reduces the law to the paper's (0 for an added term).
     ``camdyn regenerate`` writes it into the shipped rig files that lack the parameter, and
@@ -95,6 +99,7 @@ class RigParameter:
     ref: str
     rules: tuple[Rule, ...] = ()
     neutral: Union[float, None] = None
+    follower: str = ""
 
     def __post_init__(self):
         if self.neutral is not None and self.required:
@@ -104,6 +109,17 @@ class RigParameter:
                   and not r.holds(self.neutral, {})]
         if broken:
             raise ValueError(f"RigParameter {self.name!r}: its neutral value {self.neutral!r} must be {broken[0]}")
+        if self.follower not in ("",) + FOLLOWER_TYPES:
+            raise ValueError(f"RigParameter {self.name!r}: follower {self.follower!r} is not '' or one of "
+                             f"{FOLLOWER_TYPES}")
+
+    def required_for(self, follower: str) -> bool:
+        """Whether a rig of the follower type ``follower`` must give the parameter."""
+        return self.required and self.follower in ("", follower)
+
+    def belongs_to(self, follower: str) -> bool:
+        """Whether a rig of the follower type ``follower`` may give the parameter."""
+        return self.follower in ("", follower)
 
     @property
     def sign(self) -> str:
@@ -114,6 +130,10 @@ class RigParameter:
                 return "positive" if r.op == ">" else "nonnegative"
         return ""
 
+
+#: the follower types (camdyn.vocabulary.scenes.FOLLOWERS: the scene option that derives each)
+FOLLOWER_TYPES = ("oscillating", "translating")
+_OSC, _TRANS = FOLLOWER_TYPES
 
 _MM = "given in mm? camdyn uses SI metres"
 _DEGREES = "given in degrees? camdyn uses radians"
@@ -130,27 +150,38 @@ RIG_PARAMETERS: tuple[RigParameter, ...] = (
     RigParameter("r_c", "m", "cam radius", True, "Eq. 4", _LENGTH),
     RigParameter("e", "m", "cam eccentricity, distance from the cam pivot E to the cam centre", True, "Eq. 3", (
         _NON_NEGATIVE, Rule("<", "r_c", "the cam pivot E must lie inside the cam disk"))),
-    RigParameter("w_b", "m", "follower bar width", True, "Eq. 2", _LENGTH),
+    RigParameter("w_b", "m", "follower bar width", True, "Eq. 2", _LENGTH, follower=_OSC),
     RigParameter("chi0", "m", "distance from the follower pivot P to the contact along the bar in the 0-state",
-                 True, "Eq. 2, 5", _LENGTH),
+                 True, "Eq. 2, 5", _LENGTH, follower=_OSC),
     RigParameter("alpha0", "rad", "follower angle from the horizontal, clockwise, in the 0-state", True, "Eq. 5", (
         Rule("abs<=", _HALF_PI, _DEGREES, guard=True, shown="pi/2"),
-        Rule("abs<", _HALF_PI - 0.05, "tan and sec in Eq. 11 blow up near 90 degrees", shown="pi/2 - 0.05"))),
+        Rule("abs<", _HALF_PI - 0.05, "tan and sec in Eq. 11 blow up near 90 degrees", shown="pi/2 - 0.05")), follower=_OSC),
     RigParameter("theta0", "rad", "cam angle in the 0-state, counter-clockwise from the horizontal", True, "Eq. 5", (
         Rule("abs<=", 2 * math.pi, _DEGREES, guard=True, shown="2 pi"),)),
     RigParameter("d_x", "m", "horizontal distance from the follower pivot P to the spring", True, "Eq. 10, 11",
-                 _LENGTH),
+                 _LENGTH, follower=_OSC),
     RigParameter("d_y", "m", "height of the follower pivot P above the ground", True, "Eq. 11", (
-        Rule("abs<=", 10.0, _MM, guard=True),)),
-    RigParameter("L_us", "m", "free length of the follower spring", True, "Eq. 11", _LENGTH),
+        Rule("abs<=", 10.0, _MM, guard=True),), follower=_OSC),
+    RigParameter("L_us", "m", "free length of the follower spring", True, "Eq. 11", _LENGTH, follower=_OSC),
     RigParameter("k_s", "N/m", "follower spring stiffness", True, "Eq. 11", (_POSITIVE,)),
     RigParameter("I_Pb", "kg m^2", "moment of inertia of the follower about its pivot P", True, "Eq. 10", (
         _POSITIVE, Rule(">=", 1e-9, "given in g mm^2 or kg mm^2? camdyn uses SI kg m^2 (a follower lighter "
-                                    "than 1e-9 kg m^2 has a contact mode too fast to integrate)", guard=True))),
+                                    "than 1e-9 kg m^2 has a contact mode too fast to integrate)", guard=True)), follower=_OSC),
     RigParameter("Y_c", "Pa", "Young's modulus of the cam", True, "Eq. 14", _MODULUS),
     RigParameter("Y_b", "Pa", "Young's modulus of the follower", True, "Eq. 14", _MODULUS),
     RigParameter("nu_c", "1", "Poisson's ratio of the cam", True, "Eq. 14", _POISSON),
     RigParameter("nu_b", "1", "Poisson's ratio of the follower", True, "Eq. 14", _POISSON),
+    # the translating follower (Scene(follower="translating"), derive.translating): required for its rigs
+    RigParameter("m_f", "kg", "mass of the translating follower (its parts that move along the guide)", True,
+                 "translating follower", (_POSITIVE, Rule(">=", 1e-6, "given in g? camdyn uses SI kg", guard=True)),
+                 follower=_TRANS),
+    RigParameter("gamma", "rad", "angle of the translating follower's guide from the horizontal, counter-clockwise "
+                 "(pi/2: the follower above the cam); its face is normal to the guide", True, "translating follower",
+                 (Rule("abs<=", 2 * math.pi, _DEGREES, guard=True, shown="2 pi"),), follower=_TRANS),
+    RigParameter("offset", "m", "offset of the translating follower's guide axis from the cam's centre E, along "
+                 "its face", True, "translating follower", (Rule("abs<=", 10.0, _MM, guard=True),), follower=_TRANS),
+    RigParameter("F_p", "N", "spring force on the translating follower in the 0-state (its face touching the cam "
+                 "at theta0): the preload there", True, "translating follower", (_POSITIVE,), follower=_TRANS),
     # optional: the contact length, the friction laws, the damping models, each used by some scenes
     RigParameter("l_lambda", "m", "length of the line contact", False, "Eq. 13", _LENGTH),
     RigParameter("mu_m", "1", "friction coefficient", False, "Sec. 3.2, friction models I and II",
@@ -177,6 +208,8 @@ EQUILIBRIUM_QUANTITIES: tuple[Constant, ...] = (
     Constant("chi_star", "m", "chi* = chi0 - psi_j* at static equilibrium", "positive"),
     Constant("vartheta", "rad/s", "undamped linearized natural frequency (Eq. 23, misprint 4)",
              "positive"),
+    Constant("y_star", "m", "static equilibrium position y* of the translating follower (its face's distance "
+             "from E along the guide)"),
 )
 
 #: the constants of a cam motion (its speed or its oscillation), set per run

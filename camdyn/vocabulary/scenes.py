@@ -13,7 +13,8 @@ MODELS = ("nonlinear", "linear_paper", "linear_exact")  # Eq. 10; Eqs. 36-38 as 
 SLIDING_VELOCITY_FORMS = ("kinematic", "printed")       # misprint 8
 DAMPING_SIGNS = ("dissipative", "printed")              # misprint 2
 DAMPING_SWITCHES = ("episode", "memoryless")            # Sec. 3.4, models D and E (see SceneSpec)
-FOLLOWERS = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
+FOLLOWERS = ("oscillating", "translating")              # the paper's rocker (Fig. 1); a flat face on a guide
+RESPONSES = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
 #: the cam's shape: the paper's eccentric circle (Eq. 3-4), or a convex cam given by its support
 #: function h(phi) (docs/model-editing.md, "a new cam"): a periodic piecewise quintic, or circular arcs
 ECCENTRIC = "eccentric"
@@ -30,18 +31,20 @@ OPTIONS: dict[str, tuple[str, ...]] = {
     "damping_switch": DAMPING_SWITCHES,
     "follower": FOLLOWERS,
     "profile": PROFILES,
+    "response": RESPONSES,
 }
 
 #: options that say how the runtime uses a derived model rather than what is derived: they have
 #: no kernels of their own (the scene's kernels are those of its ``derived`` spec)
-RUNTIME_OPTIONS = ("follower",)
+RUNTIME_OPTIONS = ("response",)
 
 #: the slug's suffix word of each non-default misprint or switch option
 SLUG_SUFFIXES: dict[str, tuple[str, str]] = {
     "vrprinted": ("sliding_velocity", "printed"),
     "printedsign": ("damping_sign", "printed"),
     "memoryless": ("damping_switch", "memoryless"),
-    "quasistatic": ("follower", "quasistatic"),
+    "quasistatic": ("response", "quasistatic"),
+    "translating": ("follower", "translating"),
     "spline": ("profile", "spline"),
     "arcs": ("profile", "arcs"),
 }
@@ -72,13 +75,17 @@ class SceneSpec:
                           until separation t_c: one switch per contact episode) or "memoryless"
                           (the law follows the sign of psi_i_dot at every instant: loading while
                           psi_i_dot < 0, viscous otherwise)
-        follower: "dynamic" (the hybrid model: free flight, impacts, contact) or "quasistatic"
-                  (no integration: Eq. 10 solved for alpha with alpha_dot, alpha_ddot of the rigid
-                  kinematics, Eq. 29, for a follower that never leaves the cam; camdyn.runs.quasistatic)
+        follower: "oscillating" (the paper's flat-faced rocker on the pivot P, Fig. 1: its
+                  coordinate is the angle alpha) or "translating" (a flat face normal to a guide, mass
+                  m_f, spring and preload along the guide: its coordinate is the face's distance y
+                  from the cam's centre; derive.translating)
         profile:  "eccentric" (the paper's circle, Eqs. 3-4), "spline" (a convex cam given by its
                   support function h(phi) as a periodic piecewise quintic) or "arcs" (a cam of
                   circular arcs, whose junctions are switching surfaces); the profile's data
                   travels with the rig (camdyn.model.profiles)
+        response: "dynamic" (the hybrid model: free flight, impacts, contact) or "quasistatic"
+                  (no integration: Eq. 10 solved for alpha with alpha_dot, alpha_ddot of the rigid
+                  kinematics, Eq. 29, for a follower that never leaves the cam; camdyn.runs.quasistatic)
     """
 
     contact: str = "line"
@@ -89,10 +96,15 @@ class SceneSpec:
     sliding_velocity: str = "kinematic"
     damping_sign: str = "dissipative"
     damping_switch: str = "episode"
-    follower: str = "dynamic"
+    follower: str = "oscillating"
     profile: str = ECCENTRIC
+    response: str = "dynamic"
 
     def __post_init__(self):
+        if self.follower in RESPONSES:
+            raise SceneOptionError(f"scene option follower={self.follower!r}: the choice between the hybrid model "
+                                   f"and the quasi-static contact orbit is the option response={self.follower!r} "
+                                   f"now; follower names the follower's type, one of {FOLLOWERS}")
         for f in fields(self):
             value = getattr(self, f.name)
             if value not in OPTIONS[f.name]:
@@ -164,9 +176,16 @@ def combination_problem(spec: SceneSpec) -> str:
             return f"profile={spec.profile!r} needs model='nonlinear' (the linear models are the paper's, Section 8)"
         if spec.sliding_velocity != "kinematic":
             return f"profile={spec.profile!r} needs sliding_velocity='kinematic' (the printed form is the paper's circle)"
-        if spec.follower != "dynamic":
+        if spec.response != "dynamic":
             return (f"profile={spec.profile!r} has no quasi-static follower yet: its rigid contact angle is "
-                    "implicit (use follower='dynamic')")
+                    "implicit (use response='dynamic')")
+    if spec.follower == "translating":
+        if spec.model != "nonlinear":
+            return "follower='translating' needs model='nonlinear' (the linear models are the paper's, Section 8)"
+        if spec.sliding_velocity != "kinematic":
+            return "follower='translating' needs sliding_velocity='kinematic' (the printed form is the paper's rocker)"
+        if spec.response != "dynamic":
+            return "follower='translating' has no quasi-static response yet (use response='dynamic')"
     if spec.model == "linear_paper" and spec.contact != "line":
         return "model='linear_paper' is the paper's Eqs. 36-38, for line contact only"
     return ""

@@ -40,4 +40,11 @@ CATALOG: tuple[SceneSpec, ...] = tuple(_IMPACT + [
     SceneSpec(damping="D", friction="coulomb", model="linear_exact"),
     # a cam motion given by the user as a function of time
     SceneSpec(damping="D", friction="tanh", motion="user"),
+    # the translating flat-faced follower (issue 27): on the eccentric circle (its lift is harmonic)
+    # and on a cam given by its support function (a motion law's cam)
+    SceneSpec(damping="D", friction="none", follower="translating"),
+    SceneSpec(damping="D", friction="none", follower="translating", profile="spline"),
+    # its statics (equilibrium, inverse kinematics: camdyn.analysis.statics) on either cam
+    SceneSpec(damping="none", friction="none", follower="translating"),
+    SceneSpec(damping="none", friction="none", follower="translating", profile="spline"),
 ])

@@ -24,6 +24,8 @@ SCENES = {
     'line_d_coulomb_oscillating_nonlinear_vrprinted': 'scene_line_d_coulomb_oscillating_nonlinear_vrprinted',
     'line_d_none_constant_nonlinear': 'scene_line_d_none_constant_nonlinear',
     'line_d_none_constant_nonlinear_printedsign': 'scene_line_d_none_constant_nonlinear_printedsign',
+    'line_d_none_constant_nonlinear_translating': 'scene_line_d_none_constant_nonlinear_translating',
+    'line_d_none_constant_nonlinear_translating_spline': 'scene_line_d_none_constant_nonlinear_translating_spline',
     'line_d_tanh_constant_nonlinear': 'scene_line_d_tanh_constant_nonlinear',
     'line_d_tanh_constant_nonlinear_vrprinted': 'scene_line_d_tanh_constant_nonlinear_vrprinted',
     'line_d_tanh_oscillating_nonlinear': 'scene_line_d_tanh_oscillating_nonlinear',
@@ -33,6 +35,8 @@ SCENES = {
     'line_e_coulomb_constant_nonlinear_memoryless': 'scene_line_e_coulomb_constant_nonlinear_memoryless',
     'line_none_coulomb_constant_nonlinear': 'scene_line_none_coulomb_constant_nonlinear',
     'line_none_none_constant_nonlinear': 'scene_line_none_none_constant_nonlinear',
+    'line_none_none_constant_nonlinear_translating': 'scene_line_none_none_constant_nonlinear_translating',
+    'line_none_none_constant_nonlinear_translating_spline': 'scene_line_none_none_constant_nonlinear_translating_spline',
     'point_d_coulomb_constant_nonlinear': 'scene_point_d_coulomb_constant_nonlinear',
     'point_none_none_constant_nonlinear': 'scene_point_none_none_constant_nonlinear',
 }

@@ -28,10 +28,10 @@ class Outcome(ActionableOutcome):
     NONFINITE = "the state became NaN or infinite; check the rig parameters and tolerances"
     ANGLE_LIMIT = ("the follower angle approached 90 degrees, where tan(alpha) and sec(alpha) of "
                    "Eq. 11 blow up; the follower has left the cam for good")
-    #: the scene option follower="quasistatic" (camdyn.runs.quasistatic), never the engine's loop (whose
+    #: the scene option response="quasistatic" (camdyn.runs.quasistatic), never the engine's loop (whose
     #: codes index camdyn.engine.loop.OUTCOMES, the members above): the samples stop before it
     CONTACT_TENSILE = ("the quasi-static contact force F_n would turn tensile (<= 0): the follower leaves the "
                        "cam there (result.stats['where'] says when and at which cam angle) and the quasi-static "
-                       "orbit does not exist; use the full model (follower='dynamic')")
+                       "orbit does not exist; use the full model (response='dynamic')")
     NO_QUASI_STATIC = ("no contact deformation carries the follower's inertia (Newton's method did not converge; "
-                       "result.stats['where'] says when): use the full model (follower='dynamic')")
+                       "result.stats['where'] says when): use the full model (response='dynamic')")

@@ -11,6 +11,15 @@ from camdyn.engine import BACKENDS as _BACKENDS  # "compiled", "python"
 RIG = camdyn.example_rig()
 
 
+def rig_for(scene: camdyn.Scene) -> camdyn.Rig:
+    """The example rig of a scene's follower and cam family: the paper's follower (RIG) or the translating
+    example, on the eccentric circle or on a cycloidal cam (a spline: camdyn.model.presets)."""
+    from camdyn.model import presets
+    if scene.follower == "translating":
+        return presets.translating_cam_example_rig() if scene.profile == "spline" else presets.translating_example_rig()
+    return presets.cam_example_rig() if scene.profile == "spline" else RIG
+
+
 def scene_from_slug(slug: str) -> camdyn.Scene:
     """Rebuild a Scene from a generated module's SCENE table."""
     import importlib

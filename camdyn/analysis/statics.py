@@ -24,7 +24,13 @@ def _static_scene(contact: str, rig: Rig | None = None) -> Scene:
     if contact not in ("line", "point"):
         raise ParameterError("contact", contact, "'line' or 'point'")
     profile = ECCENTRIC if rig is None or rig.profile_data is None else rig.profile_data[0]
-    return Scene(contact=contact, damping="none", friction="none", profile=profile)
+    follower = "oscillating" if rig is None else rig.follower
+    return Scene(contact=contact, damping="none", friction="none", profile=profile, follower=follower)
+
+
+def inertia(rig: Rig) -> float:
+    """The follower's inertia along its coordinate: I_Pb (kg m^2), or the translating follower's m_f (kg)."""
+    return rig.m_f if rig.follower == "translating" else rig.I_Pb
 
 
 def rigid_kinematics(rig: Rig, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -32,10 +38,14 @@ def rigid_kinematics(rig: Rig, theta) -> tuple[np.ndarray, np.ndarray, np.ndarra
     contact, its second derivative in Theta (1/rad) and the spring's moment there (N m).  The
     paper's circle: Eq. 29's closed form (the generated ``rigid_contact``, after the reach check);
     any other cam: the root of the gap (camdyn.model.followers.rigid_contact, Newton) and the
-    generated ``spring_moment``."""
+    generated ``spring_moment``.  The translating follower on any cam: (y_i, y_i'', F_s), with
+    y_i = h(gamma - Theta) in closed form (the generated ``rigid_contact``; m, m/rad^2, N)."""
     theta = np.atleast_1d(np.asarray(theta, dtype=float))
     K = _static_scene("line", rig).kernels()
     p = static_parameters(rig, K)
+    if rig.follower == "translating":
+        y_i, _, curvature, spring_force = np.array([K.rigid_contact(th, p) for th in theta]).T
+        return y_i, curvature, spring_force
     if rig.profile is None:
         if np.any(np.array([K.reach(th, p) for th in theta]) <= 0):
             raise GeometryError("the follower cannot reach the cam at some cam angle (|PG_c| < r_c + w_b/2)")
@@ -125,11 +135,14 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     first where I_Pb alpha_i'' Omega^2 + F_s d_x = 0 with alpha_i'' < 0:
     Omega_loss^2 = min over Theta of F_s d_x / (-I_Pb alpha_i'').  Friction only
     scales F_n, as long as chi > mu w_b / 2, so it does not move the loss speed.
+    The translating follower: m_f y_i'' Omega^2 + F_s = F_n >= 0, the same with m_f and F_s
+    (its face's friction acts across the guide).
     Returns inf when no cam angle decelerates the follower (e = 0).
     """
     thetas = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
     alpha_i, curvature, spring_moment = rigid_kinematics(rig, thetas)
-    if np.any(np.abs(alpha_i) > ANGLE_LIMIT):
+    I = inertia(rig)
+    if rig.follower != "translating" and np.any(np.abs(alpha_i) > ANGLE_LIMIT):
         raise GeometryError("in rigid contact the follower would pass 90 degrees over a revolution")
     if np.any(spring_moment <= 0):
         return 0.0
@@ -139,9 +152,9 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
 
     def ratio(th):
         _, c, m = (float(x[0]) for x in rigid_kinematics(rig, th))
-        return m / (-rig.I_Pb * c) if c < 0 else math.inf
+        return m / (-I * c) if c < 0 else math.inf
 
-    i = int(np.argmin(np.where(pulling, spring_moment / (-rig.I_Pb * np.where(pulling, curvature, -1)), np.inf)))
+    i = int(np.argmin(np.where(pulling, spring_moment / (-I * np.where(pulling, curvature, -1)), np.inf)))
     from scipy.optimize import minimize_scalar
     step = 2 * math.pi / samples
     best = minimize_scalar(ratio, bracket=None, bounds=(thetas[i] - step, thetas[i] + step),

@@ -50,7 +50,7 @@ API_PHRASES = {"jacobian=camdyn.orbits.tangent.variational": ("jacobian", "{flag
                "ContinuationSettings.min_step": ("min_arclength_step", "{flag}"),
                "ContinuationSettings.max_step": ("max_arclength_step", "{flag}"),
                "ContinuationSettings.max_points": ("max_points", "{flag}"),
-               "friction='tanh'": ("friction", "{flag} tanh"), "follower='dynamic'": ("follower", "{flag} dynamic"), "another start value": ("start", "another {flag}")}
+               "friction='tanh'": ("friction", "{flag} tanh"), "response='dynamic'": ("response", "{flag} dynamic"), "another start value": ("start", "another {flag}")}
 
 
 def _flags(parser) -> dict[str, str]:

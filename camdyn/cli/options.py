@@ -67,8 +67,21 @@ def _scene(args, motion: str = "constant"):
                  sliding_velocity=getattr(args, "sliding_velocity", "kinematic"),
                  damping_sign=getattr(args, "damping_sign", "dissipative"),
                  damping_switch=getattr(args, "damping_switch", "episode"),
-                 follower=getattr(args, "follower", "dynamic"),
+                 response=getattr(args, "response", "dynamic"), follower=_follower(args),
                  profile=_profile(args))
+
+
+def _follower(args) -> str:
+    """The scene's follower type: --follower, else the --rig file's (camdyn.model.rig: ``follower``)."""
+    given = getattr(args, "follower", None)
+    if given:
+        return given
+    from ..errors import CamdynError
+    from ..model.presets import load_rig
+    try:
+        return load_rig(getattr(args, "rig", "example")).follower
+    except CamdynError:  # the rig's own error is raised where the rig is read (_rig)
+        return "oscillating"
 
 
 def _profile(args) -> str:
@@ -114,9 +127,12 @@ def _add_physics(p, contact: bool = True, full: bool = True):
         g.add_argument("--damping-switch", default="episode", choices=opts["damping_switch"], dest="damping_switch",
                        help="D/E: the impact law once per contact, until maximum compression (episode, Sec. 3.4), "
                             "or whenever the gap closes (memoryless) (default: episode)")
-        g.add_argument("--follower", default="dynamic", choices=opts["follower"],
+        g.add_argument("--response", default="dynamic", choices=opts["response"],
                        help="the hybrid model (dynamic), or the quasi-static contact orbit with no integration "
                             "(quasistatic: a follower that never leaves the cam) (default: dynamic)")
+        g.add_argument("--follower", default=None, choices=opts["follower"],
+                       help="the follower's type: the paper's oscillating rocker or a translating flat face "
+                            "(default: the --rig file's follower, else oscillating)")
 
 
 def _add_cam(p, required_speed: bool = False):

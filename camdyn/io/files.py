@@ -46,7 +46,9 @@ def check_suffix(path: str | Path, kind: str) -> str:
 
 
 def _columns(result) -> list[str]:
-    return ["t", "alpha", "alpha_dot", "Theta", "alpha_r"] + list(result.outputs)
+    """The time histories of a Result, its follower's state under their names (alpha or y)."""
+    q = result.meta.get("coordinate", "alpha")
+    return ["t", q, f"{q}_dot", "Theta", f"{q}_r"] + list(result.outputs)
 
 
 def write_csv(result, path: str | Path) -> None:

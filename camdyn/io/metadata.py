@@ -35,6 +35,10 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "Theta": ("rad", "cam angle, counter-clockwise"),
     "alpha_i": ("rad", "follower angle in rigid contact (Eq. 29)"),
     "alpha_r": ("rad", "residual response alpha - alpha_i (Section 4)"),
+    "y": ("m", "translating follower: its face's distance from the cam's centre along the guide"),
+    "y_dot": ("m/s", "translating follower: its velocity along the guide"),
+    "y_i": ("m", "translating follower in rigid contact, h(gamma - Theta)"),
+    "y_r": ("m", "residual response y - y_i"),
     "psi_i": ("m", "normal gap at the contact: > 0 apart, < 0 contact deflection (Eq. 6)"),
     "psi_j": ("m", "slide of the contact point along the follower (Eq. 7)"),
     "psi_i_dot": ("m/s", "rate of the normal gap psi_i"),
@@ -212,7 +216,7 @@ def run_attributes(result, rig=None, *, rig_source: str | None = None,
         "initial_state": "static equilibrium (alpha*, 0)" if "y0" not in settings else "y0",
         "outcome": result.outcome.name, "outcome_message": result.outcome.message,
         "period_s": float(result.period) if math.isfinite(result.period) else -1.0,
-        "alpha_star_rad": float(result.alpha_star),
+        "alpha_star_rad": float(result.q_star),
     }
     return attrs
 

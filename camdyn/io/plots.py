@@ -377,9 +377,9 @@ def poincare(result, *, transient_revolutions: float = 0.0, phase: float = 0.0, 
     with _style():
         fig, (ax,) = _figure(ax, figsize=(4.6, 3.6))
         keep = result.t >= result.t[0] + transient_revolutions * result.period
-        a_scale, a_unit = _prefix(result.alpha[keep] - result.alpha_star, "rad")
-        ax.plot((result.alpha[keep] - result.alpha_star) / a_scale, result.alpha_dot[keep], color="0.75", lw=0.5)
-        ax.plot((sec["alpha"] - result.alpha_star) / a_scale, sec["alpha_dot"], "o", color="k", ms=3.5,
+        a_scale, a_unit = _prefix(result.q[keep] - result.q_star, "rad")
+        ax.plot((result.q[keep] - result.q_star) / a_scale, result.q_dot[keep], color="0.75", lw=0.5)
+        ax.plot((sec["alpha"] - result.q_star) / a_scale, sec["alpha_dot"], "o", color="k", ms=3.5,
                 label=f"once per revolution ({sec['t'].size} points)")
         ax.set(xlabel=rf"$\alpha - \alpha^*$ ({a_unit})", ylabel=r"$\dot\alpha$ (rad/s)")
         ax.legend(loc="best")

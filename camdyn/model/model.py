@@ -17,16 +17,19 @@ from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
 from ..vocabulary.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
-from ..vocabulary import ECCENTRIC, JAC_D_ALPHA, JAC_D_ALPHA_DOT, SURFACE_GRADIENT
+from ..vocabulary import COORDINATES, ECCENTRIC, FOLLOWERS, JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATIC_LOAD, SURFACE_GRADIENT
 from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
-from .followers import follower_of_rig, rigid_contact
+from .followers import cam_of, follower_of_rig, rigid_contact
 from .scene import Scene, variational_kernels
 
 _DERIVED = EQUILIBRIUM_NAMES  # computed here, not given by the rig
 _CAM = CAM_NAMES              # given by the cam motion
 _PROFILE = "profile"          # a scene's input for the cam's profile data (derive.profile_code)
+_OSCILLATING, _TRANSLATING = FOLLOWERS
+#: each follower type's coordinate: its name and unit (for messages)
+_COORDINATE = {f: (name, unit) for f, (name, unit, _) in COORDINATES.items()}
 
 
 def _rig_values(rig: Rig) -> dict:
@@ -41,13 +44,18 @@ def _rig_values(rig: Rig) -> dict:
 class Equilibrium:
     """Static equilibrium at Theta = Theta0, all rates zero (Eqs. 16-18, 23)."""
 
-    alpha: float             # alpha* (rad)
+    q: float                 # the follower's coordinate: alpha* (rad), or the translating follower's y* (m)
     psi_i: float             # psi_i* (m), negative: the contact deflection
     psi_j: float             # psi_j* (m)
-    chi: float               # chi* = chi0 - psi_j* (m)
-    stiffness: float         # -dM/dalpha at alpha* (N m/rad): undamped, frictionless
+    chi: float               # chi* = chi0 - psi_j* (m); NaN for the translating follower (no moment arm)
+    stiffness: float         # -dM/dalpha at alpha* (N m/rad), or -dF/dy at y* (N/m): undamped, frictionless
     contact_stiffness: float  # k_lambda(psi_i*) (N/m), the secant stiffness (misprint 5)
-    vartheta: float          # sqrt(stiffness / I_Pb) (rad/s), Eq. 23 with misprint 4 and 7
+    vartheta: float          # sqrt(stiffness / I_Pb) (rad/s), Eq. 23 with misprint 4 and 7; / m_f translating
+
+    @property
+    def alpha(self) -> float:
+        """alpha* (rad): the coordinate q of the paper's oscillating follower."""
+        return self.q
 
     @property
     def frequency_Hz(self) -> float:
@@ -73,41 +81,55 @@ def static_parameters(rig: Rig, kernels: ModuleType) -> np.ndarray:
     return kernels.pack({name: math.nan if v is None else v for name, v in values.items()})
 
 
-def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
-    """alpha* from M(alpha*) = 0 near the 0-state, with M from the generated ``static_moment``.
+def zero_state(rig: Rig) -> float:
+    """The follower's coordinate in the 0-state (touching the cam at theta0): alpha0, or the translating
+    follower's y0 = h(gamma - theta0) on the rig's cam."""
+    if rig.follower == _TRANSLATING:
+        return float(cam_of(rig).h(rig.gamma - rig.theta0))
+    return rig.alpha0
 
-    At alpha0 the gap is zero at Theta0, so M(alpha0) = -F_s d_x: the spring must
-    press the follower onto the cam (F_s > 0), else there is no contact at rest.
-    The contact moment grows as alpha turns into the cam (alpha < alpha0), so the
-    root is bracketed by stepping down from alpha0.
+
+def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
+    """q* from M(q*) = 0 near the 0-state, with M the generated static load (``static_moment``, the
+    moment about P, Eqs. 16-18; the translating follower's ``static_force`` along its guide).
+
+    At the 0-state q0 (alpha0, y0) the gap is zero at Theta0, so M(q0) is the spring's load alone:
+    the spring must press the follower onto the cam (F_s > 0), else there is no contact at rest.
+    The contact's load grows as the coordinate moves into the cam (q < q0), so the root is
+    bracketed by stepping down from q0.
     """
     p = static_parameters(rig, kernels)
+    load = getattr(kernels, STATIC_LOAD[rig.follower])
+    q0, (name, unit) = zero_state(rig), _COORDINATE[rig.follower]
 
     def moment(a):
-        return kernels.static_moment(a, p)[0]
+        return load(a, p)[0]
 
-    M0 = moment(rig.alpha0)
+    M0 = moment(q0)
     if not M0 < 0:
+        hint = "increase L_us or lower d_y" if rig.follower == _OSCILLATING else "give a preload F_p > 0"
         raise EquilibriumError(
-            f"no static equilibrium in contact: at the 0-state (alpha0 = {rig.alpha0:g} rad) the spring "
-            f"moment is {-M0:g} N m, so the spring does not press the follower onto the cam. "
-            "It needs F_s > 0 there (Eq. 11): increase L_us or lower d_y.")
-    step, lo = 1e-9, rig.alpha0
+            f"no static equilibrium in contact: at the 0-state ({name}0 = {q0:g} {unit}) the spring's load is "
+            f"{-M0:g}, so the spring does not press the follower onto the cam. It needs F_s > 0 there (Eq. 11): "
+            f"{hint}.")
+    step, lo = 1e-9, q0
     while moment(lo) <= 0:
-        lo = rig.alpha0 - step
+        lo = q0 - step
         step *= 4
-        if rig.alpha0 - lo > 0.5:
-            raise EquilibriumError("no static equilibrium within 0.5 rad of alpha0: the contact "
-                                   "cannot balance the spring moment (check l_lambda, Y_c, Y_b, k_s)")
-    a_star = brentq(moment, lo, rig.alpha0, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-    _, dM, psi_i, psi_j, k_lambda = kernels.static_moment(a_star, p)
-    if abs(a_star) > ANGLE_LIMIT:
+        if q0 - lo > 0.5:
+            raise EquilibriumError(f"no static equilibrium within 0.5 {unit} of {name}0: the contact "
+                                   "cannot balance the spring (check l_lambda, Y_c, Y_b, k_s)")
+    a_star = brentq(moment, lo, q0, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+    _, dM, psi_i, psi_j, k_lambda = load(a_star, p)
+    if rig.follower == _OSCILLATING and abs(a_star) > ANGLE_LIMIT:
         raise GeometryError(f"static equilibrium alpha* = {a_star:g} rad is within "
                             f"{math.pi / 2 - abs(a_star):.3g} rad of 90 degrees, where Eq. 11 is singular")
     if not dM < 0:
-        raise EquilibriumError(f"the static equilibrium alpha* = {a_star:g} rad is unstable (dM/dalpha = {dM:g})")
-    return Equilibrium(float(a_star), float(psi_i), float(psi_j), float(rig.chi0 - psi_j), float(-dM),
-                       float(k_lambda), math.sqrt(-dM / rig.I_Pb))
+        raise EquilibriumError(f"the static equilibrium {name}* = {a_star:g} {unit} is unstable (d load/d{name} = {dM:g})")
+    chi = rig.chi0 - psi_j if rig.follower == _OSCILLATING else math.nan
+    inertia = rig.I_Pb if rig.follower == _OSCILLATING else rig.m_f
+    return Equilibrium(float(a_star), float(psi_i), float(psi_j), float(chi), float(-dM),
+                       float(k_lambda), math.sqrt(-dM / inertia))
 
 
 def _check_profile(rig: Rig, scene: Scene) -> None:
@@ -121,6 +143,13 @@ def _check_profile(rig: Rig, scene: Scene) -> None:
         raise SceneError(f"the scene's cam is a {scene.profile!r} profile but the rig has "
                          f"{'none (the eccentric circle)' if kind is None else repr(kind)}: give the rig a "
                          f"profile of that family (Rig(..., profile=...), camdyn.model.profiles)")
+
+
+def _check_follower(rig: Rig, scene: Scene) -> None:
+    """The scene's follower type must be the rig's (``Rig.follower``)."""
+    if scene.follower != rig.follower:
+        raise SceneError(f"the rig's follower is {rig.follower!r} but the scene's is {scene.follower!r}: use "
+                         f"Scene(..., follower={rig.follower!r}), or a rig of a {scene.follower} follower")
 
 
 def _check_cam(scene: Scene, cam) -> None:
@@ -151,13 +180,14 @@ class Model:
             raise TypeError(f"scene must be a camdyn.Scene, got {type(scene).__name__}")
         _check_cam(scene, cam)
         self.rig, self.scene, self.cam = rig, scene, cam
+        _check_follower(rig, scene)
         _check_profile(rig, scene)
         self.kernels = scene.kernels()
         optional = [n for n in self.kernels.INPUTS if n not in _DERIVED + _CAM + (_PROFILE,) and getattr(rig, n) is None]
         if optional:
             rig.require(*optional, why=f"scene {scene.slug}")
         self.equilibrium = solve_equilibrium(rig, self.kernels)
-        if scene.friction != "none" and self.equilibrium.chi <= rig.mu_m * rig.w_b / 2:
+        if scene.friction != "none" and scene.follower == _OSCILLATING and self.equilibrium.chi <= rig.mu_m * rig.w_b / 2:
             raise GeometryError(f"chi* = {self.equilibrium.chi:g} m <= mu_m w_b / 2: friction would lock "
                                 "the follower (the moment arm of Eq. 10 changes sign)")
         self._check_reach()
@@ -179,7 +209,8 @@ class Model:
     def _static_values(self) -> dict:
         """The rig's parameters and its static equilibrium by name: p without the cam's constants."""
         eq = self.equilibrium
-        return {**_rig_values(self.rig), "alpha_star": eq.alpha, "chi_star": eq.chi, "vartheta": eq.vartheta}
+        at_rest = {"alpha_star": eq.q, "chi_star": eq.chi} if self.scene.follower == _OSCILLATING else {"y_star": eq.q}
+        return {**_rig_values(self.rig), **at_rest, "vartheta": eq.vartheta}
 
     def _packed(self, cam: CamMotion) -> np.ndarray:
         """The kernels' parameter vector p: the rig, its static equilibrium and the cam's constants."""
@@ -245,7 +276,7 @@ class Model:
         """On a cam other than the circle the generated ``outputs`` has no closed form of alpha_i
         (Eq. 29): it is the root of the gap at the cam angle Theta(t), solved here
         (camdyn.model.followers.rigid_contact) into row OUT_ALPHA_I."""
-        if self.rig.profile is None:
+        if self.rig.profile is None or self.scene.follower != _OSCILLATING:  # a closed form in the kernel
             return values
         theta = self.cam_state(np.asarray(t, dtype=float))[0]
         values[self.kernels.OUT_ALPHA_I] = rigid_contact(self.rig.profile, follower_of_rig(self.rig),
@@ -260,7 +291,7 @@ class Model:
         step cannot be much longer than a few times 1/rate (its stability region), so the rate
         sets the work per simulated second; in an undamped contact mode it is vartheta (Eq. 23),
         a strong damping law or a steep friction law raises it."""
-        alpha = self.equilibrium.alpha
+        alpha = self.equilibrium.q
         best = Rate(0.0, self.kernels.MODES[0], False)
         for m, name in enumerate(self.kernels.MODES):
             ja, jad = self.jacobian(m, 0.0, alpha, 0.0)
@@ -319,7 +350,7 @@ class Model:
         return dict(zip(self.kernels.OUTPUTS, map(float, out)))
 
     def static_state(self) -> np.ndarray:
-        return np.array([self.equilibrium.alpha, 0.0])
+        return np.array([self.equilibrium.q, 0.0])
 
 
 def at_rest(rig: Rig, scene: Scene) -> Model:

@@ -59,6 +59,28 @@ def cam_example_rig(theta0: float | None = None) -> Rig:
     return rig_on_cam(rig, cam_from_law(law, follower_of_rig(rig), r_b=0.025), theta0=theta0)
 
 
+def translating_example_rig() -> Rig:
+    """An illustrative translating flat-faced follower on an eccentric circle (its lift is harmonic);
+    use it with ``Scene(follower="translating")``."""
+    return load_rig("translating-example")
+
+
+def translating_cam_example_rig() -> Rig:
+    """:func:`translating_example_rig`'s follower on a cycloidal rise-dwell-return cam: 10 mm of lift,
+    rise and return over 100 degrees, dwells of 80, base circle 15 mm (the 0-state on it, in the low
+    dwell at theta0 = 320 degrees, as the eccentric rig's); use it with ``Scene(follower="translating", profile="spline")``."""
+    import math
+
+    from .followers import TranslatingFollower
+    from .motion_laws import rise_dwell_return
+    from .synthesis import cam_from_law
+
+    rig, deg = translating_example_rig(), math.pi / 180
+    law = rise_dwell_return(0.01, (100 * deg, 80 * deg, 100 * deg, 80 * deg), law="cycloidal")
+    cam = cam_from_law(law, TranslatingFollower(rig.gamma, rig.offset), r_b=0.015)
+    return rig.replace(profile=cam, theta0=320 * deg, name="translating-cam-example")  # 320 deg: the low dwell
+
+
 def preset_files() -> list[Path]:
     """The shipped rig files, as files on disk (the package's data folder)."""
     folder = Path(str(resources.files("camdyn.model.data")))

@@ -49,7 +49,7 @@ else:  # pragma: no cover
 
 import numpy as np
 
-from ..vocabulary.parameters import RIG_PARAMETERS, RigParameter, Rule
+from ..vocabulary.parameters import FOLLOWER_TYPES, RIG_PARAMETERS, RigParameter, Rule
 from ..vocabulary.scenes import PROFILES
 from .._checks import is_real
 from ..errors import ParameterError, RigFileError
@@ -57,6 +57,8 @@ from ..errors import ParameterError, RigFileError
 __all__ = ["PARAMETERS", "NEUTRAL", "Parameter", "Rule", "Rig"]
 
 
+#: the paper's follower (Fig. 1), a rig's type where its file names none
+_OSCILLATING = FOLLOWER_TYPES[0]
 #: the units of :data:`PARAMETERS` that people read differently ("1": a pure number)
 _UNIT_WORDS = {"1": "dimensionless"}
 
@@ -74,7 +76,7 @@ class Parameter(RigParameter):
     @classmethod
     def declared(cls, row: RigParameter) -> Parameter:
         return cls(row.name, _UNIT_WORDS.get(row.unit, row.unit), row.description, row.required, row.ref,
-                   row.rules, row.neutral)
+                   row.rules, row.neutral, row.follower)
 
     @property
     def neutral_hint(self) -> str:
@@ -99,13 +101,17 @@ class Parameter(RigParameter):
         """Meaning and unit, e.g. ``"follower spring stiffness, N/m"``."""
         return f"{self.description}, {self.unit}"
 
-    def check(self, value: Any, known: Mapping[str, float]) -> float | None:
+    def check(self, value: Any, known: Mapping[str, float], follower: str = _OSCILLATING) -> float | None:
         """Return ``value`` as a float (``None`` if optional and not given) or raise
-        :class:`ParameterError`; ``known``: the parameters validated before this one."""
+        :class:`ParameterError`; ``known``: the parameters validated before this one; ``follower``:
+        the rig's follower type (a parameter of the other type may not be given)."""
         if value is None:
-            if self.required:
-                raise ParameterError(self.name, None, "required", reason=self.meaning)
+            if self.required_for(follower):
+                raise ParameterError(self.name, None, "required", reason=f"{self.meaning} ({follower} follower)")
             return None
+        if not self.belongs_to(follower):
+            raise ParameterError(self.name, value, f"not given for a {follower} follower",
+                                 reason=f"{self.meaning}: a parameter of the {self.follower} follower")
         x = math.nan
         if is_real(value):
             try:
@@ -132,7 +138,7 @@ PARAMETERS: tuple[Parameter, ...] = tuple(Parameter.declared(row) for row in RIG
 NEUTRAL: dict[str, float] = {p.name: p.neutral for p in PARAMETERS if p.neutral is not None}
 
 _BY_NAME = {p.name: p for p in PARAMETERS}
-_TEXT_FIELDS = ("name", "description")
+_TEXT_FIELDS = ("name", "description", "follower")
 _FIELDS = (*_BY_NAME, *_TEXT_FIELDS)
 
 
@@ -177,11 +183,13 @@ def _with_declared_fields(cls: type) -> type:
     the fields come from the declaration in ``camdyn.vocabulary.parameters``, not from a second list."""
     notes: dict[str, str] = {}
     for p in PARAMETERS:
-        notes[p.name] = "float" if p.required else "float | None"
-        if not p.required:
+        always = p.required and not p.follower  # required of every rig, whatever its follower
+        notes[p.name] = "float" if always else "float | None"
+        if not always:
             setattr(cls, p.name, None)
-    notes.update(name="str", description="str", origin="str", profile="object", profile_data="tuple")
-    cls.name, cls.description = "unnamed", ""
+    notes.update(name="str", description="str", follower="str", origin="str", profile="object",
+                 profile_data="tuple")
+    cls.name, cls.description, cls.follower = "unnamed", "", _OSCILLATING
     cls.origin = dataclasses.field(default="", compare=False)  # provenance, not physics
     # the cam's shape when it is not the paper's circle; compared and hashed by its data
     cls.profile = dataclasses.field(default=None, compare=False, repr=False)
@@ -205,9 +213,12 @@ class Rig:
     """
 
     def __post_init__(self) -> None:
+        if self.follower not in FOLLOWER_TYPES:
+            raise ParameterError("follower", self.follower, f"one of {FOLLOWER_TYPES}",
+                                 reason="the follower's type (Scene option follower)")
         known: dict[str, float] = {}
         for p in PARAMETERS:
-            known[p.name] = p.check(getattr(self, p.name), known)
+            known[p.name] = p.check(getattr(self, p.name), known, self.follower)
             object.__setattr__(self, p.name, known[p.name])
         for field in (*_TEXT_FIELDS, "origin"):
             if not isinstance(getattr(self, field), str):
@@ -262,7 +273,8 @@ class Rig:
         if not isinstance(d, Mapping):
             raise RigFileError(source, f"expected a table of parameters, got {type(d).__name__}")
         _check_names(d, source, (*_FIELDS, "origin"))
-        missing = [p.name for p in PARAMETERS if p.required and p.name not in d]
+        follower = d.get("follower", _OSCILLATING)
+        missing = [p.name for p in PARAMETERS if p.required_for(str(follower)) and p.name not in d]
         if missing:
             raise RigFileError(source, f"missing required parameter(s): {', '.join(missing)}", key=missing[0])
         try:
@@ -306,6 +318,10 @@ class Rig:
             "# camdyn rig file: SI units (see camdyn.model.rig.PARAMETERS)",
             f"name = {_toml_string(self.name)}",
             f"description = {_toml_string(self.description)}",
+        ]
+        if self.follower != _OSCILLATING:
+            lines.append(f"follower = {_toml_string(self.follower)}")
+        lines += [
             "",
             "[parameters]",
         ]
@@ -323,7 +339,9 @@ def _parameter_docs() -> str:
     """The numpydoc "Parameters" section of :class:`Rig`, generated from :data:`PARAMETERS`."""
     out = ["", "    Parameters", "    ----------"]
     for p in PARAMETERS:
-        out.append(f"    {p.name} : float, {p.unit}, {'required' if p.required else 'optional (None: not given)'}")
+        need = ("required" if not p.follower else f"required for a {p.follower} follower") if p.required \
+            else "optional (None: not given)"
+        out.append(f"    {p.name} : float, {p.unit}, {need}")
         text = f"{p.description[0].upper()}{p.description[1:]} ({p.ref}). Valid: {p.valid}."
         if p.neutral is not None:
             text += f" {p.name} = {p.neutral!r} gives the paper's law."
@@ -331,7 +349,9 @@ def _parameter_docs() -> str:
             if rule.guard:
                 text += f" Rejected unless {rule.text} ({rule.hint})."
         out.append(f"        {text}")
-    out += ["    name : str", "        Short name of the rig.", "    description : str", "        Free text."]
+    out += ["    name : str", "        Short name of the rig.", "    description : str", "        Free text.",
+            "    follower : str", f"        The follower's type, one of {FOLLOWER_TYPES} (default: the paper's "
+            "oscillating follower); the Scene's option follower must be the same."]
     return "\n".join(out) + "\n"
 
 

@@ -155,7 +155,7 @@ def motion_scale(model: Model, alpha: np.ndarray, alpha_dot: np.ndarray) -> np.n
     """The size of a motion, per state component: ``max |alpha - alpha*|`` (rad) and ``max
     |alpha_dot|`` (rad/s) over its samples, at least 1e-12 of each's unit (a motion at rest):
     the scale of shooting's residual and of the finite-difference steps."""
-    scale = np.array([np.max(np.abs(alpha - model.equilibrium.alpha)), np.max(np.abs(alpha_dot))])
+    scale = np.array([np.max(np.abs(alpha - model.equilibrium.q)), np.max(np.abs(alpha_dot))])
     tiny = np.array([1e-12, 1e-12 * model.equilibrium.vartheta])
     return np.maximum(scale, tiny)
 

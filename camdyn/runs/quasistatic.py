@@ -48,7 +48,7 @@ class QuasiStaticOutcome(ActionableOutcome):
 
     SUCCESS = "the quasi-static contact orbit holds at every time asked (F_n > 0 throughout)"
     TENSILE = ("the contact force F_n would turn tensile (<= 0): the follower leaves the cam there and the "
-               "quasi-static orbit does not exist; use the full model (follower='dynamic')")
+               "quasi-static orbit does not exist; use the full model (response='dynamic')")
     NEWTON_FAILED = ("Newton's method found no contact deformation that carries the inertia (no convergence): "
                      "the contact is too soft or the speed too high for a quasi-static contact; use the full model")
 

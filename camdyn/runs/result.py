@@ -8,6 +8,7 @@ import numpy as np
 
 from ..engine import Switches
 from ..outcome import Outcome
+from ..vocabulary import RIGID_OUTPUT
 
 
 class Outputs(Mapping):
@@ -56,17 +57,19 @@ class Outputs(Mapping):
 class Result:
     """Time histories of one run (SI units), sampled uniformly at ``t``.
 
-    Arrays: t, alpha, alpha_dot, Theta, alpha_i (rigid-contact angle, Eq. 29),
-    alpha_r = alpha - alpha_i (residual response, Section 4), psi_i, psi_j,
-    psi_i_dot, F_s, F_n, F_f, v_r, N_x, energy, P_in, D_c, D_f, and ``regime``
-    (the name of the regime active at each sample).  ``switches`` lists every
-    regime switch (:class:`~camdyn.engine.switches.Switches`: each a ``Switch``, the times as
-    ``switches.t``); ``outcome`` says how the run ended (check ``result.ok``).
+    Arrays: t, the follower's coordinate ``q`` and its rate ``q_dot`` under their names (the
+    paper's oscillating follower: alpha, alpha_dot, rad; the translating follower: y, y_dot, m),
+    Theta, the coordinate in rigid contact (alpha_i, Eq. 29; y_i) and the residual response
+    alpha_r = alpha - alpha_i (Section 4; y_r), psi_i, psi_j, psi_i_dot, F_s, F_n, F_f, v_r, N_x,
+    energy, P_in, D_c, D_f, and ``regime`` (the name of the regime active at each sample).
+    ``switches`` lists every regime switch (:class:`~camdyn.engine.switches.Switches`: each a
+    ``Switch``, the times as ``switches.t``); ``outcome`` says how the run ended (check ``result.ok``).
+    ``q_star`` is the coordinate at the static equilibrium (alpha*, y*).
     """
 
     t: np.ndarray
-    alpha: np.ndarray
-    alpha_dot: np.ndarray
+    q: np.ndarray
+    q_dot: np.ndarray
     Theta: np.ndarray
     regime: np.ndarray
     outputs: Mapping[str, np.ndarray]    # a dict, or Outputs (computed when first read)
@@ -75,22 +78,43 @@ class Result:
     stats: dict
     period: float
     scene: str
-    alpha_star: float
+    q_star: float
     meta: dict = field(default_factory=dict)
 
     def __getattr__(self, name):
         outputs = self.__dict__.get("outputs", {})
         if name in outputs:
             return outputs[name]
+        coordinate = self.__dict__.get("meta", {}).get("coordinate", "alpha")
+        if name in _NAMED and _NAMED[name][0] != coordinate:
+            raise AttributeError(f"Result has no attribute {name!r}: the follower's coordinate is {coordinate!r} "
+                                 f"(result.{coordinate}, or result.q)")
         raise AttributeError(f"Result has no attribute {name!r}")
+
+    def _named(self, name: str):
+        """The state quantity ``name`` (alpha, alpha_dot, ... or y, y_dot, ...) where it is this run's."""
+        coordinate, attribute = _NAMED[name]
+        if self.meta.get("coordinate", "alpha") != coordinate:
+            raise AttributeError(name)  # __getattr__ says why
+        return attribute(self)
+
+    alpha = property(lambda self: self._named("alpha"), doc="The oscillating follower's angle q (rad).")
+    alpha_dot = property(lambda self: self._named("alpha_dot"), doc="Its rate q_dot (rad/s).")
+    alpha_star = property(lambda self: self._named("alpha_star"), doc="alpha* (rad), the static equilibrium.")
+    alpha_r = property(lambda self: self._named("alpha_r"), doc="alpha - alpha_i, the residual response (Section 4).")
+    y = property(lambda self: self._named("y"), doc="The translating follower's position q (m).")
+    y_dot = property(lambda self: self._named("y_dot"), doc="Its velocity q_dot (m/s).")
+    y_star = property(lambda self: self._named("y_star"), doc="y* (m), the static equilibrium.")
+    y_r = property(lambda self: self._named("y_r"), doc="y - y_i, the residual response.")
+
+    @property
+    def residual(self) -> np.ndarray:
+        """The residual response: the coordinate less its value in rigid contact (alpha_r, y_r)."""
+        return self.q - self.outputs[RIGID_OUTPUT[self.meta.get("follower", "oscillating")]]
 
     @property
     def ok(self) -> bool:
         return self.outcome.ok
-
-    @property
-    def alpha_r(self) -> np.ndarray:
-        return self.alpha - self.outputs["alpha_i"]
 
     @property
     def in_contact(self) -> np.ndarray:
@@ -117,10 +141,10 @@ class Result:
     def after(self, t0: float) -> "Result":
         """The samples at t >= t0 (e.g. to drop a transient)."""
         keep = self.t >= t0
-        return Result(self.t[keep], self.alpha[keep], self.alpha_dot[keep], self.Theta[keep],
+        return Result(self.t[keep], self.q[keep], self.q_dot[keep], self.Theta[keep],
                       self.regime[keep], {k: v[keep] for k, v in self.outputs.items()},
                       self.switches[self.switches.t >= t0], self.outcome, self.stats,
-                      self.period, self.scene, self.alpha_star, self.meta)
+                      self.period, self.scene, self.q_star, self.meta)
 
     def summary(self) -> str:
         lines = [f"scene {self.scene}: {self.outcome.name} ({self.outcome.message})",
@@ -128,3 +152,9 @@ class Result:
                  f"  {len(self.switches)} regime switches, {self.impacts().size} impacts, "
                  f"{self.stats.get('steps', 0)} steps, {self.stats.get('nfev', 0)} RHS evaluations"]
         return "\n".join(lines)
+
+#: the state quantities by their names: (the coordinate they belong to, how to read them)
+_NAMED = {"alpha": ("alpha", lambda r: r.q), "alpha_dot": ("alpha", lambda r: r.q_dot),
+          "alpha_star": ("alpha", lambda r: r.q_star), "alpha_r": ("alpha", lambda r: r.residual),
+          "y": ("y", lambda r: r.q), "y_dot": ("y", lambda r: r.q_dot), "y_star": ("y", lambda r: r.q_star),
+          "y_r": ("y", lambda r: r.residual)}

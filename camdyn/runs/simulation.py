@@ -14,7 +14,7 @@ from ..model.model import Model
 from ..model.rig import PARAMETERS, Rig
 from ..model.scene import Scene
 from ..outcome import Outcome
-from ..vocabulary import CAM_THETA
+from ..vocabulary import CAM_THETA, COORDINATES
 from . import quasistatic, stopping
 from .pieces import integrate_in_pieces
 from .request import DEFAULT_BACKEND, RunRequest, Span, run_request
@@ -65,7 +65,7 @@ def simulate(rig: Rig, scene: Scene | None = None, cam: CamMotion | None = None,
     once-per-revolution section repeats (needs a whole number of samples per revolution) and
     completes the Result to the requested length by repeating the converged cycle
     (:mod:`camdyn.runs.stopping`; ``result.stats["revolutions_run"]``, ``["stop_period"]``).
-    A scene with ``follower="quasistatic"`` is not integrated: the Result holds the quasi-static
+    A scene with ``response="quasistatic"`` is not integrated: the Result holds the quasi-static
     contact orbit at the samples (:mod:`camdyn.runs.quasistatic`; alpha_dot the rigid rate), up to
     where it does not exist (``Outcome.CONTACT_TENSILE``, ``result.stats["where"]``).
 
@@ -92,7 +92,7 @@ def run(rig: Rig, scene: Scene | None, cam: CamMotion, request: RunRequest,
     span = request.span
     duration = span.duration(cam, model.equilibrium.vartheta)
     t_eval = span.times(duration)
-    if scene.follower == "quasistatic":
+    if scene.response == "quasistatic":
         return _quasi_static(model, t_eval, request)
     y0 = model.static_state() if request.y0 is None else np.asarray(request.y0, dtype=float)
     integrate_with = functools.partial(integrate, backend=request.backend)
@@ -116,13 +116,13 @@ def run(rig: Rig, scene: Scene | None, cam: CamMotion, request: RunRequest,
 
 
 def _quasi_static(model: Model, t_eval: np.ndarray, request: RunRequest) -> Result:
-    """The scene option follower="quasistatic": the quasi-static contact orbit at the samples
+    """The scene option response="quasistatic": the quasi-static contact orbit at the samples
     (:mod:`camdyn.runs.quasistatic`, no integration), its outputs from the generated kernel; the
     samples end before a time where it does not exist (the outcome says why, stats["where"] where)."""
     refused = {"y0": request.y0, "energy_ledger": request.options.ledger, "stop": request.stop}
     for name, value in refused.items():
         if value is not None and value is not False:
-            raise ParameterError(name, value, "not given with follower='quasistatic' (no integration: the orbit "
+            raise ParameterError(name, value, "not given with response='quasistatic' (no integration: the orbit "
                                  "has no start, ledger or stop)")
     orbit = quasistatic.orbit_at(model, t_eval)
     K = model.kernels
@@ -130,7 +130,7 @@ def _quasi_static(model: Model, t_eval: np.ndarray, request: RunRequest) -> Resu
     outcome = {"SUCCESS": Outcome.SUCCESS, "TENSILE": Outcome.CONTACT_TENSILE,
                "NEWTON_FAILED": Outcome.NO_QUASI_STATIC}[orbit.outcome.name]
     stats = {"nfev": 0, "steps": 0, "rejected_steps": 0, "njev": 0, "switches": 0, "backend": request.backend,
-             "follower": "quasistatic", "where": "" if orbit.ok else orbit.message}
+             "response": "quasistatic", "where": "" if orbit.ok else orbit.message}
     traj = Trajectory(orbit.t, np.vstack([orbit.alpha, orbit.alpha_dot]), mode, tuple(K.MODES),
                       Switches.none(transition_surfaces(K), K.MODES), outcome,
                       stats, int(mode[-1]) if mode.size else 0)
@@ -197,9 +197,11 @@ def _result(model: Model, traj, backend: str) -> Result:
     outputs = Outputs(names, functools.partial(_output_values, model, traj, backend))
     theta = np.broadcast_to(model.cam_state(t)[CAM_THETA], t.shape).astype(float) if t.size else t.copy()
     contact = dict(zip(K.MODES, map(bool, K.CONTACT_OF_MODE)))
+    follower = model.scene.follower
     return Result(t, alpha, alpha_dot, theta, traj.regime.astype(str), outputs, traj.switches,
-                  traj.outcome, traj.stats, model.period, model.scene.slug, model.equilibrium.alpha,
-                  {"rig": model.rig.name, "cam": model.cam, "contact": contact})
+                  traj.outcome, traj.stats, model.period, model.scene.slug, model.equilibrium.q,
+                  {"rig": model.rig.name, "cam": model.cam, "contact": contact, "follower": follower,
+                   "coordinate": COORDINATES[follower][0]})
 
 
 #: Result.outputs' names of the energy ledger's works of FLOWS (P_in, D_c, D_f), in that order

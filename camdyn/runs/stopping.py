@@ -201,7 +201,7 @@ def extend(result, t_eval: np.ndarray, period: int, per_rev: int, t_end: float):
     cycles = int(math.ceil((t_end - end) / cycle))
     continued = Switches.joined([kept, last.repeated(cycle, cycles)])
     outputs = {k: grown(v, k in ACCUMULATED) for k, v in result.outputs.items()}
-    return dataclasses.replace(result, t=t_eval.copy(), alpha=grown(result.alpha), alpha_dot=grown(result.alpha_dot),
+    return dataclasses.replace(result, t=t_eval.copy(), q=grown(result.q), q_dot=grown(result.q_dot),
                                Theta=grown(result.Theta, True), regime=grown(result.regime), outputs=outputs,
                                switches=continued[continued.t <= t_end])
 

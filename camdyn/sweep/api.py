@@ -108,7 +108,7 @@ class PoincareSection:
     def __call__(self, result: Result) -> dict:
         rate = _sample_rate(result)   # NaN for a run that stopped before its second sample
         per_rev = max(1, int(round(result.period * rate))) if math.isfinite(rate) else 1
-        section = result.alpha[::per_rev][self.transient_revolutions:]
+        section = result.q[::per_rev][self.transient_revolutions:]
         summary = Summary(self.transient_revolutions)(result)
         return {"alpha_section": (("revolution",), section), "impacts_per_rev": summary["impacts_per_rev"]}
 

@@ -107,7 +107,7 @@ class AttractorSection:
         if not result.ok or result.t.size == 0:
             return {**out, "cycle_alpha": ("cycle", []), "cycle_alpha_dot": ("cycle", [])}
         p = int(result.stats.get("stop_period", 0))
-        alpha, alpha_dot = result.alpha[-(p or self.max_period):], result.alpha_dot[-(p or self.max_period):]
+        alpha, alpha_dot = result.q[-(p or self.max_period):], result.q_dot[-(p or self.max_period):]
         if p:
             first = int(np.argmin(alpha))
             alpha, alpha_dot = np.roll(alpha, -first), np.roll(alpha_dot, -first)
@@ -124,7 +124,7 @@ class AttractorSection:
         settings = LyapunovSettings(self.lyapunov_revolutions, 0, self.lyapunov_batches)
         try:
             model = Model(inputs.rig, inputs.scene, inputs.cam)
-            found = spectrum(model, settings, (result.alpha[k], result.alpha_dot[k]), inputs.request.options,
+            found = spectrum(model, settings, (result.q[k], result.q_dot[k]), inputs.request.options,
                              inputs.request.backend)
         except Exception as exc:  # no tangent dynamics here (damping C, E...): no verdict
             if _interrupted(exc):

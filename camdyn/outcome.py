@@ -35,3 +35,8 @@ class Outcome(ActionableOutcome):
                        "orbit does not exist; use the full model (response='dynamic')")
     NO_QUASI_STATIC = ("no contact deformation carries the follower's inertia (Newton's method did not converge; "
                        "result.stats['where'] says when): use the full model (response='dynamic')")
+    #: the engine loop's too (camdyn.engine.loop.OUTCOMES), last so that the codes of the members above (a
+    #: sweep's outcome variable) stay what they were
+    OFF_FACE = ("the contact reached an end of the follower's face (the rig's face_start or face_end; Scene "
+                "face='bounded'), or an impact would land beyond one: the cam would touch the face's edge, which the "
+                "model does not describe; lengthen the face (or move it), or run at another speed")

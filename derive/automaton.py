@@ -32,6 +32,10 @@ Modes and their surfaces (non-linear model):
   contact_*_stick --(slip_rate_fwd, +1)--> contact_*_fwd; --(slip_rate_bwd, -1)--> contact_*_bwd
   contact_* --(junction, +1 or -1)--> the same mode   a cam of arcs: the step restarts where the
                                                        contact passes from one arc to the next
+  contact_* --(face, -1)--> off_face                   a bounded face: the contact reached an end of
+                                                       it; off_face is terminal (the run ends there,
+                                                       Outcome.OFF_FACE), and so is an impact that
+                                                       would land beyond an end
 
 With ``damping_switch="episode"`` (the default, Sec. 3.4) the impact law acts from first
 contact to maximum compression and the viscous law from there to separation: the law is
@@ -52,6 +56,7 @@ class Mode:
     contact: bool
     phase: str | None = None   # models D, E (non-linear): "impact" or "viscous"
     slip: str | None = None    # Coulomb friction: "fwd", "bwd" or "stick"
+    terminal: bool = False     # the run ends on entering it (its fields are free flight's, never integrated)
 
 
 @dataclass(frozen=True)
@@ -114,12 +119,24 @@ def _slips(spec: SceneSpec, stick: bool) -> tuple[str | None, ...]:
     return ("fwd", "bwd", "stick") if stick and spec.model == "nonlinear" else ("fwd", "bwd")
 
 
+#: the terminal mode of a bounded face: the contact is beyond an end of the follower's face
+OFF_FACE = "off_face"
+
+
 def modes(spec: SceneSpec) -> tuple[Mode, ...]:
     out = [Mode("free", False)] if spec.model == "nonlinear" else []
     for phase in _phases(spec):
         for slip in _slips(spec, stick=True):
             out.append(Mode(mode_name(True, phase, slip), True, phase, slip))
+    if spec.face == "bounded":
+        out.append(Mode(OFF_FACE, False, terminal=True))
     return tuple(out)
+
+
+def _on_face(targets: tuple[Target, ...], last: Target) -> tuple[Target, ...]:
+    """A bounded face: each contact candidate only where the contact lands on the face (face >= 0),
+    then ``last`` (the terminal off_face, or for the initial rule the candidates that follow)."""
+    return tuple(Target(t.mode, t.conditions + (Condition("face", +1),)) for t in targets) + (last,)
 
 
 def _entering(spec: SceneSpec, extra: tuple[Condition, ...] = ()) -> tuple[Target, ...]:
@@ -170,7 +187,7 @@ def build(spec: SceneSpec) -> Automaton:
     coulomb = coulomb and spec.follower != "translating"  # (see _slips)
     surfaces = ("gap", "gap_rate") + (("slip", "slip_rate_fwd", "slip_rate_bwd") if coulomb else ())
     transitions = [Transition("free", "gap", -1, _entering(spec))]
-    for mode in all_modes[1:]:
+    for mode in (m for m in all_modes if m.contact):
         transitions.append(Transition(mode.name, "gap", +1, (Target("free"),)))
         transitions += _damping_transitions(spec, mode)
         if coulomb:
@@ -180,4 +197,10 @@ def build(spec: SceneSpec) -> Automaton:
         transitions += [Transition(mode.name, "junction", direction, (Target(mode.name),))
                         for mode in all_modes if mode.contact for direction in (+1, -1)]
     initial = _entering(spec, (Condition("gap", -1),)) + (Target("free"),)
+    if spec.face == "bounded":
+        surfaces += ("face",)
+        transitions = [Transition(tr.source, tr.surface, tr.direction, _on_face(tr.targets, Target(OFF_FACE)))
+                       if tr.source == "free" else tr for tr in transitions]
+        transitions += [Transition(mode.name, "face", -1, (Target(OFF_FACE),)) for mode in all_modes if mode.contact]
+        initial = _on_face(initial[:-1], Target(OFF_FACE, (Condition("gap", -1),))) + initial[-1:]
     return Automaton(all_modes, surfaces, {"gap": "gap_rate"}, initial, tuple(transitions))

@@ -502,7 +502,11 @@ def _automaton_code(A: Automaton) -> list[str]:
               "#: per mode: the damping law of models D, E ('impact' t_a..t_b, 'viscous' after), or None",
               "PHASE_OF_MODE = " + repr(tuple(m.phase for m in A.modes)),
               "#: per mode: Coulomb friction, sliding forward ('fwd', v_r > 0), backward, or 'stick', or None",
-              "SLIP_OF_MODE = " + repr(tuple(m.slip for m in A.modes))] + _named("SURFACES", "SURFACE", A.surfaces)
+              "SLIP_OF_MODE = " + repr(tuple(m.slip for m in A.modes))]
+    if any(m.terminal for m in A.modes):  # (a module without it has none: camdyn.engine.tables)
+        lines += ["#: per mode: the run ends on entering it (Outcome.OFF_FACE: the contact beyond the face's end)",
+                  "TERMINAL_OF_MODE = " + repr(tuple(m.terminal for m in A.modes))]
+    lines += _named("SURFACES", "SURFACE", A.surfaces)
     rate = [surf[A.rates[s]] if s in A.rates else "-1" for s in A.surfaces]
     lines += ["#: per surface: the surface that is its time derivative (-1: none); an excursion across",
               "#: zero and back inside one step is found where the derivative changes sign",

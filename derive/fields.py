@@ -168,6 +168,8 @@ def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
         phi = plain(translating.phi_contact() if spec.follower == dynamics.TRANSLATING else geometry.phi_contact(),
                     spec.motion)
         return Kernel((Definition(value, profile.junction(phi), "the arcs' junction indicator"),), (value,))
+    if name == "face":
+        return _face_margin(spec)
     if name in ("slip_rate_fwd", "slip_rate_bwd") and mode.contact:
         side = _mechanics(spec, mode, direction=1 if name == "slip_rate_fwd" else -1)
         v_t, v_a, v_ad = V_R_PARTIALS
@@ -175,6 +177,21 @@ def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
         rate = v_t + v_a * q.rate + v_ad * q.acceleration
         return Kernel(side + _slip_partials(spec)[1:], (rate,)).pruned()
     return None
+
+
+def _face_margin(spec: SceneSpec) -> Kernel:
+    """The surface of a bounded face: (s - face_start)(face_end - s), s the contact's position along the
+    face (the rocker's moment arm chi = chi0 - psi_j, Eq. 2; the translating follower's distance from its
+    guide's axis, derive.translating.on_face), wherever the follower is (in flight: where an impact
+    would land)."""
+    if spec.follower == dynamics.TRANSLATING:
+        position = dynamics._on_cam(spec.profile, translating.on_face())
+    else:
+        position = S.chi0 - dynamics.psi_j(spec.profile)
+    s_face, margin = quantity("s_face"), quantity("face_margin")
+    return Kernel((Definition(s_face, plain(position, spec.motion), "the contact's position along the face"),
+                   Definition(margin, (s_face - S.face_start) * (S.face_end - s_face),
+                              "positive while the contact is on the face")), (margin,))
 
 
 def continuation_parameters(spec: SceneSpec, modes) -> tuple[str, ...]:

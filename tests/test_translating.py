@@ -160,3 +160,37 @@ def test_bad_input_is_refused_with_the_reason():
         camdyn.Scene(follower="quasistatic")
     with pytest.raises(ParameterError, match="F_p"):
         RIG.replace(F_p=0.0)
+
+
+# --- a bounded face (Scene(face="bounded")) --------------------------------------------------------
+@pytest.mark.parametrize("follower", ["translating", "oscillating"])
+def test_a_contact_that_reaches_the_end_of_the_face_ends_the_run_with_off_face(follower):
+    """The contact's position on the face (the translating follower's -h'(phi) - offset = -e sin(phi); the
+    rocker's chi) sweeps a range over a turn; a face that covers it runs to the end, one that stops short
+    ends the run with Outcome.OFF_FACE at the switch onto the terminal mode, where the contact is at the end."""
+    if follower == "translating":
+        rig, scene = RIG, camdyn.Scene(follower="translating", friction="none", face="bounded")
+        wide, short = (-1.2 * RIG.e, 1.2 * RIG.e), (-0.8 * RIG.e, 1.2 * RIG.e)
+    else:
+        rig, scene = camdyn.example_rig(), camdyn.Scene(friction="none", face="bounded")  # (derived on first use: no
+        # Coulomb modes, a few seconds of SymPy)
+        wide, short = (rig.chi0 - 0.01, rig.chi0 + 0.01), (rig.chi0 - 0.01, rig.chi0 + 1e-3)
+    ok = camdyn.simulate(rig.replace(face_start=wide[0], face_end=wide[1]), scene, speed_rpm=300, revolutions=2)
+    assert ok.ok and "off_face" not in set(ok.regime)
+    edge = rig.replace(face_start=short[0], face_end=short[1])
+    stopped = camdyn.simulate(edge, scene, speed_rpm=300, revolutions=2)
+    assert stopped.outcome is camdyn.Outcome.OFF_FACE and stopped.t[-1] < 2 * stopped.period
+    last = stopped.switches[-1]
+    assert (last.surface, last.after) == ("face", "off_face")
+    K = scene.kernels()
+    model = camdyn.Model(edge, scene, camdyn.ConstantSpeed(300))
+    margin = model.surface(K.MODE_FREE, K.SURFACE_FACE, last.t, last.alpha, last.alpha_dot)
+    assert abs(margin) <= 1e-10 * (short[1] - short[0]) ** 2  # located on the end: the engine's xtol
+
+
+def test_a_bounded_face_needs_its_ends():
+    scene = camdyn.Scene(follower="translating", friction="none", face="bounded")
+    with pytest.raises(ParameterError, match="face_start"):
+        camdyn.simulate(RIG, scene, speed_rpm=300, revolutions=1)
+    with pytest.raises(ParameterError, match="face_end"):
+        RIG.replace(face_start=0.01, face_end=-0.01)

@@ -38,8 +38,8 @@ cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
 
 #: the camdyn.Outcome members run() can end with; its outcome code is the member's index here
 OUTCOMES = (Outcome.SUCCESS, Outcome.STEP_FAILED, Outcome.MAX_EVENTS, Outcome.CHATTER, Outcome.NONFINITE,
-            Outcome.ANGLE_LIMIT)
-SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT = (OUTCOMES.index(o) for o in OUTCOMES)
+            Outcome.ANGLE_LIMIT, Outcome.OFF_FACE)
+SUCCESS, STEP_FAILED, MAX_EVENTS, CHATTER, NONFINITE_STATE, ANGLE_LIMIT, OFF_FACE = (OUTCOMES.index(o) for o in OUTCOMES)
 #: one switch: when, which transition (row of Tables), the modes before and after, the state after
 SWITCH = np.dtype([("t", np.float64), ("transition", np.int64), ("before", np.int64), ("after", np.int64),
                    ("alpha", np.float64), ("alpha_dot", np.float64)])
@@ -222,6 +222,8 @@ def run(prob, method, cfg, start, samples):
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
+    if tab.data[tab.mode_terminal + m] == 1:  # it starts where the model ends (a contact beyond the face)
+        outcome = OFF_FACE
     h_last, retries, capped, err_prev = -1.0, 0, False, ERR_FLOOR
     screen = cfg.reach_factor < math.inf  # clear a step from its ends (rules.clear_of_surfaces)
     while t < t_end and outcome == SUCCESS:
@@ -277,7 +279,9 @@ def run(prob, method, cfg, start, samples):
                 sw = _record(sw, n_sw, t_cross, w, m, m_new, c0, c1)
                 n_sw += 1
                 t, y0, y1, m = t_cross, c0, c1, m_new
-                if n_sw >= cfg.max_events:
+                if tab.data[tab.mode_terminal + m] == 1:
+                    outcome = OFF_FACE
+                elif n_sw >= cfg.max_events:
                     outcome = MAX_EVENTS
                 elif chattering(sw[SW_T], n_sw, cfg.chatter_window, cfg.chatter_switches):
                     outcome = CHATTER

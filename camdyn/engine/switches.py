@@ -21,7 +21,8 @@ from .loop import SWITCH
 @dataclass(frozen=True)
 class Switch:
     """One switch of mode: when, which surface was crossed, the modes before and after, and the
-    state the run continued from."""
+    state the run continued from: the follower's coordinate and its rate, in the fields ``alpha``
+    and ``alpha_dot`` whatever the follower (the translating follower's y, m, and y_dot, m/s)."""
 
     t: float
     surface: str

@@ -1,7 +1,8 @@
 """The hybrid automaton of a generated scene module, as the integer tables the loop reads.
 
 A generated module states its automaton as data (``MODES``, ``SURFACES``, ``INITIAL``,
-``TRANSITIONS``, ``RESETS``, ``RATE_OF_SURFACE``, ``CONTACT_OF_MODE``; see
+``TRANSITIONS``, ``RESETS``, ``RATE_OF_SURFACE``, ``CONTACT_OF_MODE``, ``TERMINAL_OF_MODE`` where a
+mode ends the run; see
 ``camdyn.derive.automaton`` for the rules).  :func:`tables` packs it into :class:`Tables`:
 compressed rows, so that mode m's transitions are ``watch_start[m]:watch_start[m + 1]`` and a
 transition's candidate targets are ``target_start[w]:target_start[w + 1]``; the initial choice
@@ -30,6 +31,7 @@ IDENTITY = -1
 class Tables(NamedTuple):
     data: np.ndarray               # every table below, one after the other (int64)
     mode_contact: int              # per mode: 1 in contact, 0 in free flight
+    mode_terminal: int             # per mode: 1 where the run ends on entering it (a bounded face's off_face)
     watch_start: int               # per mode, and one past the end: its transitions (rows)
     surface: int                   # per transition: the surface it watches
     direction: int                 # per transition: +1 (upward crossing) or -1 (downward)
@@ -76,7 +78,8 @@ def _tables(K) -> Tables:
         target_start.append(len(target_mode))
     resets = [IDENTITY if K.RESETS[tr[RESET]] == "identity" else tr[RESET] for tr in transitions]
     sampled_start, sampled = sampled_surfaces(K, transitions, watch_start)
-    parts = [K.CONTACT_OF_MODE, watch_start, [tr[SURFACE] for tr in transitions], [tr[DIRECTION] for tr in transitions],
+    terminal = getattr(K, "TERMINAL_OF_MODE", (False,) * n_modes)  # declared by a scene that has one
+    parts = [K.CONTACT_OF_MODE, terminal, watch_start, [tr[SURFACE] for tr in transitions], [tr[DIRECTION] for tr in transitions],
              resets,
              target_start, target_mode, condition_start, condition_surface, condition_sign, K.RATE_OF_SURFACE,
              [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled]

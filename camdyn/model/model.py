@@ -229,6 +229,13 @@ class Model:
                 "too close to the pivot P: no follower angle touches the cam there (|PG_c| < r_c + w_b/2); "
                 "check e, r_c, w_b, chi0 and alpha0")
 
+    @property
+    def coordinate_limit(self) -> float:
+        """The bound on |coordinate| past which a run ends (Outcome.ANGLE_LIMIT): the paper's follower
+        near 90 degrees, where tan and sec of Eq. 11 blow up (ANGLE_LIMIT); none (inf) for the
+        translating follower, whose laws have no singularity."""
+        return ANGLE_LIMIT if self.scene.follower == _OSCILLATING else math.inf
+
     @cached_property
     def period(self) -> float:
         return self.cam.period

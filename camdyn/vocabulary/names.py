@@ -42,6 +42,8 @@ SURFACES: dict[str, tuple[str, str]] = {
                                "backward where it turns negative"),
     "junction": ("1", "a cam of circular arcs (profile 'arcs'): zero where the contact passes a junction of "
                       "two arcs, where the curvature jumps; the step restarts there, in the same mode"),
+    "face": ("m^2", "a bounded face (face 'bounded'): (s - face_start)(face_end - s) of the contact's position s "
+                    "along the face, negative where the contact is beyond an end"),
 }
 
 # --- output quantities ------------------------------------------------------------------------

@@ -62,6 +62,8 @@ class Rule:
     def holds(self, x: float, known: dict) -> bool:
         """Whether ``x`` satisfies the rule; ``known``: the parameters validated before it."""
         b = known[self.bound] if isinstance(self.bound, str) else self.bound
+        if b is None:  # an optional bound not given: a scene that reads both demands it (Rig.require)
+            return True
         compare = _COMPARE[self.op.removeprefix("abs")]
         return compare(abs(x) if self.op.startswith("abs") else x, b)
 
@@ -182,7 +184,14 @@ RIG_PARAMETERS: tuple[RigParameter, ...] = (
                  "its face", True, "translating follower", (Rule("abs<=", 10.0, _MM, guard=True),), follower=_TRANS),
     RigParameter("F_p", "N", "spring force on the translating follower in the 0-state (its face touching the cam "
                  "at theta0): the preload there", True, "translating follower", (_POSITIVE,), follower=_TRANS),
-    # optional: the contact length, the friction laws, the damping models, each used by some scenes
+    # optional: the follower's face ends (Scene(face="bounded")), the contact length, the friction laws, the
+    # damping models, each used by some scenes
+    RigParameter("face_start", "m", "where the follower's face begins, as the contact's position along it: the "
+                 "oscillating follower's distance chi from P along the bar, the translating follower's from its guide's "
+                 "axis along the face", False, "Eq. 2; translating follower", (Rule("abs<=", 10.0, _MM, guard=True),)),
+    RigParameter("face_end", "m", "where the follower's face ends, as face_start measures it", False,
+                 "Eq. 2; translating follower", (Rule(">", "face_start", "the face ends after it begins"),
+                                                 Rule("abs<=", 10.0, _MM, guard=True))),
     RigParameter("l_lambda", "m", "length of the line contact", False, "Eq. 13", _LENGTH),
     RigParameter("mu_m", "1", "friction coefficient", False, "Sec. 3.2, friction models I and II",
                  (_NON_NEGATIVE,)),

@@ -15,6 +15,7 @@ DAMPING_SIGNS = ("dissipative", "printed")              # misprint 2
 DAMPING_SWITCHES = ("episode", "memoryless")            # Sec. 3.4, models D and E (see SceneSpec)
 FOLLOWERS = ("oscillating", "translating")              # the paper's rocker (Fig. 1); a flat face on a guide
 RESPONSES = ("dynamic", "quasistatic")                  # the hybrid model; the quasi-static contact orbit
+FACES = ("unbounded", "bounded")                        # the follower's face: long enough; ends at face_start/_end
 #: the cam's shape: the paper's eccentric circle (Eq. 3-4), or a convex cam given by its support
 #: function h(phi) (docs/model-editing.md, "a new cam"): a periodic piecewise quintic, or circular arcs
 ECCENTRIC = "eccentric"
@@ -31,6 +32,7 @@ OPTIONS: dict[str, tuple[str, ...]] = {
     "damping_switch": DAMPING_SWITCHES,
     "follower": FOLLOWERS,
     "profile": PROFILES,
+    "face": FACES,
     "response": RESPONSES,
 }
 
@@ -45,6 +47,7 @@ SLUG_SUFFIXES: dict[str, tuple[str, str]] = {
     "memoryless": ("damping_switch", "memoryless"),
     "quasistatic": ("response", "quasistatic"),
     "translating": ("follower", "translating"),
+    "bounded": ("face", "bounded"),
     "spline": ("profile", "spline"),
     "arcs": ("profile", "arcs"),
 }
@@ -83,6 +86,9 @@ class SceneSpec:
                   support function h(phi) as a periodic piecewise quintic) or "arcs" (a cam of
                   circular arcs, whose junctions are switching surfaces); the profile's data
                   travels with the rig (camdyn.model.profiles)
+        face:     "unbounded" (the face is long enough wherever the contact goes) or "bounded" (it ends
+                  at the rig's face_start and face_end: a contact that reaches an end, or an impact
+                  that would land beyond one, ends the run with Outcome.OFF_FACE)
         response: "dynamic" (the hybrid model: free flight, impacts, contact) or "quasistatic"
                   (no integration: Eq. 10 solved for alpha with alpha_dot, alpha_ddot of the rigid
                   kinematics, Eq. 29, for a follower that never leaves the cam; camdyn.runs.quasistatic)
@@ -98,6 +104,7 @@ class SceneSpec:
     damping_switch: str = "episode"
     follower: str = "oscillating"
     profile: str = ECCENTRIC
+    face: str = "unbounded"
     response: str = "dynamic"
 
     def __post_init__(self):
@@ -179,6 +186,8 @@ def combination_problem(spec: SceneSpec) -> str:
         if spec.response != "dynamic":
             return (f"profile={spec.profile!r} has no quasi-static follower yet: its rigid contact angle is "
                     "implicit (use response='dynamic')")
+    if spec.face == "bounded" and spec.model != "nonlinear":
+        return "face='bounded' needs model='nonlinear' (the contact's ends are switching surfaces of the hybrid model)"
     if spec.follower == "translating":
         if spec.model != "nonlinear":
             return "follower='translating' needs model='nonlinear' (the linear models are the paper's, Section 8)"

@@ -278,10 +278,10 @@ def test_surface_with_rate_is_surface_bit_for_bit(slug):
     crossing check samples a surface with its rate in one call, the root search and the targets
     read them one at a time, and the two must agree to the last bit."""
     from camdyn.engine.kernels import compiled_kernels, python_kernels
-    from registry import RIG, cam_for, scene_from_slug
+    from registry import cam_for, rig_for, scene_from_slug
     mod = _module(slug)
     scene = scene_from_slug(slug)
-    model = camdyn.Model(RIG, scene, cam_for(scene))
+    model = camdyn.Model(rig_for(scene), scene, cam_for(scene))
     p = np.ascontiguousarray(model.p, dtype=float)
     rng = np.random.default_rng(11)
     states = np.column_stack([rng.uniform(0, 0.5, 2000), rng.uniform(-0.3, 0.3, 2000), rng.uniform(-50, 50, 2000)])

@@ -206,7 +206,8 @@ def test_no_shipped_rig_comes_near_the_rate_limit(preset):
     rates = {}
     for slug in SCENES:
         scene = scene_from_slug(slug)
-        if scene.motion != "constant" or scene.model != "nonlinear":
+        if scene.motion != "constant" or scene.model != "nonlinear" or scene.follower != rig.follower \
+                or scene.profile != "eccentric":  # another follower's, or a cam the preset does not have
             continue
         try:
             rates[slug] = Model(rig, scene, cam_for(scene)).fastest_rate.value

@@ -23,8 +23,12 @@ VALID = dict(
     d_x=0.1, d_y=0.3, L_us=0.25, k_s=2000.0, I_Pb=0.0075, Y_c=2e11, Y_b=2e11,
     nu_c=0.3, nu_b=0.3, l_lambda=0.0016, mu_m=0.3, s=10.0, zeta_D=0.01, beta_D=4.25,
 )
+#: the parameters an oscillating rig (the default follower) must give: of every rig, or of its follower type
 REQUIRED = ["r_c", "e", "w_b", "chi0", "alpha0", "theta0", "d_x", "d_y", "L_us",
             "k_s", "I_Pb", "Y_c", "Y_b", "nu_c", "nu_b"]
+#: the translating follower's own parameters, required of its rigs (and refused by the others)
+TRANSLATING = ["m_f", "gamma", "offset", "F_p"]
+OSCILLATING_ONLY = ["w_b", "chi0", "alpha0", "d_x", "d_y", "L_us", "I_Pb"]
 OPTIONAL = ["l_lambda", "mu_m", "s", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
             "zeta_E", "beta_E"]
 
@@ -52,13 +56,16 @@ def test_ints_and_numpy_scalars_stored_as_float():
 
 def test_table_matches_dataclass_fields():
     fields = {f.name: f for f in dataclasses.fields(Rig)}
-    assert [p.name for p in PARAMETERS] == REQUIRED + OPTIONAL
-    assert list(fields) == REQUIRED + OPTIONAL + ["name", "description", "origin", "profile", "profile_data"]
+    assert [p.name for p in PARAMETERS] == REQUIRED + TRANSLATING + OPTIONAL
+    assert list(fields) == REQUIRED + TRANSLATING + OPTIONAL + ["name", "description", "follower", "origin", "profile",
+                                                                "profile_data"]
     for p in PARAMETERS:
         has_default = fields[p.name].default is not dataclasses.MISSING
-        assert p.required is not has_default
+        assert (p.required and not p.follower) is not has_default  # a follower's own: checked in __post_init__
         if has_default:
             assert fields[p.name].default is None
+    assert {p.name for p in PARAMETERS if p.follower == "oscillating"} == set(OSCILLATING_ONLY)
+    assert {p.name for p in PARAMETERS if p.follower == "translating"} == set(TRANSLATING)
 
 
 @pytest.mark.parametrize("name", REQUIRED)
@@ -66,7 +73,7 @@ def test_missing_required_parameter_named(name):
     d = {k: v for k, v in VALID.items() if k != name}
     with pytest.raises(RigFileError, match=rf"missing required parameter\(s\): {name}$"):
         Rig.from_dict(d)
-    with pytest.raises(TypeError, match=rf"'{name}'"):
+    with pytest.raises(ParameterError if name in OSCILLATING_ONLY else TypeError, match=rf"{name}"):
         Rig(**d)
     with pytest.raises(ParameterError, match=rf"^{name} is not given: required"):
         Rig(**{**d, name: None})
@@ -356,7 +363,8 @@ def test_rig_reads_the_one_declaration_in_derive():
     assert [p.name for p in PARAMETERS] == list(declared.RIG_NAMES)
     for p, row in zip(PARAMETERS, declared.RIG_PARAMETERS):
         assert (p.required, p.rules, p.description) == (row.required, row.rules, row.description)
-    known = set(declared.RIG_NAMES) | set(declared.EQUILIBRIUM_NAMES) | set(declared.CAM_NAMES)
+    profile_data = {"profile"}  # a cam profile's data block (derive.profile_code), given by the rig's profile
+    known = set(declared.RIG_NAMES) | set(declared.EQUILIBRIUM_NAMES) | set(declared.CAM_NAMES) | profile_data
     for module in generated.SCENES.values():
         kernels = importlib.import_module(f"camdyn.generated.{module}")
         assert set(kernels.INPUTS) <= known, module

@@ -649,8 +649,9 @@ def work_precision(records, *, ax=None, title: str | None = None, error_label: s
 
 def mechanism(rig, theta: float | None = None, *, ax=None, title: str | None = None):
     """The cam (its profile turned to the cam angle ``theta``, rad; default the rig's theta0) and
-    the oscillating follower in rigid contact with it (Fig. 1): the bar from the pivot P along the
-    follower angle, its cam-side face, the contact point.  Any cam: the paper's circle or the rig's
+    the follower in rigid contact with it: the oscillating follower (Fig. 1: the bar from the pivot
+    P along the follower angle, its cam-side face) or the translating one (its guide's axis and its
+    face, normal to the guide), and the contact point.  Any cam: the paper's circle or the rig's
     profile (camdyn.model.profiles), drawn from its support function (contact points c(phi))."""
     from ..model.followers import cam_of, follower_of_rig, rigid_contact
 
@@ -664,10 +665,21 @@ def mechanism(rig, theta: float | None = None, *, ax=None, title: str | None = N
     ax.fill(x * 1e3, y * 1e3, color="0.85", edgecolor="0.2", lw=1.0)
     ax.plot([0], [0], "k+", ms=8)
     contact = rigid_contact(cam, follower, np.array([theta]))
+    draw = _translating_follower if follower.kind == "translating" else _oscillating_follower
+    where = draw(ax, rig, follower, contact, np.abs(body).max())
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title or f"cam at {math.degrees(theta) % 360:.0f} deg, {where}")
+    return fig
+
+
+def _oscillating_follower(ax, rig, follower, contact, size: float) -> str:
+    """The paper's follower on ``ax`` (mm): its bar's axis from P, its face, P and the contact."""
     a, chi = float(contact.q[0]), float(contact.on_face[0])
     u, n = np.array([math.cos(a), -math.sin(a)]), np.array([math.sin(a), math.cos(a)])
     P = -np.asarray(follower.P_to_E)
-    reach = max(chi * 1.3, np.abs(body).max() * 2.5)
+    reach = max(chi * 1.3, size * 2.5)
     face = np.array([P + t * u + rig.w_b / 2 * n for t in (0.0, reach)])
     axis = np.array([P, P + reach * u])
     ax.plot(axis[:, 0] * 1e3, axis[:, 1] * 1e3, color="C0", lw=0.8, ls="--")
@@ -675,8 +687,21 @@ def mechanism(rig, theta: float | None = None, *, ax=None, title: str | None = N
     ax.plot([P[0] * 1e3], [P[1] * 1e3], "o", color="C0")
     O = P + chi * u + rig.w_b / 2 * n
     ax.plot([O[0] * 1e3], [O[1] * 1e3], "o", color="C3", ms=4)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.set_title(title or f"cam at {math.degrees(theta) % 360:.0f} deg, follower at {math.degrees(a):.2f} deg")
-    return fig
+    return f"follower at {math.degrees(a):.2f} deg"
+
+
+def _translating_follower(ax, rig, follower, contact, size: float) -> str:
+    """The translating follower on ``ax`` (mm): its guide's axis, its face at y along the guide, the
+    contact (at ``on_face`` from the axis along the face's unit t)."""
+    y, along = float(contact.q[0]), float(contact.on_face[0])
+    g = np.array([math.cos(follower.gamma), math.sin(follower.gamma)])
+    t = follower.along_face
+    axis0 = follower.offset * t
+    half = max(abs(along) * 1.3, size)
+    face = np.array([axis0 + y * g + k * half * t for k in (-1.0, 1.0)])
+    axis = np.array([axis0 + y * g, axis0 + (y + 2 * size) * g])
+    ax.plot(axis[:, 0] * 1e3, axis[:, 1] * 1e3, color="C0", lw=0.8, ls="--")
+    ax.plot(face[:, 0] * 1e3, face[:, 1] * 1e3, color="C0", lw=2.0)
+    O = axis0 + y * g + along * t
+    ax.plot([O[0] * 1e3], [O[1] * 1e3], "o", color="C3", ms=4)
+    return f"follower at y = {y * 1e3:.2f} mm"

@@ -8,7 +8,7 @@ One of four forms (lengths in mm, angles in degrees, as the keys say)::
 
     [cam]                               # a motion law (camdyn.model.motion_laws)
     law = "cycloidal"                   # or "345", "modified_trapezoid" (as rise_dwell_return takes)
-    lift_rad = 0.05                     # the oscillating follower's angular lift
+    lift_rad = 0.05                     # the oscillating follower's angular lift (translating: lift_mm)
     angles_deg = [100, 80, 100, 80]     # rise, dwell, return, dwell
     base_radius_mm = 25.0
 
@@ -36,7 +36,7 @@ from ..errors import CamdynError, RigFileError
 from ..vocabulary import ECCENTRIC
 
 #: the keys each form takes (``theta0_deg`` besides, for all but the block)
-FORMS = {"table": ("table", "base_radius_mm"), "law": ("law", "lift_rad", "angles_deg", "base_radius_mm"),
+FORMS = {"table": ("table", "base_radius_mm"), "law": ("law", "lift_rad", "lift_mm", "angles_deg", "base_radius_mm"),
          "arcs": ("arcs",), "block": ("kind", "block")}
 _ARC_KEYS = ("r_b_mm", "r_n_mm", "d_mm", "R_mm", "nose_angle_deg")
 
@@ -113,9 +113,23 @@ def _profile(form: str, cam: Mapping, rig, folder: Path):
         return cam_from_table(path, follower_of_rig(rig), r_b=float(r_b) / 1000)
     from .motion_laws import rise_dwell_return
     from .synthesis import cam_from_law
-    law = rise_dwell_return(float(cam["lift_rad"]), tuple(math.radians(float(a)) for a in cam["angles_deg"]),
+    law = rise_dwell_return(_law_lift(cam, rig), tuple(math.radians(float(a)) for a in cam["angles_deg"]),
                             law=cam["law"])
     return cam_from_law(law, follower_of_rig(rig), r_b=float(r_b) / 1000)
+
+
+#: a motion law's lift key by follower type: an angle for the rocker, a length for the translating follower
+_LIFT_KEYS = {"oscillating": "lift_rad", "translating": "lift_mm"}
+
+
+def _law_lift(cam: Mapping, rig) -> float:
+    """The law's lift in SI (rad or m), under the key of the rig's follower type."""
+    key = _LIFT_KEYS[rig.follower]
+    other = [k for k in _LIFT_KEYS.values() if k != key and k in cam]
+    if other or key not in cam:
+        raise ValueError(f"a motion law for a {rig.follower} follower gives its lift as {key}"
+                         + (f", not {other[0]}" if other else ""))
+    return float(cam[key]) / (1000 if key == "lift_mm" else 1)
 
 
 def cam_lines(profile) -> list[str]:

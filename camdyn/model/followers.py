@@ -181,10 +181,13 @@ def cam_of(rig):
     return rig.profile if rig.profile is not None else EccentricCircle(rig.r_c, rig.e)
 
 
-def follower_of_rig(rig) -> OscillatingFollower:
-    """The rig's oscillating follower: E - P from its 0-state (Eq. 5 for any cam: the bar's surface
+def follower_of_rig(rig) -> OscillatingFollower | TranslatingFollower:
+    """The rig's follower.  Oscillating: E - P from its 0-state (Eq. 5 for any cam: the bar's surface
     touches the cam's support line of normal angle phi0 = 3 pi/2 - alpha0 - theta0 at chi0, so
-    E - P = (chi0 - h'(phi0)) u0 + (w_b/2 + h(phi0)) n0; derive.geometry.P_to_E_general)."""
+    E - P = (chi0 - h'(phi0)) u0 + (w_b/2 + h(phi0)) n0; derive.geometry.P_to_E_general).
+    Translating: its guide's angle gamma and axis offset (the rig's)."""
+    if rig.follower == TranslatingFollower.kind:
+        return TranslatingFollower(rig.gamma, rig.offset)
     cam, a0 = cam_of(rig), rig.alpha0
     phi0 = 1.5 * math.pi - a0 - rig.theta0
     along, across = rig.chi0 - float(cam.h(phi0, 1)), rig.w_b / 2 + float(cam.h(phi0))
@@ -196,8 +199,15 @@ def rig_on_cam(rig, profile, *, follower: OscillatingFollower | None = None, the
     """``rig`` with the cam ``profile`` (:mod:`camdyn.model.profiles`), its pivot where ``follower``
     puts it (default: where it is on the rig's present cam, :func:`follower_of_rig`), and its
     0-state (Eq. 5) re-stated on the new cam: at the cam angle ``theta0`` (default the rig's) the
-    follower in rigid contact, alpha0 its angle and chi0 its moment arm there."""
-    follower = follower or follower_of_rig(rig)
+    follower in rigid contact, alpha0 its angle and chi0 its moment arm there.  A translating
+    follower keeps its guide; its 0-state is y0 = h(gamma - theta0) on the new cam, where its
+    preload F_p is given."""
     theta0 = rig.theta0 if theta0 is None else finite("theta0", theta0, "a finite cam angle, rad")
+    if rig.follower == TranslatingFollower.kind:
+        if follower is not None:
+            raise ParameterError("follower", follower, "None for a translating follower's rig (its guide is the rig's "
+                                 "gamma and offset)")
+        return rig.replace(profile=profile, theta0=theta0)
+    follower = follower or follower_of_rig(rig)
     contact = rigid_contact(profile, follower, np.array([theta0]))
     return rig.replace(profile=profile, theta0=theta0, alpha0=float(contact.q[0]), chi0=float(contact.on_face[0]))

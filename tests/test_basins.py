@@ -132,8 +132,8 @@ def test_a_cycle_is_reduced_to_its_minimal_period_within_tol():
 def test_the_measure_keeps_the_cycle_from_its_smallest_alpha():
     class Fake:
         ok, t = True, np.arange(10.0)
-        alpha = np.array([0, 0, 0, 0, 0, 0, 0, 0.4, 0.2, 0.3])
-        alpha_dot = np.arange(10.0)
+        q = np.array([0, 0, 0, 0, 0, 0, 0, 0.4, 0.2, 0.3])  # the follower's coordinate (Result.q: alpha here)
+        q_dot = np.arange(10.0)
         stats = {"stop_period": 3}
 
     got = AttractorSection()(Fake(), None)

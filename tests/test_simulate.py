@@ -8,7 +8,7 @@ import pytest
 
 import camdyn
 from camdyn.analysis import statics as analysis, signal
-from registry import METHODS, RIG, SCENES, cam_for, scene_from_slug
+from registry import METHODS, RIG, SCENES, cam_for, rig_for, scene_from_slug
 
 FRICTIONLESS = camdyn.Scene(damping="none", friction="none")
 
@@ -128,10 +128,10 @@ def test_methods_agree_on_impact_times(method):
 @pytest.mark.parametrize("slug", SCENES)
 def test_every_generated_scene_runs(slug):
     scene = scene_from_slug(slug)
-    r = camdyn.simulate(RIG, scene, cam_for(scene), t_end=0.03, sample_rate_Hz=10_000,
+    r = camdyn.simulate(rig_for(scene), scene, cam_for(scene), t_end=0.03, sample_rate_Hz=10_000,
                         backend="python" if scene.motion == "user" else "compiled")
     assert r.ok, r.outcome
-    for name in ("alpha", "alpha_dot", "Theta"):
+    for name in ("q", "q_dot", "Theta"):
         assert np.all(np.isfinite(getattr(r, name)))
     for name, v in r.outputs.items():
         assert np.all(np.isfinite(v)), name

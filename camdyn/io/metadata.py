@@ -57,7 +57,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "regime": ("", "contact regime at the sample"),
 }
 
-_RIG_TEXT = ("name", "description")
+_RIG_TEXT = ("name", "description", "follower")  # (a file without the follower: the paper's, oscillating)
 _BOOL_SETTINGS = ("energy_ledger",)
 
 

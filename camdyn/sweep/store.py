@@ -443,7 +443,7 @@ def attributes(spec: SweepSpec) -> dict:
     attrs = {"title": TITLE, "source": f"camdyn {__version__}", "camdyn_version": __version__,
              "grid": " ".join(spec.names), "points": spec.size, "scene": scene.slug}
     attrs.update({f"scene_{k}": v for k, v in dataclasses.asdict(scene).items()})
-    attrs.update({"rig": rig.name, "rig_description": rig.description,
+    attrs.update({"rig": rig.name, "rig_description": rig.description, "rig_follower": rig.follower,
                   "rig_source": rig.origin or "not recorded (a Rig built in code)"})
     attrs.update({f"rig_{p.name}": getattr(rig, p.name) for p in PARAMETERS if getattr(rig, p.name) is not None})
     attrs["rig_units"] = ", ".join(f"{p.name} {_unit(p.unit)}" for p in PARAMETERS)
@@ -508,7 +508,8 @@ def rig_of(attrs: dict):
     from ..model.rig import Rig
 
     values = {p.name: attrs[f"rig_{p.name}"] for p in PARAMETERS if f"rig_{p.name}" in attrs}
-    return Rig(**values, name=attrs.get("rig", "unnamed"), description=attrs.get("rig_description", ""))
+    return Rig(**values, name=attrs.get("rig", "unnamed"), description=attrs.get("rig_description", ""),
+               follower=attrs.get("rig_follower", "oscillating"))  # a file from before the follower types
 
 
 def scene_of(attrs: dict):

@@ -125,6 +125,18 @@ def lift_knife(theta):
 LAWS = {"flat": lift_flat, "knife": lift_knife}
 
 
+def detachment_speed(law, mass=1.221, stiffness=1430.8, gravity=0.0, samples=720000):
+    """Lowest constant cam speed (rev/min) at which the constrained mode's contact force,
+    m omega^2 s''(theta) + k (s - OFFSET) + m g, reaches zero somewhere on the cam, and that angle
+    (deg). Sampled on ``samples`` angles; where s'' jumps the larger deceleration counts."""
+    th = np.linspace(0, 2 * math.pi, samples, endpoint=False)
+    s, _, d2 = law(th)
+    dec = d2 < 0
+    w2 = (stiffness * (s[dec] - OFFSET) + mass * gravity) / (-mass * d2[dec])
+    i = int(np.argmin(w2))
+    return math.sqrt(w2[i]) * 60 / (2 * math.pi), th[dec][i] / DEG
+
+
 def check(ref: str | None = None) -> None:
     """Prints the laws' features; with ``ref`` (the example's committed output CF.ref: columns t,
     ..., CamPosition = s - 0.3, CamVelocity = ds/dt, at 358 rev/min) compares them with it."""
@@ -142,6 +154,10 @@ def check(ref: str | None = None) -> None:
         lo = lift_knife(a - 1e-5); hi = lift_knife(a + 1e-5)
         print(f"knife {name:10s} at {a / DEG:8.4f} deg: s'' {float(lo[2]):+.5f} -> {float(hi[2]):+.5f} m/rad^2 "
               f"(1e-5 rad either side)")
+    for name, law in LAWS.items():
+        rpm, at = detachment_speed(law)
+        print(f"{name}: detachment at {rpm:.2f} rev/min (m 1.221 kg, k 1430.8 N/m, spring free at 0.3 m, "
+              f"no gravity), first at theta = {at:.2f} deg")
     h = th[1] - th[0]
     for name, law in LAWS.items():
         s, d1, _ = law(th)

@@ -33,10 +33,11 @@ per-step Python: setting the forcing, reading the state); the impacts; the Poinc
   the pre-impact state needs to close the gap, y_k / (-v_k), clipped to the step: Moreau-Jean only
   knows the impact lies in the step.
 - The section is the follower's absolute position u and velocity du/dt at cam angle
-  --section-deg, once per revolution, interpolated linearly between the steps around it.
+  --section-deg (default 130 deg, in flight between two impacts in both runs of docs/second-rig.md),
+  once per revolution, interpolated linearly between the steps around it.
 
 Against the reference (the smallest h): for each reference impact the nearest impact of the run
-(|t_h - t_ref|, max and median over the reference impacts), and the section's largest difference
+(|t_h - t_ref|: median, 90th percentile and max over the reference impacts), and the section's largest difference
 over the revolutions in position and in velocity. These are differences from the smallest step's
 run, not from the exact solution: they bound the error of the coarser steps only while the
 reference is much closer to the exact solution than they are.
@@ -169,9 +170,10 @@ def compare(res: dict, ref: dict) -> dict:
     th = np.array([i["t"] for i in res["impacts"]])
     if tr.size and th.size:
         err = np.min(np.abs(tr[:, None] - th[None, :]), axis=1)
-        imp = {"impact_t_err_max": float(err.max()), "impact_t_err_median": float(np.median(err))}
+        imp = {"impact_t_err_max": float(err.max()), "impact_t_err_median": float(np.median(err)),
+               "impact_t_err_p90": float(np.percentile(err, 90))}
     else:
-        imp = {"impact_t_err_max": None, "impact_t_err_median": None}
+        imp = {"impact_t_err_max": None, "impact_t_err_median": None, "impact_t_err_p90": None}
     m = min(len(res["section"]), len(ref["section"]))
     du = [abs(a["u"] - b["u"]) for a, b in zip(res["section"][:m], ref["section"][:m])]
     dv = [abs(a["udot"] - b["udot"]) for a, b in zip(res["section"][:m], ref["section"][:m])]
@@ -184,7 +186,7 @@ def main() -> None:
     ap.add_argument("--revolutions", type=int, default=20)
     ap.add_argument("--steps", type=float, nargs="+", default=[1e-3, 3e-4, 1e-4, 3e-5, 1e-5])
     ap.add_argument("--law", choices=sorted(LAWS), default="flat")
-    ap.add_argument("--section-deg", type=float, default=180.0)
+    ap.add_argument("--section-deg", type=float, default=130.0)
     ap.add_argument("--v-min", type=float, default=0.5, help="m/s")
     ap.add_argument("--restitution", type=float, default=0.8)
     ap.add_argument("--gravity", type=float, default=0.0, help="m/s^2 along -u (the example has none)")
@@ -212,18 +214,18 @@ def main() -> None:
             "reference_h": ref["h"], "siconos": getattr(siconos, "__version__", "?"),
             "python": platform.python_version(), "loadavg": os.getloadavg(), "command": " ".join(sys.argv)}
     with open(args.out, "w") as fh:
-        json.dump({"meta": meta, "runs": rows}, fh, indent=1)
+        json.dump({"meta": meta, "runs": rows}, fh, separators=(",", ":"))
 
     print(f"law {args.law}, {args.speed_rpm} rev/min, {args.revolutions} revolutions, section at "
           f"{args.section_deg} deg, impacts faster than {args.v_min} m/s; reference h = {ref['h']:g} s")
-    print("| h (s) | steps | wall (s) | impacts | impact-time diff max (s) | median (s) | "
+    print("| h (s) | steps | wall (s) | impacts | impact-time diff median (s) | 90th pct (s) | max (s) | "
           "section u diff max (m) | section du/dt diff max (m/s) | deepest gap (m) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     f = lambda x: "—" if x is None else f"{x:.2e}"  # noqa: E731
     for r in rows:
         c = r["vs_reference"] or {}
         print(f"| {r['h']:g} | {r['steps']} | {r['wall_s']:.3f} | {len(r['impacts'])} | "
-              f"{f(c.get('impact_t_err_max'))} | {f(c.get('impact_t_err_median'))} | "
+              f"{f(c.get('impact_t_err_median'))} | {f(c.get('impact_t_err_p90'))} | {f(c.get('impact_t_err_max'))} | "
               f"{f(c.get('section_u_err_max'))} | {f(c.get('section_udot_err_max'))} | {r['min_gap_m']:.2e} |")
 
 

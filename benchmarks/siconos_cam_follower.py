@@ -11,7 +11,8 @@ Other options: --law flat|knife (the cam's lift law, benchmarks/second_rig_cam.p
 translating flat-faced follower on the arc cam, the default; ``knife`` for the law the Siconos
 CamFollower example codes), --steps (the fixed steps h, s; the smallest is the reference),
 --section-deg (cam angle of the Poincare section), --v-min (smallest approach speed counted as an
-impact), --restitution, --gravity.
+impact), --restitution, --gravity; --selfcheck (the forcing against the constrained mode's contact
+force, below the detachment speed); --scan-rpm N1 N2 ... (periodic or not, per speed, at one step).
 
 The model (docs/second-rig.md): a follower of mass m on a spring k whose free length puts the
 follower at u = 0.3 m from the cam's rotation centre (u is the follower face's height; on the cam,
@@ -165,6 +166,29 @@ def selfcheck(args) -> None:
           f"max |q| = {np.abs(q).max():.2e} m")
 
 
+def scan(args) -> None:
+    """One run per speed at h = the first of --steps: is the section periodic (period <= 8, every
+    coordinate repeating to --scan-tol in m and m/s over the last third of the revolutions), how many
+    impacts per revolution there, the fastest approach."""
+    h = args.steps[0]
+    print(f"law {args.law}, h = {h:g} s, {args.revolutions} revolutions, section at {args.section_deg} deg, "
+          f"last {args.revolutions // 3} revolutions, impacts faster than {args.v_min} m/s")
+    print("| rev/min | period | impacts / rev | fastest approach (m/s) | section u range (m) |")
+    print("|---|---|---|---|---|")
+    for rpm in args.scan_rpm:
+        args.speed_rpm = rpm
+        r = run(h, args)
+        w = args.revolutions // 3
+        sec = np.array([(x["u"], x["udot"]) for x in r["section"]])[-w:]
+        period = next((p for p in range(1, 9) if p < len(sec)
+                       and np.max(np.abs(sec[p:] - sec[:-p])) < args.scan_tol), None)
+        t_from = (args.revolutions - w) * 60.0 / rpm
+        imp = [x for x in r["impacts"] if x["t"] >= t_from]
+        fastest = max((abs(x["v_before"]) for x in imp), default=0.0)
+        print(f"| {rpm:g} | {period or 'none <= 8'} | {len(imp) / w:g} | {fastest:.3g} | {np.ptp(sec[:, 0]):.2e} |",
+              flush=True)
+
+
 def compare(res: dict, ref: dict) -> dict:
     tr = np.array([i["t"] for i in ref["impacts"]])
     th = np.array([i["t"] for i in res["impacts"]])
@@ -182,7 +206,7 @@ def compare(res: dict, ref: dict) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--speed-rpm", type=float, required=True)
+    ap.add_argument("--speed-rpm", type=float)
     ap.add_argument("--revolutions", type=int, default=20)
     ap.add_argument("--steps", type=float, nargs="+", default=[1e-3, 3e-4, 1e-4, 3e-5, 1e-5])
     ap.add_argument("--law", choices=sorted(LAWS), default="flat")
@@ -193,12 +217,18 @@ def main() -> None:
     ap.add_argument("--out")
     ap.add_argument("--selfcheck", action="store_true",
                     help="compare the contact impulse with the constrained mode's force over one revolution")
+    ap.add_argument("--scan-rpm", type=float, nargs="+",
+                    help="instead of the table: one run per speed at the first --steps, periodic or not")
+    ap.add_argument("--scan-tol", type=float, default=1e-3)
     args = ap.parse_args()
+    if args.scan_rpm:
+        scan(args)
+        return
     if args.selfcheck:
         selfcheck(args)
         return
-    if not args.out:
-        ap.error("--out is required")
+    if not args.out or args.speed_rpm is None:
+        ap.error("--speed-rpm and --out are required")
 
     steps = sorted(args.steps, reverse=True)
     runs = [run(h, args) for h in steps]

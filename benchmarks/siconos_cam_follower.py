@@ -22,7 +22,7 @@ relative velocity with restitution e. Siconos integrates it in the relative coor
 q = u - s(theta(t)) (the translation the Siconos CamFollower documentation describes): a
 LagrangianLinearTIDS (mass m, stiffness k, no damping) driven by
 f(t) = -(m s''(t) + k (s(t) - 0.3)) - m g, a LagrangianLinearTIR y = q >= 0, a NewtonImpactNSL(e),
-MoreauJeanOSI(theta = 0.5) and an LCP one-step problem (Siconos's default LCP solver). The forcing
+MoreauJeanOSI(theta = 0.5) and an LCP one-step problem (Siconos's default LCP solver, Lemke). The forcing
 is passed as a vector set before every step to (f(t_k) + f(t_k+1)) / 2, which is what Moreau-Jean's
 theta = 0.5 quadrature would evaluate with a plugin.
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from ...model.rig import PARAMETERS
-from ...vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
+from ...vocabulary import COORDINATES, STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from ..shooting import sorted_multipliers
 from .events import EVENTS
 from .problem import N_STATE, SPEED, ContinuationOutcome, Problem
@@ -22,7 +22,8 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     Dims: ``point`` (every orbit of every branch, branch by branch, in the order continued),
     ``multiplier`` (2, by decreasing modulus), ``revolution`` (n of the longest period, NaN
     beyond a point's own), ``event``, ``branch`` (a coordinate: 0, 1, ...).  Per point:
-    ``lambda`` (the parameter, its unit), ``alpha`` and ``alpha_dot`` at the section,
+    ``lambda`` (the parameter, its unit), ``alpha`` and ``alpha_dot`` at the section (the follower's
+    coordinate and rate, named in the attribute ``coordinate``: the translating follower's y, m),
     ``multiplier_real``/``_imag``/``_modulus`` (NaN where unresolved), ``resolved`` (the point's
     derivatives passed the rule of :mod:`camdyn.orbits.derivatives`), ``stable`` (resolved and every
     ``|mu| < 1``), ``jacobian_provider`` (code into attrs ``providers``), ``difference_step``
@@ -52,6 +53,7 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
              "phase_fraction": problem.phase_fraction, "rig": problem.rig.name, "scene": problem.scene.slug,
              "modes": " ".join(problem.model(problem.start).kernels.MODES), "event_kinds": " ".join(EVENTS),
              "outcomes": " ".join(o.name for o in outcomes), "providers": " ".join(providers),
+             "coordinate": _coordinate(problem)[0],
              **{f"scale_{name}": float(s[i]) for i, name in enumerate(STATE)}}
     for i, b in enumerate(branches):
         attrs[f"branch_{i}_message"] = f"{b.outcome.message}" + (f" ({b.message.strip('; ')})" if b.message else "")
@@ -72,7 +74,15 @@ def _branch_variables(branches: list, outcomes: list) -> dict:
     }
 
 
+def _coordinate(problem: Problem) -> tuple[str, str]:
+    """The follower's coordinate, its name and unit (the variables alpha... hold it whatever the follower:
+    the translating follower's y, m)."""
+    name, unit, _ = COORDINATES[problem.scene.follower]
+    return name, unit
+
+
 def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, providers: list) -> dict:
+    q, q_unit = _coordinate(problem)
     points = [p for b in branches for p in b.points]
     resolved = np.array([p.resolved for p in points], dtype=bool)
     mu = np.array([sorted_multipliers(p.jacobian) for p in points]).reshape(len(points), N_STATE)
@@ -81,10 +91,10 @@ def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, pr
     P, PM = ("point",), ("point", "multiplier")
     return {
         "lambda": (P, np.array([p.lam for p in points]), {"units": unit, "long_name": problem.parameter}),
-        "alpha": (P, np.array([p.x[STATE_ALPHA] for p in points]), {"units": "rad",
-                                                                    "long_name": "alpha at the section"}),
+        "alpha": (P, np.array([p.x[STATE_ALPHA] for p in points]), {"units": q_unit,
+                                                                    "long_name": f"{q} at the section"}),
         "alpha_dot": (P, np.array([p.x[STATE_ALPHA_DOT] for p in points]),
-                      {"units": "rad/s", "long_name": "alpha_dot at the section"}),
+                      {"units": f"{q_unit}/s", "long_name": f"{q}_dot at the section"}),
         "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier, real part"}),
         "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier, imaginary part"}),
         "multiplier_modulus": (PM, np.abs(mu), {"units": "1", "long_name": "|Floquet multiplier|"}),
@@ -96,8 +106,8 @@ def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, pr
                               {"long_name": "the provider of dP/dx (index into the attribute providers)"}),
         "difference_step": (("point", "difference"),
                             np.array([p.derivation.steps for p in points]).reshape(-1, N_STATE + 1),
-                            {"long_name": "central-difference steps in alpha (rad), alpha_dot (rad/s) and the "
-                                          "parameter (its unit); NaN: not by differences"}),
+                            {"long_name": f"central-difference steps in {q} ({q_unit}), {q}_dot ({q_unit}/s) and "
+                                          "the parameter (its unit); NaN: not by differences"}),
         "max_gap": (P, np.array([p.max_gap for p in points]),
                     {"units": "m", "long_name": "largest gap psi_i over the orbit (Eq. 6); < 0: deflection, "
                                                 "the follower never leaves the cam"}),
@@ -108,12 +118,13 @@ def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, pr
                  {"long_name": "mode at the section (index into the attribute modes)"}),
         "residual": (P, np.array([p.residual for p in points]), {"units": "1", "long_name": "scaled residual"}),
         "alpha_revolution": (("point", "revolution"), _padded([p.alpha_revolutions for p in points], n_rev),
-                             {"units": "rad", "long_name": "alpha at the starts of the orbit's revolutions "
-                                                           "(the brute-force diagram's sections)"}),
+                             {"units": q_unit, "long_name": f"{q} at the starts of the orbit's revolutions "
+                                                            "(the brute-force diagram's sections)"}),
     }
 
 
 def _event_variables(problem: Problem, branches: list, events: list, unit: str, n_rev: int) -> dict:
+    q, q_unit = _coordinate(problem)
     offsets = np.cumsum([0] + [len(b.points) for b in branches])
     E, EM = ("event",), ("event", "multiplier")
     mu = np.array([e.multipliers for e in events], dtype=complex).reshape(-1, N_STATE)
@@ -121,13 +132,14 @@ def _event_variables(problem: Problem, branches: list, events: list, unit: str, 
         "event_kind": (E, np.array([EVENTS.index(e.kind) for e in events], dtype=int),
                        {"long_name": "event kind (index into the attribute event_kinds)"}),
         "event_lambda": (E, np.array([e.lam for e in events]), {"units": unit, "long_name": problem.parameter}),
-        "event_alpha": (E, np.array([e.x[STATE_ALPHA] for e in events]), {"units": "rad"}),
-        "event_alpha_dot": (E, np.array([e.x[STATE_ALPHA_DOT] for e in events]), {"units": "rad/s"}),
+        "event_alpha": (E, np.array([e.x[STATE_ALPHA] for e in events]), {"units": q_unit, "long_name": q}),
+        "event_alpha_dot": (E, np.array([e.x[STATE_ALPHA_DOT] for e in events]), {"units": f"{q_unit}/s",
+                                                                                  "long_name": f"{q}_dot"}),
         "event_branch": (E, np.array([e.branch for e in events], dtype=int), {"long_name": "the branch of the event"}),
         "event_point": (E, np.array([offsets[e.branch] + e.point for e in events], dtype=int),
                         {"long_name": "index of the point just before the event"}),
         "event_alpha_revolution": (("event", "revolution"), _padded([e.alpha_revolutions for e in events], n_rev),
-                                   {"units": "rad", "long_name": "alpha at the starts of the revolutions at the event"}),
+                                   {"units": q_unit, "long_name": f"{q} at the starts of the revolutions at the event"}),
         "event_max_gap": (E, np.array([e.max_gap for e in events]),
                           {"units": "m", "long_name": "largest gap psi_i over the orbit at the event (0 at grazing)"}),
         "event_multiplier_real": (EM, mu.real, {"units": "1"}),

@@ -37,6 +37,6 @@ class Outcome(ActionableOutcome):
                        "result.stats['where'] says when): use the full model (response='dynamic')")
     #: the engine loop's too (camdyn.engine.loop.OUTCOMES), last so that the codes of the members above (a
     #: sweep's outcome variable) stay what they were
-    OFF_FACE = ("the contact reached an end of the follower's face (the rig's face_start or face_end; Scene "
-                "face='bounded'), or an impact would land beyond one: the cam would touch the face's edge, which the "
-                "model does not describe; lengthen the face (or move it), or run at another speed")
+    OFF_FACE = ("the contact reached an end of the follower's bounded face (where the rig says it starts or "
+                "ends), or an impact would land beyond one: the cam would touch the face's edge, which the model does "
+                "not describe; lengthen the face (or move it), or run at another speed")

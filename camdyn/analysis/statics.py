@@ -236,7 +236,8 @@ class ResidualStats:
 
 
 def residual_stats(result: Result, *, transient_revolutions: float = 0.0) -> ResidualStats:
-    """The rms and peak-to-peak of the residual response alpha_r (Section 4, Fig. 4).
+    """The rms and peak-to-peak of the residual response alpha_r (Section 4, Fig. 4; the translating
+    follower's y_r).
 
     Parameters
     ----------
@@ -248,7 +249,7 @@ def residual_stats(result: Result, *, transient_revolutions: float = 0.0) -> Res
     Returns
     -------
     ResidualStats
-        ``rms`` (of alpha_r about its mean) and ``peak_to_peak``, in rad.
+        ``rms`` (of alpha_r about its mean) and ``peak_to_peak``, in rad (y_r: m).
 
     Raises
     ------
@@ -258,7 +259,7 @@ def residual_stats(result: Result, *, transient_revolutions: float = 0.0) -> Res
     if not math.isfinite(result.period) and transient_revolutions:
         raise ParameterError("transient_revolutions", transient_revolutions, "0 for a cam with no period")
     r = result.after(result.t[0] + transient_revolutions * result.period) if transient_revolutions else result
-    return ResidualStats(signal.rms(r.alpha_r, remove_mean=True), signal.peak_to_peak(r.alpha_r))
+    return ResidualStats(signal.rms(r.residual, remove_mean=True), signal.peak_to_peak(r.residual))
 
 
 def alpha_spectrum(result: Result, *, window: str = "hann"):

@@ -47,7 +47,8 @@ def cmd_simulate(args) -> int:
     if result.t.size > 1 and math.isfinite(result.period):
         transient = min(args.transient_revolutions, max(0.0, (result.t[-1] - result.t[0]) / result.period - 1e-9))
         stats = residual_stats(result, transient_revolutions=transient)
-        print(f"  alpha_r: rms {stats.rms:.6g} rad, peak-to-peak {stats.peak_to_peak:.6g} rad"
+        q, unit = result.meta.get("coordinate", "alpha"), "m" if result.meta.get("coordinate") == "y" else "rad"
+        print(f"  {q}_r: rms {stats.rms:.6g} {unit}, peak-to-peak {stats.peak_to_peak:.6g} {unit}"
               + (f" (after {transient:g} revolutions)" if transient else ""))
     if args.csv:
         write_csv(result, args.csv)

@@ -111,6 +111,12 @@ def describe_scene(scene) -> str:
         words.append("printed damping sign")
     if o.get("damping_switch") == "memoryless":
         words.append("memoryless D/E switch")
+    if o.get("follower", "oscillating") != "oscillating":
+        words.append(f"{o['follower']} follower")
+    if o.get("profile", "eccentric") != "eccentric":
+        words.append(f"{o['profile']} cam")
+    if o.get("face") == "bounded":
+        words.append("bounded face")
     return ", ".join(words)
 
 

@@ -57,6 +57,7 @@ PAPER_STYLE = {
 
 _SYMBOLS = {
     "alpha": r"\alpha", "alpha_dot": r"\dot\alpha", "alpha_r": r"\alpha_r", "alpha_i": r"\alpha_i",
+    "y": r"y", "y_dot": r"\dot y", "y_r": r"y_r", "y_i": r"y_i",
     "Theta": r"\Theta", "psi_i": r"\psi_i", "psi_j": r"\psi_j", "psi_i_dot": r"\dot\psi_i", "F_s": r"F_s",
     "F_n": r"F_n", "F_f": r"F_f", "v_r": r"v_r", "N_x": r"N_x", "energy": r"E", "P_in": r"P_{in}",
     "D_c": r"D_c", "D_f": r"D_f",
@@ -208,7 +209,7 @@ def time_history(results, quantity: str = "alpha_r", *, revolutions: tuple[float
 def overview(result, *, quantities: Sequence[str] | None = None, title: str | None = None):
     """A stacked view of one run over t/T: alpha_r, F_n and (with friction) v_r; free flight shaded."""
     if quantities is None:
-        quantities = ["alpha_r", "F_n"]
+        quantities = [result.meta.get("coordinate", "alpha") + "_r", "F_n"]
         if np.any(np.asarray(result.F_f) != 0):
             quantities.append("v_r")
     with _style():

@@ -231,7 +231,7 @@ class Model:
 
     @property
     def coordinate_limit(self) -> float:
-        """The bound on |coordinate| past which a run ends (Outcome.ANGLE_LIMIT): the paper's follower
+        """The bound on the coordinate's size past which a run ends (Outcome.ANGLE_LIMIT): the paper's follower
         near 90 degrees, where tan and sec of Eq. 11 blow up (ANGLE_LIMIT); none (inf) for the
         translating follower, whose laws have no singularity."""
         return ANGLE_LIMIT if self.scene.follower == _OSCILLATING else math.inf

@@ -62,6 +62,21 @@ MASS = 1.221        # kg, Siconos CamFollower example (and the issue)
 STIFFNESS = 1430.8  # N/m, same source
 
 
+
+def _moreau_jean(sk, h: float, n: int, restitution: float):
+    """The follower's relative coordinate as a Siconos Lagrangian system (mass, spring), its unilateral
+    contact with Newton's impact law, and Moreau-Jean time stepping (theta 0.5, LCP) over n steps of h:
+    (the system, its external force buffer, the interaction, the simulation)."""
+    ds = sk.LagrangianLinearTIDS(np.array([0.0]), np.array([0.0]), np.array([[MASS]]),
+                                 np.array([[STIFFNESS]]), np.array([[0.0]]))
+    fext = np.zeros(1)
+    ds.setFExtPtr(fext)
+    inter = sk.Interaction(sk.NewtonImpactNSL(restitution), sk.LagrangianLinearTIR(np.array([[1.0]])))
+    nsds = sk.NonSmoothDynamicalSystem(0.0, n * h)
+    nsds.insertDynamicalSystem(ds)
+    nsds.link(inter, ds)
+    return ds, fext, inter, sk.TimeStepping(nsds, sk.TimeDiscretisation(0.0, h), sk.MoreauJeanOSI(0.5), sk.LCP())
+
 def run(h: float, args) -> dict:
     import siconos.kernel as sk
 
@@ -76,15 +91,7 @@ def run(h: float, args) -> dict:
     force = -(MASS * omega**2 * d2 + STIFFNESS * (s - OFFSET)) - MASS * args.gravity
     f_step = 0.5 * (force[:-1] + force[1:])
 
-    ds = sk.LagrangianLinearTIDS(np.array([0.0]), np.array([0.0]), np.array([[MASS]]),
-                                 np.array([[STIFFNESS]]), np.array([[0.0]]))
-    fext = np.zeros(1)
-    ds.setFExtPtr(fext)
-    inter = sk.Interaction(sk.NewtonImpactNSL(args.restitution), sk.LagrangianLinearTIR(np.array([[1.0]])))
-    nsds = sk.NonSmoothDynamicalSystem(0.0, n * h)
-    nsds.insertDynamicalSystem(ds)
-    nsds.link(inter, ds)
-    sim = sk.TimeStepping(nsds, sk.TimeDiscretisation(0.0, h), sk.MoreauJeanOSI(0.5), sk.LCP())
+    ds, fext, inter, sim = _moreau_jean(sk, h, n, args.restitution)
 
     q = np.empty(n + 1); v = np.empty(n + 1); p = np.zeros(n + 1)
     q[0] = 0.0; v[0] = 0.0
@@ -137,15 +144,7 @@ def selfcheck(args) -> None:
     t = np.arange(n + 1) * h
     s, _, d2 = law(omega * t)
     force = -(MASS * omega**2 * d2 + STIFFNESS * (s - OFFSET)) - MASS * args.gravity
-    ds = sk.LagrangianLinearTIDS(np.array([0.0]), np.array([0.0]), np.array([[MASS]]),
-                                 np.array([[STIFFNESS]]), np.array([[0.0]]))
-    fext = np.zeros(1)
-    ds.setFExtPtr(fext)
-    inter = sk.Interaction(sk.NewtonImpactNSL(args.restitution), sk.LagrangianLinearTIR(np.array([[1.0]])))
-    nsds = sk.NonSmoothDynamicalSystem(0.0, n * h)
-    nsds.insertDynamicalSystem(ds)
-    nsds.link(inter, ds)
-    sim = sk.TimeStepping(nsds, sk.TimeDiscretisation(0.0, h), sk.MoreauJeanOSI(0.5), sk.LCP())
+    ds, fext, inter, sim = _moreau_jean(sk, h, n, args.restitution)
     p = np.zeros(n + 1); q = np.zeros(n + 1)
     for k in range(n):
         fext[0] = 0.5 * (force[k] + force[k + 1])

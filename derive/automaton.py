@@ -17,7 +17,9 @@ Semantics (the engine implements exactly these rules, once):
   along the motion decides (alpha moved by alpha_dot over 1e-9 s).  The last candidate has no
   condition, so a target always exists.
 * The state after the switch is the transition's **reset** of the state before it: the
-  identity in this model, where the contact is compliant (a restitution law would be a reset).
+  identity where the contact is compliant; the rigid law's impact is a reset (Newton's law), and a
+  chatter of impacts converging geometrically ends with the automaton's ``chatter`` transition in its
+  place (the engine's rule, camdyn.engine.rules.chatter_ends).
 * The **initial** mode is chosen by the same rule from the ``initial`` candidates.
 
 Modes and their surfaces (non-linear model):
@@ -97,6 +99,9 @@ class Automaton:
     initial: tuple[Target, ...]
     transitions: tuple[Transition, ...]
     resets: tuple[str, ...] = ("identity",)
+    #: the rigid law's chatter end: a transition of the same source, surface and direction as the impact
+    #: it replaces where the engine finds the impacts converging geometrically (camdyn.engine.rules.chatter_ends)
+    chatter: Transition | None = None
 
     def mode(self, name: str) -> Mode:
         return next(m for m in self.modes if m.name == name)
@@ -177,8 +182,29 @@ def _damping_transitions(spec: SceneSpec, mode: Mode) -> list[Transition]:
     return []
 
 
+#: the rigid law's resets: Newton's impact law, and the plastic impact that ends a chatter
+IMPACT, PLASTIC = "impact", "plastic"
+
+
+def _rigid(spec: SceneSpec) -> Automaton:
+    """The rigid contact law (derive.rigid): free flight bounces off the cam at the gap with Newton's
+    impact law (a reset; the follower flies on), and a chatter of impacts converging geometrically ends
+    in the constrained mode ``contact`` (the plastic reset) where its contact force is compressive; the
+    follower leaves the constrained mode where the contact force turns negative."""
+    free, contact = Mode("free", False), Mode(mode_name(True), True)
+    transitions = (Transition("free", "gap", -1, (Target("free"),), IMPACT),
+                   Transition(contact.name, "contact_force", -1, (Target("free"),)))
+    riding = Target(contact.name, (Condition("contact_force", +1),))
+    chatter = Transition("free", "gap", -1, (riding, Target("free")), PLASTIC)
+    initial = (Target(contact.name, (Condition("gap", -1), Condition("contact_force", +1))), Target("free"))
+    return Automaton((free, contact), ("gap", "gap_rate", "contact_force"), {"gap": "gap_rate"}, initial,
+                     transitions, ("identity", IMPACT, PLASTIC), chatter)
+
+
 def build(spec: SceneSpec) -> Automaton:
     """The automaton of a scene (see the module docstring)."""
+    if spec.contact == "rigid":
+        return _rigid(spec)
     all_modes = modes(spec)
     coulomb = spec.friction == "coulomb"
     if spec.model != "nonlinear":  # sliding contact throughout; the friction sign fixed at the start

@@ -47,4 +47,7 @@ CATALOG: tuple[SceneSpec, ...] = tuple(_IMPACT + [
     # its statics (equilibrium, inverse kinematics: camdyn.analysis.statics) on either cam
     SceneSpec(damping="none", friction="none", follower="translating"),
     SceneSpec(damping="none", friction="none", follower="translating", profile="spline"),
+    # the rigid contact law (issue 28): Newton's impacts, the constrained mode, chatter's end
+    SceneSpec(contact="rigid", damping="none", friction="none"),
+    SceneSpec(contact="rigid", damping="none", friction="none", follower="translating"),
 ])

@@ -45,6 +45,7 @@ PARAM_ORDER = S.RIG_NAMES + tuple(sym.name for sym in laws.CONSTANTS) + S.DERIVE
 UNITS = {**{name: p.unit for name, p in S.PARAMS.items()}, "Y_e": "Pa",
          PROFILE_BLOCK: "m and rad: the profile's data (derive.profile_code)"}
 ARGS = {"m": "mode index: a position in MODES (MODE_<NAME> constants)",
+        "j": "reset index: a position in RESETS (RESET_<NAME> constants)",
         "s": "surface index: a position in SURFACES (SURFACE_<NAME> constants)",
         "t": "time (s)", "alpha": "follower angle alpha (rad, clockwise)",
         "alpha_dot": "follower angular velocity (rad/s)", "Theta": "cam angle (rad)",
@@ -59,7 +60,7 @@ RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
                 "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "V_s": "J", "V_s_printed": "J",
-                "y_ddot": "m/s^2", "dy_ddot_dy": "1/s^2", "dy_ddot_dy_dot": "1/s", "dh_dy": "surface unit/m",
+                "alpha": "rad", "alpha_dot": "rad/s", "y": "m", "y_dot": "m/s", "y_ddot": "m/s^2", "dy_ddot_dy": "1/s^2", "dy_ddot_dy_dot": "1/s", "dh_dy": "surface unit/m",
                 "dh_dy_dot": "surface unit s/m", "F": "N", "dF_dy": "N/m", "y_i": "m", "dy_i_dTheta": "m/rad",
                 "d2y_i_dTheta2": "m/rad^2", "spring_force": "N",
                 **{name: unit for f in S.COORDINATES for name, (unit, _) in outputs_of(f).items()},
@@ -238,6 +239,8 @@ class _Writer:
     def _value_name(self, arg: str, value: int) -> str:
         if arg == "m":
             return constant_name("MODE", self.automaton.modes[value].name)
+        if arg == "j":
+            return constant_name("RESET", self.automaton.resets[value])
         return constant_name("SURFACE", self.automaton.surfaces[value])
 
     def guard(self, keys, context) -> str:
@@ -380,6 +383,8 @@ class _Writer:
 def _universe(f: Function, automaton: Automaton) -> set:
     if f.dispatch == ("m",):
         return {(m,) for m in range(len(automaton.modes))}
+    if f.dispatch == ("j",):
+        return {(j,) for j in range(len(automaton.resets))}
     if f.dispatch == ("m", "s"):
         return {(m, s) for m in range(len(automaton.modes)) for s in range(len(automaton.surfaces))}
     return {()}
@@ -520,7 +525,13 @@ def _automaton_code(A: Automaton) -> list[str]:
               "#: target whose conditions hold",
               "TRANSITIONS = ("]
     lines += ["    (" + ", ".join(_transition_cells(tr, mode, surf, targets)) + ")," for tr in A.transitions]
-    return lines + [")"]
+    lines += [")"]
+    if A.chatter is not None:
+        lines += ["#: the rigid law's chatter end, a row like TRANSITIONS': where the impacts through the transition of",
+                  "#: the same source, surface and direction converge geometrically, the engine takes this row's",
+                  "#: targets and reset instead (camdyn.engine.rules.chatter_ends)",
+                  "CHATTER = (" + ", ".join(_transition_cells(A.chatter, mode, surf, targets)) + ")"]
+    return lines
 
 
 def _transition_cells(tr, mode: dict, surf: dict, targets) -> list[str]:

@@ -28,9 +28,11 @@ def static_gap(profile: str = dynamics.ECCENTRIC, follower: str = dynamics.OSCIL
 
 
 def static_moment(contact: str, profile: str = dynamics.ECCENTRIC) -> sp.Expr:
-    """M(alpha) at rest, undamped and frictionless: Eq. 18 is M(alpha*) = 0."""
-    regime = dynamics.ContactRegime(contact=contact, profile=profile)
-    return at_rest(dynamics.moment_about_P(dynamics.forces(regime), profile=profile))
+    """M(alpha) at rest, undamped and frictionless: Eq. 18 is M(alpha*) = 0.  The rigid law has no
+    deflection to balance the spring: its M is the spring's alone (negative where the spring presses the
+    follower onto the cam), and its equilibrium is the 0-state."""
+    regime = None if contact == "rigid" else dynamics.ContactRegime(contact=contact, profile=profile)
+    return at_rest(dynamics.moment_about_P(dynamics.forces(regime, profile=profile), profile=profile))
 
 
 def static_load(contact: str, profile: str = dynamics.ECCENTRIC, follower: str = dynamics.OSCILLATING) -> sp.Expr:
@@ -38,7 +40,8 @@ def static_load(contact: str, profile: str = dynamics.ECCENTRIC, follower: str =
     the translating follower's force along its guide, F_n - F_s at Theta0 (undamped, frictionless)."""
     if follower == dynamics.OSCILLATING:
         return static_moment(contact, profile)
-    f = dynamics.forces(dynamics.ContactRegime(contact=contact, profile=profile, follower=follower))
+    regime = None if contact == "rigid" else dynamics.ContactRegime(contact=contact, profile=profile, follower=follower)
+    f = dynamics.forces(regime, follower, profile)
     return at_rest(translating.force_along_guide(f.F_s, f.F_n, f.F_f))
 
 

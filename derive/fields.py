@@ -25,7 +25,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import dynamics, energy, equilibrium, geometry, laws, linear, profile, translating
+from . import dynamics, energy, equilibrium, geometry, laws, linear, profile, rigid, translating
 from . import symbols as S
 from .automaton import Mode
 from .dynamics import Q
@@ -134,10 +134,33 @@ def _linear_field(spec: SceneSpec, mode: Mode) -> Definition:
 
 
 # --- the kernels --------------------------------------------------------------------------
+def _rigid_field(spec: SceneSpec) -> tuple[Definition, ...]:
+    """The rigid law's constrained mode: the gap rate's partials and the acceleration that keeps the
+    follower on the cam (derive.rigid.constrained_acceleration)."""
+    q = coordinate(spec)
+    psi_dot = plain(dynamics.gap_rate(spec.profile, spec.follower), spec.motion)
+    return rigid.gap_rate_partials(psi_dot, q) + (
+        Definition(q.acceleration, rigid.constrained_acceleration(q), "riding the cam: psi_i_ddot = 0 (rigid contact)"),)
+
+
+def _rigid_contact_force(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
+    """The rigid law's constrained mode with its contact force: the geometry (Eqs. 6-8, 2), the spring
+    (Eq. 11), the constrained acceleration and the normal force that produces it (derive.rigid)."""
+    r = regime(spec, mode)
+    q = coordinate(spec)
+    geometry = _plain_all(dynamics._contact_geometry(r) + [Definition(Q.F_s, dynamics.spring_force(
+        spec.follower, spec.profile), "spring force (Eq. 11)")], spec.motion)
+    force = Definition(Q.F_n, plain(rigid.contact_force(r, q.acceleration), spec.motion),
+                       "normal force of the rigid contact: keeps the follower on the cam")
+    return geometry + _rigid_field(spec) + (force,)
+
+
 def field(spec: SceneSpec, mode: Mode) -> Kernel:
     """alpha_ddot of the mode."""
     if spec.model != "nonlinear":
         return Kernel((_linear_field(spec, mode),), (Q.alpha_ddot,))
+    if spec.contact == "rigid" and mode.contact:
+        return Kernel(_rigid_field(spec), (coordinate(spec).acceleration,)).pruned()
     defs = _sliding_mode(spec) if mode.slip == "stick" else _mechanics(spec, mode)
     return Kernel(defs, (coordinate(spec).acceleration,)).pruned()
 
@@ -170,6 +193,10 @@ def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
         return Kernel((Definition(value, profile.junction(phi), "the arcs' junction indicator"),), (value,))
     if name == "face":
         return _face_margin(spec)
+    if name == "contact_force":
+        if not mode.contact:
+            return None
+        return Kernel(_rigid_contact_force(spec, mode), (Q.F_n,)).pruned()
     if name in ("slip_rate_fwd", "slip_rate_bwd") and mode.contact:
         side = _mechanics(spec, mode, direction=1 if name == "slip_rate_fwd" else -1)
         v_t, v_a, v_ad = V_R_PARTIALS
@@ -330,7 +357,7 @@ def _energy_terms(contact: str, profile: str, follower: str):
     and in contact V_c(psi_i), in plain symbols (psi_i named; a point contact on a cam other than the
     circle: rho named)."""
     radius = Q.rho if contact == "point" and profile != dynamics.ECCENTRIC else S.r_c
-    V_c = laws.contact_potential(contact, Q.psi_i, radius)
+    V_c = sp.Integer(0) if contact == "rigid" else laws.contact_potential(contact, Q.psi_i, radius)
     if follower == dynamics.TRANSLATING:
         V_s = dynamics._on_cam(profile, translating.spring_potential(S.y_s))
         if sp.expand(V_s.diff(S.y_s) - dynamics._on_cam(profile, translating.spring_force(S.y_s))) != 0:
@@ -343,7 +370,10 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
     """The output quantities (vocabulary.OUTPUTS order) in the mode."""
     r = regime(spec, mode)
     zero = sp.Integer(0)
-    if mode.slip == "stick":
+    rigid_law = spec.contact == "rigid"
+    if rigid_law and mode.contact:
+        defs = _rigid_contact_force(spec, mode)
+    elif mode.slip == "stick":
         defs = _mechanics(spec, mode, direction=1)[:-1]  # the forces without Coulomb's F_f, alpha_ddot
         defs = tuple(d for d in defs if d.symbol not in (Q.mu, Q.F_f)) + _stuck_friction(spec, mode)
     else:
@@ -370,6 +400,9 @@ def outputs(spec: SceneSpec, mode: Mode) -> Kernel:
     E = inertia * q.rate**2 / 2 + V_s + (V_c if r else zero)
     if r is None:  # free flight: no contact force, nothing delivered or dissipated
         dE_dt = D_c = D_f = zero
+    elif rigid_law:  # no deflection, no damping law: the impacts' losses are jumps of the energy, not flows
+        D_c, D_f = zero, forces.F_f * v_kin
+        dE_dt = (inertia * q.acceleration + dV_s) * q.rate
     else:
         F_d = -Q.c_lambda * Q.psi_i_dot  # the damping part of F_n (Eq. 12)
         D_c, D_f = -F_d * Q.psi_i_dot, forces.F_f * v_kin

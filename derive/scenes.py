@@ -35,7 +35,8 @@ from functools import lru_cache
 
 import sympy as sp
 
-from . import dynamics, energy, equilibrium, fields, geometry, laws, translating
+from . import dynamics, energy, equilibrium, fields, geometry, laws, rigid, translating
+from .dynamics import Q
 from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
@@ -135,6 +136,31 @@ def _single(*results: sp.Expr) -> tuple[Case, ...]:
     return (Case((), Kernel((), tuple(results))),)
 
 
+def _stiffness_at_rest(spec: SceneSpec, psi_i: sp.Expr, radius: sp.Expr) -> sp.Expr:
+    """k_lambda(psi_i*) (Eq. 13 or 34, secant); infinite for the rigid law."""
+    return sp.oo if spec.contact == "rigid" else laws.contact_stiffness(spec.contact, psi_i, radius)
+
+
+def _reset_cases(spec: SceneSpec, A: Automaton) -> tuple[Case, ...]:
+    """Each reset of the automaton (RESETS): the state after it, (q, q_dot+): the identity, or the rigid
+    law's impact (Newton's law) and plastic impact (derive.rigid)."""
+    q = fields.coordinate(spec)
+    psi_dot = fields.plain(dynamics.gap_rate(spec.profile, spec.follower), spec.motion)
+    cases = []
+    for j, name in enumerate(A.resets):
+        if name == "identity":
+            cases.append(Case((j,), Kernel((), (q.plain, q.rate))))
+            continue
+        rate = rigid.impact_rate(Q.psi_i_dot, q) if name == "impact" else rigid.plastic_rate(Q.psi_i_dot, q)
+        after = sp.Symbol(f"{q.rate.name}_after", real=True)
+        defs = (Definition(Q.psi_i_dot, psi_dot, "gap rate before the impact (Eq. 8)"),
+                rigid.gap_rate_partials(psi_dot, q)[2],
+                Definition(after, rate, "Newton's impact law: psi_i_dot leaves at -xi times its arrival"
+                           if name == "impact" else "a plastic impact: psi_i_dot leaves at 0 (a chatter's end)"))
+        cases.append(Case((j,), Kernel(defs, (q.plain, after))))
+    return tuple(cases)
+
+
 def _translating_static_functions(spec: SceneSpec) -> list[Function]:
     """The translating follower's kernels that do not depend on a run: the static force along the
     guide at Theta0 (its zero is the equilibrium, as Eqs. 16-18), the follower in rigid contact
@@ -149,8 +175,7 @@ def _translating_static_functions(spec: SceneSpec) -> list[Function]:
     name = STATIC_LOAD[spec.follower]
     return [
         Function(name, ("y", "p"), (), ("F", "dF_dy", "psi_i", "psi_j", "k_lambda"),
-                 _single(F, F.diff(S.y_s), psi_i_star, psi_j_star,
-                         laws.contact_stiffness(spec.contact, psi_i_star, radius)),
+                 _single(F, F.diff(S.y_s), psi_i_star, psi_j_star, _stiffness_at_rest(spec, psi_i_star, radius)),
                  "Static force along the guide at Theta0 (F_n - F_s; its zero is the equilibrium y*), its slope, "
                  "psi_i*, psi_j* and the contact stiffness k_lambda(psi_i) (Eq. 13 or 34, secant).", "tuple"),
         Function("rigid_contact", ("Theta", "p"), (), ("y_i", "dy_i_dTheta", "d2y_i_dTheta2", "spring_force"),
@@ -174,8 +199,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
         equilibrium.at_rest(geometry.curvature_radius()))
     static = [
         Function("static_moment", ("alpha", "p"), (), ("M", "dM_dalpha", "psi_i", "psi_j", "k_lambda"),
-                 _single(M, M.diff(S.alpha_s), psi_i_star, psi_j_star,
-                         laws.contact_stiffness(spec.contact, psi_i_star, radius)),
+                 _single(M, M.diff(S.alpha_s), psi_i_star, psi_j_star, _stiffness_at_rest(spec, psi_i_star, radius)),
                  "Static moment about P at Theta0, its slope, psi_i*, psi_j* (Eqs. 16-18) and the contact "
                  "stiffness k_lambda(psi_i) (Eq. 13 or 34, secant).", "tuple"),
         Function("spring_potential", ("alpha", "p"), (), ("V_s", "V_s_printed"),
@@ -243,6 +267,10 @@ def build(spec: SceneSpec) -> SceneModule:
                               _mode_cases(A, lambda mode: fields.outputs(spec, mode)),
                               "The output quantities in mode m: out[OUT_<NAME>] for each name of OUTPUTS.",
                               "fill"))
+    if len(A.resets) > 1:
+        functions.append(Function("reset", ("j", "t", q, q_dot, "p", "out"), ("j",), (q, q_dot), _reset_cases(spec, A),
+                                  "The state after reset j (RESETS): out[STATE_ALPHA] = the coordinate, "
+                                  "out[STATE_ALPHA_DOT] = its rate (camdyn.vocabulary).", "fill"))
     functions += _static_functions(spec)
     return SceneModule(spec, A, tuple(functions), _variational_functions(spec, A))
 
@@ -251,7 +279,7 @@ def _variational_functions(spec: SceneSpec, A: Automaton) -> tuple[Function, ...
     """The kernels of the companion module: the field's parameter derivatives (non-linear model)
     and the switching surfaces' gradients (a scene with transitions)."""
     functions = []
-    if spec.model == "nonlinear":
+    if spec.model == "nonlinear" and spec.contact != "rigid":  # (the rigid law's: not derived yet)
         names = fields.continuation_parameters(spec, A.modes)
         functions.append(Function("field_sensitivity", _state_args(spec, "m", out=True), ("m",),
                                   tuple(f"d{state_names(spec.follower)[0]}_ddot_d{n}" for n in names),

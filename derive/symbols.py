@@ -81,6 +81,7 @@ m_f = PARAMS["m_f"].symbol
 gamma = PARAMS["gamma"].symbol
 offset = PARAMS["offset"].symbol
 F_p = PARAMS["F_p"].symbol
+xi = PARAMS["xi"].symbol
 face_start = PARAMS["face_start"].symbol
 face_end = PARAMS["face_end"].symbol
 alpha_star = PARAMS["alpha_star"].symbol

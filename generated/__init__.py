@@ -39,4 +39,6 @@ SCENES = {
     'line_none_none_constant_nonlinear_translating_spline': 'scene_line_none_none_constant_nonlinear_translating_spline',
     'point_d_coulomb_constant_nonlinear': 'scene_point_d_coulomb_constant_nonlinear',
     'point_none_none_constant_nonlinear': 'scene_point_none_none_constant_nonlinear',
+    'rigid_none_none_constant_nonlinear': 'scene_rigid_none_none_constant_nonlinear',
+    'rigid_none_none_constant_nonlinear_translating': 'scene_rigid_none_none_constant_nonlinear_translating',
 }

@@ -30,8 +30,8 @@ from ..vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
-from .rules import (NONFINITE, across, chattering, clear_of_surfaces, first_crossing, initial_mode, left_at_start,
-                    scratch, switch, zero_at_start)
+from .rules import (CHATTER_COUNT, NONFINITE, across, chatter_ends, chattering, clear_of_surfaces, first_crossing,
+                    initial_mode, left_at_start, scratch, switch, value, zero_at_start)
 from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coefficients, dense_eval, initial_step
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -220,6 +220,9 @@ def run(prob, method, cfg, start, samples):
     K, Q, work, buf, ledger_work, ledger_tmp, sw = _buffers(method, tab)
     ledger = samples.y.shape[0] > STATE_ROWS
     n_sw, i_sample, outcome, nfev, steps, rejected = 0, 0, SUCCESS, 0, 0, 0
+    history = np.empty(4)  # the impacts of a chatter (rules.chatter_ends; scenes with rigid impacts)
+    for k in range(4):  # not np.zeros: one overload less to compile on a cold start
+        history[k] = 0.0
     t, t_end, y0, y1 = start.t, start.t_end, start.alpha, start.alpha_dot
     m = start.mode if start.mode >= 0 else initial_mode(prob, t, y0, y1, cfg.look_ahead)
     if tab.data[tab.mode_terminal + m] == 1:  # it starts where the model ends (a contact beyond the face)
@@ -274,7 +277,14 @@ def run(prob, method, cfg, start, samples):
                     have_start, retries = False, retries + 1
                     continue
                 retries = 0
-                m_new, c0, c1 = switch(prob, w, t_cross, c0, c1, cfg, buf)
+                row = w
+                if w == tab.chatter:  # an impact: the chatter's end where its sequence has converged
+                    rate = value(prob, m, tab.data[tab.surface_rate + tab.data[tab.surface + w]], t_cross, c0, c1)
+                    if chatter_ends(history, t_cross, rate, cfg.atol, cfg.xtol * max(1.0, abs(t_cross))):
+                        row = tab.n_transitions + 1
+                else:
+                    history[CHATTER_COUNT] = 0.0
+                m_new, c0, c1 = switch(prob, row, t_cross, c0, c1, cfg, buf)
                 capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
                 sw = _record(sw, n_sw, t_cross, w, m, m_new, c0, c1)
                 n_sw += 1

@@ -42,6 +42,20 @@ the mode at its start.
 
 *Chatter.*  More than ``chatter_switches`` switches within ``chatter_window`` (relative) of the
 latest is a run making no progress: it stops (``Outcome.CHATTER``).
+
+*A chatter's end.*  A scene with rigid impacts declares the transition a chatter end replaces (the
+impact, ``CHATTER``).  At each impact through it the rate of approach v_k (its surface's declared
+rate, < 0) is kept; where three impacts in a row shrink it by one ratio r (v_k / v_k-1 and
+v_k-1 / v_k-2 within ``CHATTER_RATIO_SPREAD`` of each other, 0 < r < 1), the impacts are those of a
+bouncing ball under the constant relative acceleration |a| = 2 |v_k| / dt_k (dt_k the last flight):
+the next hop would rise H = r^2 |v_k| dt_k / 4 and the rest would end at the accumulation point
+t_k + dt_k r / (1 - r).  Once H is below ``atol`` (the gap's metres against the coordinate's
+tolerance: the hops are below what the integration resolves), or two impacts fall within the time
+resolution ``xtol``, or one arrives with no approach (hops below rounding), the impact takes the
+chatter end's targets and reset instead (:func:`chatter_ends`): the plastic impact into the constrained mode.
+From there the constrained motion is the true one from the accumulation point on (both ride the
+cam with no relative velocity) and differs from it before by at most H.  A sequence that does not
+converge is followed impact by impact, up to the chatter and event limits above.
 """
 from __future__ import annotations
 
@@ -237,8 +251,19 @@ def turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb
 @jitable
 def _changes(direction, ga, gb, rate, ra, rb):
     """Whether a sample may hide a crossing: a sign change in the direction, or (with a rate
-    surface) a turn of the rate (:func:`_turns`); :func:`_crossing_in` decides."""
-    return crossed(ga, gb, direction) or (rate >= 0 and _turns(direction, ga, ra, rb))
+    surface) a turn of the rate (:func:`_turns`), or a hop from the surface (:func:`_hops_back`);
+    :func:`_crossing_in` decides."""
+    return crossed(ga, gb, direction) or (rate >= 0 and (_turns(direction, ga, ra, rb)
+                                                         or _hops_back(direction, ga, gb, ra, rb)))
+
+
+@jitable
+def _hops_back(direction, ga, gb, ra, rb):
+    """A value on the surface or just across it at ta (a restart at a located crossing) that leaves
+    towards the watched side (its rate away from the far side: a reset turned the motion, the rigid
+    law's impact) and is across again at tb, the rate turned: a hop out and back inside (ta, tb],
+    which no sign change of the samples shows (*Crossings*)."""
+    return ga * direction >= 0.0 and ra * direction < 0.0 and rb * direction > 0.0 and gb * direction >= 0.0
 
 
 @jitable
@@ -259,6 +284,11 @@ def _crossing_in(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, r
             lo, glo, genuine = turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb)
         if genuine:
             return locate(prob, m, s, t, h, y0, y1, Q, lo, tb, glo, gb, cfg.xtol)[0]
+    elif rate >= 0 and _hops_back(direction, ga, gb, ra, rb):
+        t_ext, g_ext = extremum(prob, m, s, rate, t, h, y0, y1, Q, ta, tb, ra, rb)
+        if g_ext * direction < 0.0:  # the hop's apex, on the watched side: the landing follows it
+            return locate(prob, m, s, t, h, y0, y1, Q, t_ext, tb, g_ext, gb, cfg.xtol)[0]
+        return t_ext  # an apex that never cleared the surface: it lands there (a hop below rounding)
     elif rate >= 0 and _turns(direction, ga, ra, rb):
         t_ext, g_ext = hidden_excursion(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, gb, ra, rb,
                                         cfg.reach_factor)
@@ -432,12 +462,39 @@ def across(prob, m, w, t, a, ad):
     return tab.data[tab.direction + w] * value(prob, m, tab.data[tab.surface + w], t, a, ad) >= 0.0
 
 
+#: the spread of successive impact ratios (relative) within which a sequence counts as geometric
+CHATTER_RATIO_SPREAD = 0.05
+#: the slots of a chatter's history (:func:`chatter_ends`): the last impact's time and rate of approach,
+#: the last ratio of rates, and how many impacts in a row are kept
+CHATTER_T, CHATTER_V, CHATTER_RATIO, CHATTER_COUNT = range(4)
+
+
+@jitable
+def chatter_ends(history, t, v, atol, resolution):
+    """Whether the impact at time t with the rate of approach v (< 0) ends a chatter (*A chatter's end*,
+    the module docstring); ``history`` (CHATTER_* slots) is updated with it.  An impact with no approach
+    (v >= 0), or one within the time ``resolution`` of the last, also ends it: the follower cannot leave
+    the cam by more than rounding (released on a cam that recedes more slowly than it falls)."""
+    n = history[CHATTER_COUNT]
+    ends = v >= 0.0 or (n >= 1 and t - history[CHATTER_T] <= resolution)
+    if not ends and n >= 1 and history[CHATTER_V] < 0.0 and v < 0.0:
+        r = v / history[CHATTER_V]
+        dt = t - history[CHATTER_T]
+        if n >= 2 and 0.0 < r < 1.0 and dt > 0.0 and abs(r - history[CHATTER_RATIO]) <= CHATTER_RATIO_SPREAD * r:
+            ends = r * r * (-v) * dt / 4.0 <= atol
+        history[CHATTER_RATIO] = r
+    history[CHATTER_T], history[CHATTER_V] = t, v
+    history[CHATTER_COUNT] = 0.0 if ends else n + 1.0
+    return ends
+
+
 @jitable
 def switch(prob, w, t, a, ad, cfg, buf):
-    """The mode after transition w fires at (t, a, ad), and the state after its reset."""
+    """The mode after transition w fires at (t, a, ad), and the state after its reset; ``w`` past the
+    transitions, the chatter end's row (n_transitions + 1, with its reset)."""
     tab = prob.tables
     m_new = target(prob, w, t, a, ad, cfg.look_ahead)
-    j = tab.data[tab.reset + w]
+    j = tab.data[tab.reset + w] if w < tab.n_transitions else tab.chatter_reset
     if j >= 0:
         prob.kernels.reset(j, t, a, ad, prob.p, buf)
         return m_new, buf[STATE_ALPHA], buf[STATE_ALPHA_DOT]

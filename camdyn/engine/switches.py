@@ -95,6 +95,11 @@ class Switches(Sequence):
         """The mode after each switch (an index into ``modes``)."""
         return self.records["after"]
 
+    @property
+    def surface(self) -> np.ndarray:
+        """The surface each switch crossed, by name (from its transition)."""
+        return np.array([self.surfaces[int(w)] for w in self.records["transition"]], dtype=object)
+
     def shifted(self, dt: float) -> "Switches":
         """The same switches ``dt`` later (a piece of a run put in absolute time)."""
         out = self.records.copy()

@@ -49,6 +49,8 @@ class Tables(NamedTuple):
     n_transitions: int
     n_surfaces: int
     n_outputs: int
+    chatter: int = -1              # the impact transition a chatter end replaces (-1: none); its candidates
+    chatter_reset: int = IDENTITY  # are the target row n_transitions + 1, its reset this
 
 
 def tables(K: ModuleType) -> Tables:
@@ -66,9 +68,11 @@ def _module_tables(K: ModuleType) -> Tables:
 def _tables(K) -> Tables:
     transitions = transition_rows(K)
     n_modes = len(K.MODES)
+    chatter = getattr(K, "CHATTER", None)  # the rigid law's chatter end (derive.automaton)
     watch_start = np.searchsorted([tr[SOURCE] for tr in transitions], np.arange(n_modes + 1), side="left")
     target_start, target_mode, condition_start, condition_surface, condition_sign = [0], [], [0], [], []
-    for candidates in [tr[TARGETS] for tr in transitions] + [K.INITIAL]:
+    rows = [tr[TARGETS] for tr in transitions] + [K.INITIAL] + ([chatter[TARGETS]] if chatter is not None else [])
+    for candidates in rows:
         for mode, conditions in candidates:
             target_mode.append(mode)
             for surface, sign in conditions:
@@ -85,7 +89,18 @@ def _tables(K) -> Tables:
              [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled]
     starts = np.cumsum([0] + [len(part) for part in parts])[:-1]
     data = np.ascontiguousarray(np.concatenate([np.asarray(part, dtype=np.int64) for part in parts]), dtype=np.int64)
-    return Tables(data, *map(int, starts), n_modes, len(transitions), len(K.SURFACES), len(K.OUTPUTS))
+    replaced, reset = _chatter(K, transitions, chatter)
+    return Tables(data, *map(int, starts), n_modes, len(transitions), len(K.SURFACES), len(K.OUTPUTS), replaced, reset)
+
+
+def _chatter(K, transitions: list[tuple], chatter) -> tuple[int, int]:
+    """The index of the transition a chatter end replaces (its source, surface and direction) and the
+    chatter end's reset kernel index; (-1, IDENTITY) for a scene without one."""
+    if chatter is None:
+        return -1, IDENTITY
+    key = (chatter[SOURCE], chatter[SURFACE], chatter[DIRECTION])
+    replaced = next(w for w, tr in enumerate(transitions) if (tr[SOURCE], tr[SURFACE], tr[DIRECTION]) == key)
+    return replaced, IDENTITY if K.RESETS[chatter[RESET]] == "identity" else int(chatter[RESET])
 
 
 def sampled_surfaces(K: ModuleType, transitions: list[tuple], watch_start) -> tuple[list[int], list[int]]:

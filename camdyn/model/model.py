@@ -89,6 +89,18 @@ def zero_state(rig: Rig) -> float:
     return rig.alpha0
 
 
+def _rigid_equilibrium(rig: Rig, at_rest: tuple) -> Equilibrium:
+    """The rigid law's equilibrium: the 0-state itself (no deflection), the spring pressing the follower
+    onto the cam; its stiffness and frequency those of the follower on its spring alone (the contact has
+    none: vartheta sets only the step's cap and the run-length checks there)."""
+    _, dM, psi_i, psi_j, _ = at_rest
+    q0 = zero_state(rig)
+    chi = rig.chi0 if rig.follower == _OSCILLATING else math.nan
+    inertia = rig.I_Pb if rig.follower == _OSCILLATING else rig.m_f
+    return Equilibrium(float(q0), float(psi_i), float(psi_j), float(chi), float(-dM), math.inf,
+                       math.sqrt(abs(dM) / inertia))
+
+
 def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
     """q* from M(q*) = 0 near the 0-state, with M the generated static load (``static_moment``, the
     moment about P, Eqs. 16-18; the translating follower's ``static_force`` along its guide).
@@ -106,6 +118,8 @@ def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
         return load(a, p)[0]
 
     M0 = moment(q0)
+    if kernels.SCENE.get("contact") == "rigid" and M0 < 0:
+        return _rigid_equilibrium(rig, load(q0, p))
     if not M0 < 0:
         hint = "increase L_us or lower d_y" if rig.follower == _OSCILLATING else "give a preload F_p > 0"
         raise EquilibriumError(

@@ -123,9 +123,11 @@ class Result:
         return np.array([contact[name] for name in self.regime], dtype=bool)
 
     def impacts(self) -> np.ndarray:
-        """Times at which contact starts (a switch from a free mode to a contact mode)."""
+        """Times at which contact starts (a switch from a free mode to a contact mode), and the rigid
+        contact's impacts (a switch through the gap from free flight back into it: the bounce)."""
         before, after = self._contact_across_switches()
-        return self.switches.t[~before & after]
+        bounce = ~before & ~after & (self.switches.surface == "gap")
+        return self.switches.t[(~before & after) | bounce]
 
     def separations(self) -> np.ndarray:
         """Times at which contact ends."""

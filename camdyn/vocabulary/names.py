@@ -42,6 +42,8 @@ SURFACES: dict[str, tuple[str, str]] = {
                                "backward where it turns negative"),
     "junction": ("1", "a cam of circular arcs (profile 'arcs'): zero where the contact passes a junction of "
                       "two arcs, where the curvature jumps; the step restarts there, in the same mode"),
+    "contact_force": ("N", "the rigid contact's normal force in the constrained mode (contact 'rigid'): the "
+                           "follower leaves the cam where it turns negative"),
     "face": ("m^2", "a bounded face (face 'bounded'): (s - face_start)(face_end - s) of the contact's position s "
                     "along the face, negative where the contact is beyond an end"),
 }

@@ -193,6 +193,9 @@ RIG_PARAMETERS: tuple[RigParameter, ...] = (
                  "Eq. 2; translating follower", (Rule(">", "face_start", "the face ends after it begins"),
                                                  Rule("abs<=", 10.0, _MM, guard=True))),
     RigParameter("l_lambda", "m", "length of the line contact", False, "Eq. 13", _LENGTH),
+    RigParameter("xi", "1", "coefficient of restitution of the rigid contact's impacts: the normal relative velocity "
+                 "leaves at -xi times its arrival (Newton's law)", False, "Eq. 31; contact 'rigid'",
+                 (_NON_NEGATIVE, Rule("<=", 1.0, "a restitution above 1 would add energy at each impact"))),
     RigParameter("mu_m", "1", "friction coefficient", False, "Sec. 3.2, friction models I and II",
                  (_NON_NEGATIVE,)),
     RigParameter("s", "s/m", "smoothing factor of the tanh friction model", False,

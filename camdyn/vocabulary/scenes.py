@@ -5,7 +5,9 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, fields
 
 # --- scene options ------------------------------------------------------------------------
-CONTACT_LAWS = ("line", "point")                        # Eq. 13 (line), Eq. 34 (point, Hertz)
+CONTACT_LAWS = ("line", "point", "rigid")               # Eq. 13 (line), Eq. 34 (point, Hertz); rigid: impacts
+#: the compliant contact laws (a contact stiffness, a deflection); the others are rigid (Newton's impacts)
+COMPLIANT = ("line", "point")
 DAMPING_MODELS = ("none", "A", "B", "C", "D", "E")      # Eqs. 24-28
 FRICTION_MODELS = ("none", "coulomb", "tanh")           # model I (Coulomb), model II (tanh)
 MOTIONS = ("constant", "oscillating", "user")           # Section 7
@@ -66,7 +68,9 @@ class SceneSpec:
 
     Its options::
 
-        contact:  "line" (Eq. 13) or "point" (Eq. 34)
+        contact:  "line" (Eq. 13), "point" (Eq. 34) or "rigid" (no deflection: Newton's impact law with
+                  the rig's restitution xi, the follower riding the cam in a constrained mode, chatter
+                  ended at its accumulation point; derive.rigid)
         damping:  "none" or "A".."E" (Eqs. 24-28)
         friction: "none", "coulomb" (model I) or "tanh" (model II)
         motion:   "constant", "oscillating" or "user" (Section 7)
@@ -186,6 +190,13 @@ def combination_problem(spec: SceneSpec) -> str:
         if spec.response != "dynamic":
             return (f"profile={spec.profile!r} has no quasi-static follower yet: its rigid contact angle is "
                     "implicit (use response='dynamic')")
+    if spec.contact == "rigid":
+        for name, allowed in (("damping", "none"), ("friction", "none"), ("model", "nonlinear"), ("face", "unbounded"),
+                              ("response", "dynamic"), ("motion", "constant")):
+            if getattr(spec, name) != allowed:
+                return (f"contact='rigid' needs {name}={allowed!r}: the impact law (restitution xi) takes the place of "
+                        "the compliant damping laws" if name == "damping" else
+                        f"contact='rigid' needs {name}={allowed!r} (not derived for the rigid law yet)")
     if spec.face == "bounded" and spec.model != "nonlinear":
         return "face='bounded' needs model='nonlinear' (the contact's ends are switching surfaces of the hybrid model)"
     if spec.follower == "translating":

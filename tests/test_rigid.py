@@ -1,0 +1,136 @@
+"""The rigid contact law (issue 28): Newton's impact law as a reset, the constrained mode and its
+contact force, the chatter's end at its accumulation point, against closed forms."""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import camdyn
+from camdyn.analysis import contact_loss_speed
+from camdyn.engine import EventSettings
+from camdyn.errors import ParameterError, SceneError
+from camdyn.model.presets import translating_example_rig
+
+XI = 0.8
+RIG = translating_example_rig().replace(xi=XI)
+SCENE = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none")
+ROCKER = camdyn.example_rig().replace(xi=XI)
+ROCKER_SCENE = camdyn.Scene(contact="rigid", damping="none", friction="none")
+
+
+@pytest.fixture(autouse=True)
+def _quiet():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", camdyn.CompileNotice)
+        yield
+
+
+@pytest.mark.parametrize("rig, scene", [(RIG, SCENE), (ROCKER, ROCKER_SCENE)], ids=["translating", "oscillating"])
+def test_the_impact_reset_is_newtons_law(rig, scene):
+    """At states with the cam turning, the generated impact reset leaves the normal relative velocity at
+    -xi times its arrival (so the normal relative kinetic energy keeps xi^2 of itself: 1 - xi^2 is lost),
+    the position unchanged; the plastic reset leaves it at 0.  Bound: rounding of the rates (1e-12)."""
+    model = camdyn.Model(rig, scene, camdyn.ConstantSpeed(300))
+    K = scene.kernels()
+    q0 = model.static_state()[0]
+    rng = np.random.default_rng(3)
+    out = np.empty(2)
+    for t, dq, v in zip(rng.uniform(0, 0.2, 20), rng.uniform(-1e-4, 1e-4, 20), rng.uniform(-0.5, 0.5, 20)):
+        before = model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, t, q0 + dq, v)
+        for reset, factor in ((K.RESET_IMPACT, -XI), (K.RESET_PLASTIC, 0.0)):
+            K.reset(reset, t, q0 + dq, v, model.p, out)
+            assert out[0] == q0 + dq
+            after = model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, t, out[0], out[1])
+            assert after == pytest.approx(factor * before, abs=1e-12 * max(1.0, abs(before)))
+
+
+def _bounces(xi: float, drop: float, count: int) -> np.ndarray:
+    """The closed form of the translating follower dropped by ``drop`` above its rest on the cam at rest:
+    the flights are arcs of the spring's oscillation about y_c = y0 - F_p/k_s (frequency w = sqrt(k_s/m_f)),
+    each leaving and landing at the same speed, which each impact multiplies by xi: the first landing at
+    acos(d/(d + drop))/w with the speed w sqrt((d + drop)^2 - d^2), d = F_p/k_s; a flight at launch speed
+    v lasts 2 atan2(v/w, d)/w.  Returns the first ``count`` impact times."""
+    w, d = math.sqrt(RIG.k_s / RIG.m_f), RIG.F_p / RIG.k_s
+    times, v = [math.acos(d / (d + drop)) / w], w * math.sqrt((d + drop) ** 2 - d ** 2)
+    for _ in range(count - 1):
+        v *= xi
+        times.append(times[-1] + 2 * math.atan2(v / w, d) / w)
+    return np.array(times)
+
+
+def test_a_follower_bouncing_on_a_dwell_is_the_closed_form_and_its_chatter_ends_at_the_accumulation_point():
+    """Dropped 1 mm on the cam at rest (a dwell): the impact times are the closed form's (bound 1e-9 s at
+    rtol 1e-11; measured 4e-12 s over 40 impacts), the chatter ends in the constrained mode where the hops
+    fall below atol, before the closed form's accumulation point and within the time the remaining flights
+    take (a geometric tail below 1e-6 s here), and the follower rests on the cam."""
+    y0 = RIG.r_c - RIG.e  # the 0-state: the base circle
+    r = camdyn.simulate(RIG, SCENE, speed_rpm=0, t_end=0.3, y0=(y0 + 1e-3, 0.0), rtol=1e-11, atol=1e-14,
+                        sample_rate_Hz=1000)
+    assert r.ok
+    impacts = r.impacts()
+    closed = _bounces(XI, 1e-3, 400)
+    assert impacts.size > 40
+    np.testing.assert_allclose(impacts[:40], closed[:40], rtol=0, atol=1e-9)
+    end = r.switches[-1]
+    assert (end.surface, end.before, end.after) == ("gap", "free", "contact")
+    accumulation = closed[-1]  # the flights after 400 impacts last < 1e-30 s
+    assert end.t <= accumulation and accumulation - end.t < 1e-6
+    assert r.y[-1] == y0 and r.y_dot[-1] == 0.0
+
+
+def test_a_perfectly_elastic_bounce_never_ends_as_chatter():
+    """xi = 1: every bounce rises as high as the first; the chatter rule must never end it (ratio 1)."""
+    rig = RIG.replace(xi=1.0)
+    y0 = rig.r_c - rig.e
+    r = camdyn.simulate(rig, SCENE, speed_rpm=0, t_end=0.5, y0=(y0 + 1e-4, 0.0), rtol=1e-11, atol=1e-14,
+                        sample_rate_Hz=1000)
+    assert r.ok and "contact" not in set(r.regime)
+    np.testing.assert_allclose(r.impacts(), _bounces(1.0, 1e-4, r.impacts().size), rtol=0, atol=1e-9)
+
+
+def test_a_chatter_that_does_not_converge_in_time_is_refused():
+    """A chatter followed impact by impact up to the event limit ends the run with its outcome."""
+    y0 = RIG.r_c - RIG.e
+    r = camdyn.simulate(RIG.replace(xi=0.99), SCENE, speed_rpm=0, t_end=2.0, y0=(y0 + 1e-3, 0.0),
+                        events=EventSettings(max_events=30))
+    assert r.outcome is camdyn.Outcome.MAX_EVENTS and len(r.switches) == 30
+
+
+@pytest.mark.parametrize("rig, scene", [(RIG, SCENE), (ROCKER, ROCKER_SCENE)], ids=["translating", "oscillating"])
+def test_the_rigid_follower_leaves_the_cam_at_the_inverse_kinematics_speed(rig, scene):
+    """No compliance: 0.1 % below the inverse-kinematics speed the follower rides the cam (it never leaves;
+    the rocker, released at rest where the cam recedes more slowly than it would fall, is put on the cam
+    by the chatter's end within the time resolution of the start), 0.1 % above it leaves the constrained
+    mode where its contact force turns negative."""
+    loss = contact_loss_speed(rig)
+    below = camdyn.simulate(rig, scene, speed_rpm=0.999 * loss, revolutions=3)
+    assert below.ok and below.separations().size == 0 and np.all(below.switches.t < 1e-12)
+    assert set(below.regime[1:]) == {"contact"}
+    above = camdyn.simulate(rig, scene, speed_rpm=1.001 * loss, revolutions=3)
+    assert above.ok and above.separations().size > 0
+
+
+def test_the_translating_follower_leaves_where_the_closed_form_says():
+    """At 1.1 x the loss speed the constrained force F_p + k_s e - (k_s e - m_f Omega^2 e) cos(phi) first
+    reaches zero at phi = 2 pi - acos(-(F_p + k_s e) / (m_f Omega^2 e - k_s e)); the rigid run leaves there
+    (bound 1e-7 rad: the engine's location of the force's root)."""
+    loss = contact_loss_speed(RIG)
+    omega = 1.1 * loss * 2 * math.pi / 60
+    r = camdyn.simulate(RIG, SCENE, speed_rpm=1.1 * loss, revolutions=1, rtol=1e-11)
+    leave = r.separations()[0]
+    phi = (RIG.gamma - (RIG.theta0 + omega * leave)) % (2 * math.pi)
+    kse = RIG.k_s * RIG.e
+    assert phi == pytest.approx(2 * math.pi - math.acos(-(RIG.F_p + kse) / (RIG.m_f * omega**2 * RIG.e - kse)),
+                                abs=1e-7)
+
+
+def test_bad_input_for_the_rigid_law_is_refused_with_the_reason():
+    with pytest.raises(ParameterError, match="xi"):
+        RIG.replace(xi=1.2)
+    with pytest.raises(SceneError, match="damping"):
+        camdyn.Scene(contact="rigid", damping="D")
+    with pytest.raises(ParameterError, match="xi"):
+        camdyn.simulate(translating_example_rig(), SCENE, speed_rpm=100, revolutions=1)

@@ -197,8 +197,13 @@ def _rigid(spec: SceneSpec) -> Automaton:
     riding = Target(contact.name, (Condition("contact_force", +1),))
     chatter = Transition("free", "gap", -1, (riding, Target("free")), PLASTIC)
     initial = (Target(contact.name, (Condition("gap", -1), Condition("contact_force", +1))), Target("free"))
-    return Automaton((free, contact), ("gap", "gap_rate", "contact_force"), {"gap": "gap_rate"}, initial,
-                     transitions, ("identity", IMPACT, PLASTIC), chatter)
+    surfaces = ("gap", "gap_rate", "contact_force")
+    if spec.profile == "arcs":  # the constrained acceleration jumps with the curvature: restart there, and
+        # leave where the contact force it needs jumps below zero (a corner of the cam flings the follower)
+        surfaces += ("junction",)
+        transitions += tuple(Transition(contact.name, "junction", d, (riding, Target("free"))) for d in (+1, -1))
+    return Automaton((free, contact), surfaces, {"gap": "gap_rate"}, initial, transitions,
+                     ("identity", IMPACT, PLASTIC), chatter)
 
 
 def build(spec: SceneSpec) -> Automaton:

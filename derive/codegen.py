@@ -60,6 +60,8 @@ RESULT_UNITS = {"alpha_ddot": "rad/s^2", "dalpha_ddot_dalpha": "1/s^2", "dalpha_
                 "M": "N m", "dM_dalpha": "N m/rad", "psi_i": "m", "psi_j": "m", "k_lambda": "N/m",
                 "reach_margin": "m", "alpha_i": "rad", "dalpha_i_dTheta": "1", "d2alpha_i_dTheta2": "1/rad",
                 "spring_moment": "N m", "V_s": "J", "V_s_printed": "J",
+                "dq_dq": "1", "dq_dq_dot": "s", "dq_dot_dq": "1/s", "dq_dot_dq_dot": "1", "dq_dt": "q/s",
+                "dq_dot_dt": "q/s^2",
                 "alpha": "rad", "alpha_dot": "rad/s", "y": "m", "y_dot": "m/s", "y_ddot": "m/s^2", "dy_ddot_dy": "1/s^2", "dy_ddot_dy_dot": "1/s", "dh_dy": "surface unit/m",
                 "dh_dy_dot": "surface unit s/m", "F": "N", "dF_dy": "N/m", "y_i": "m", "dy_i_dTheta": "m/rad",
                 "d2y_i_dTheta2": "m/rad^2", "spring_force": "N",
@@ -673,6 +675,8 @@ def _variational_source(L: _Layout) -> str:
     spec, A = L.mod.spec, L.mod.automaton
     data = [f"SLUG = {spec.slug!r}", "PARAMS = " + repr(tuple(L.params))]
     data += _named("MODES", "MODE", [m.name for m in A.modes]) + _named("SURFACES", "SURFACE", A.surfaces)
+    if len(A.resets) > 1:  # reset_jacobian dispatches on them
+        data += _named("RESETS", "RESET", A.resets)
     sensitivity = next((f.results for f in L.mod.variational if f.name == "field_sensitivity"), None)
     if sensitivity is not None:
         names = tuple(sensitivity_parameter(n) for n in sensitivity)

@@ -40,8 +40,9 @@ from .dynamics import Q
 from . import symbols as S
 from .automaton import Automaton, build as build_automaton
 from .fields import Kernel, motion_substitution
-from .graph import Definition, quantity
-from camdyn.vocabulary import (ECCENTRIC, CAM_STATE, OPTIONS, OUTPUTS, STATIC_LOAD, SURFACE_WITH_RATE, SceneOptionError,
+from .graph import Definition, derivative_symbol, derivatives, quantity
+from camdyn.vocabulary import (ECCENTRIC, CAM_STATE, OPTIONS, OUTPUTS, RESET_JACOBIAN, STATIC_LOAD, SURFACE_WITH_RATE,
+                               SceneOptionError,
                                SceneSpec, outputs_of, state_names)
 
 SceneSpecError = SceneOptionError  # the name derive used before the shared vocabulary
@@ -158,6 +159,23 @@ def _reset_cases(spec: SceneSpec, A: Automaton) -> tuple[Case, ...]:
                 Definition(after, rate, "Newton's impact law: psi_i_dot leaves at -xi times its arrival"
                            if name == "impact" else "a plastic impact: psi_i_dot leaves at 0 (a chatter's end)"))
         cases.append(Case((j,), Kernel(defs, (q.plain, after))))
+    return tuple(cases)
+
+
+def _reset_jacobian_cases(spec: SceneSpec, A: Automaton) -> tuple[Case, ...]:
+    """Each reset's Jacobian: the derivatives of the state after it, (q+, q_dot+), by q, q_dot and t (at a
+    fixed state, through the cam's motion), by the chain rule through its named quantities, in the order
+    of RESET_JACOBIAN."""
+    q = fields.coordinate(spec)
+    cases = []
+    for case in _reset_cases(spec, A):
+        after = tuple(Definition(quantity(f"state_{k}_after"), r, "the state after the reset")
+                      for k, r in enumerate(case.kernel.results))
+        named = case.kernel.definitions + after
+        by = {x: derivatives(named, x) for x in (q.plain, q.rate, S.t_s)}
+        out = tuple(derivative_symbol(d.name, x, by[x]) for d in after for x in (q.plain, q.rate)) + tuple(
+            derivative_symbol(d.name, S.t_s, by[S.t_s]) for d in after)
+        cases.append(Case(case.key, Kernel(named + sum(by.values(), ()), out).pruned()))
     return tuple(cases)
 
 
@@ -295,6 +313,12 @@ def _variational_functions(spec: SceneSpec, A: Automaton) -> tuple[Function, ...
                                   "surfaces m watches: out[GRAD_D_ALPHA] = dh/dalpha, out[GRAD_D_ALPHA_DOT] = "
                                   "dh/dalpha_dot, out[GRAD_D_T] = dh/dt at a fixed state (through Theta(t)); "
                                   "nan elsewhere.", "fill"))
+    if len(A.resets) > 1:
+        functions.append(Function("reset_jacobian", ("j", "t") + state_names(spec.follower) + ("p", "out"), ("j",),
+                                  RESET_JACOBIAN, _reset_jacobian_cases(spec, A),
+                                  "Derivatives of the state after reset j (RESETS) by the state before it and by t "
+                                  "at a fixed state, out[RJ_<NAME>] in the order of RESET_JACOBIAN (camdyn.vocabulary): "
+                                  "the reset's part of the saltation matrix of an impact.", "fill"))
     return tuple(functions)
 
 

@@ -134,3 +134,39 @@ def test_bad_input_for_the_rigid_law_is_refused_with_the_reason():
         camdyn.Scene(contact="rigid", damping="D")
     with pytest.raises(ParameterError, match="xi"):
         camdyn.simulate(translating_example_rig(), SCENE, speed_rpm=100, revolutions=1)
+
+
+@pytest.mark.parametrize("factor", [1.2, 1.5])
+def test_saltation_multipliers_of_an_impacting_orbit_are_those_of_finite_differences(factor):
+    """An impacting period-1 orbit of the rigid translating follower: its Floquet multipliers by the
+    tangent dynamics, through the generalized saltation matrix of each impact (the reset's Jacobian,
+    generated), against central differences of the map.  Bound 1e-6: the differences' truncation and the
+    map's noise at the default tolerances (measured 2e-8)."""
+    from camdyn.orbits.derivatives import finite_differences
+    from camdyn.orbits.tangent import variational
+    speed = factor * contact_loss_speed(RIG)
+    by_differences = camdyn.periodic_orbit(RIG, SCENE, speed_rpm=speed, jacobian=finite_differences)
+    by_saltation = camdyn.periodic_orbit(RIG, SCENE, speed_rpm=speed, jacobian=variational)
+    assert by_differences.ok and by_saltation.ok
+    assert np.max(np.abs(np.sort_complex(by_saltation.multipliers) - np.sort_complex(by_differences.multipliers))) < 1e-6
+    assert np.max(np.abs(by_saltation.multipliers)) > 0.1  # an orbit the impacts leave room to move in
+
+
+def test_the_second_rig_leaves_its_arc_cam_at_the_inverse_kinematics_speed_and_corners_fling_it():
+    """The second published rig (camdyn.model.presets.second_rig: six arcs, docs/second-rig.md): its
+    inverse-kinematics detachment speed is where the rigid follower starts to leave, and above it the
+    follower leaves at the flank-nose junction, where the curvature's jump turns the needed contact force
+    negative at once (a corner of the cam: the junction's restart goes to free flight)."""
+    from camdyn.model.presets import second_rig
+    rig = second_rig()
+    scene = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
+    loss = contact_loss_speed(rig)
+    below = camdyn.simulate(rig, scene, speed_rpm=0.999 * loss, revolutions=3)
+    assert below.ok and below.separations().size == 0
+    above = camdyn.simulate(rig, scene, speed_rpm=1.07 * loss, revolutions=3)  # 256 rev/min
+    assert above.ok and above.separations().size >= 3
+    leaves = np.array([s.t for s in above.switches if s.before == "contact" and s.after == "free"])
+    assert any(s.surface == "junction" for s in above.switches if s.after == "free" and s.before == "contact")
+    phase = np.mod(leaves - leaves[0] + 0.5 * above.period, above.period) - 0.5 * above.period
+    assert np.max(np.abs(phase)) < 1e-9  # every revolution at the same corner (the junction or the force's jump
+    # there: the two surfaces cross at the same instant, which one is found first is rounding)

@@ -17,7 +17,8 @@ from scipy.optimize import brentq
 
 from .cam import CamMotion, ConstantSpeed
 from ..vocabulary.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
-from ..vocabulary import COORDINATES, ECCENTRIC, FOLLOWERS, JAC_D_ALPHA, JAC_D_ALPHA_DOT, STATIC_LOAD, SURFACE_GRADIENT
+from ..vocabulary import (COORDINATES, ECCENTRIC, FOLLOWERS, JAC_D_ALPHA, JAC_D_ALPHA_DOT, RESET_JACOBIAN, STATIC_LOAD,
+                          SURFACE_GRADIENT)
 from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
@@ -361,6 +362,16 @@ class Model:
                              f"{self.kernels.MODES[m]!r} of scene {self.kernels.SLUG!r} is not defined at "
                              f"t = {t:g} s: a surface the mode does not watch, or a user cam motion whose "
                              "Theta_ddot would have to be differentiated (give the scene a built-in motion)")
+        return out
+
+    def reset_jacobian(self, j: int, t: float, alpha: float, alpha_dot: float) -> np.ndarray:
+        """The derivatives of the state after reset j (RESETS) by the state before it and by t, in the
+        order of RESET_JACOBIAN (the generated ``reset_jacobian``: the rigid law's impacts)."""
+        kernel = getattr(self.variational, "reset_jacobian", None)
+        if kernel is None:
+            raise SceneError(f"scene {self.kernels.SLUG!r} has no resets to differentiate")
+        out = np.empty(len(RESET_JACOBIAN))
+        kernel(j, t, alpha, alpha_dot, self.p, out)
         return out
 
     def outputs(self, m: int, t: float, alpha: float, alpha_dot: float) -> dict[str, float]:

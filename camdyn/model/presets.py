@@ -81,6 +81,36 @@ def translating_cam_example_rig() -> Rig:
     return rig.replace(profile=cam, theta0=320 * deg, name="translating-cam-example")  # 320 deg: the low dwell
 
 
+def second_rig() -> Rig:
+    """The flat-faced translating follower on the cam of six circular arcs of the second published rig
+    (docs/second-rig.md: Alzate et al. 2007, Osorio et al. 2008; every number from the Siconos
+    CamFollower example, marked there reported / inferred): mass 1.221 kg, spring 1430.8 N/m pressing
+    with 143.08 N on the base circle (radius 0.40 m; the spring free 0.3 m from the cam's centre),
+    restitution 0.8.  The cam's axis is its body x axis; the 0-state is on the base circle.  Use it with
+    ``Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")``."""
+    import math
+
+    import numpy as np
+
+    from .profiles import ArcProfile
+
+    deg = math.pi / 180
+    c_flank, c_nose, rho_nose = 0.45, 0.40393320723821, 0.15
+    # where the flank and the nose meet: the normal parallel to the line of their centres
+    flank_nose = -math.pi / 2 + (math.pi - math.atan2(c_nose * math.sin(110 * deg), c_nose * math.cos(110 * deg)
+                                                      - c_flank))
+    angles = np.array([-90 * deg, flank_nose, -20 * deg, 20 * deg, -flank_nose, 90 * deg, 270 * deg])
+    rho = np.array([0.85, rho_nose, c_nose + rho_nose, rho_nose, 0.85, 0.40])
+    cx = np.array([0.0, c_nose * math.cos(20 * deg), 0.0, c_nose * math.cos(20 * deg), 0.0, 0.0])
+    cy = np.array([c_flank, -c_nose * math.sin(20 * deg), 0.0, c_nose * math.sin(20 * deg), -c_flank, 0.0])
+    cam = ArcProfile(angles, rho, cx, cy)
+    return Rig(r_c=0.40, e=0.0, theta0=-math.pi / 2, k_s=1430.8, Y_c=200e9, Y_b=200e9, nu_c=0.3, nu_b=0.3,
+               m_f=1.221, gamma=math.pi / 2, offset=0.0, F_p=1430.8 * (0.40 - 0.3), xi=0.8, follower="translating",
+               profile=cam, name="second-rig", description="the second published rig's arc cam and flat-faced "
+               "follower, as the Siconos CamFollower example gives it (docs/second-rig.md)",
+               origin=f"camdyn preset 'second-rig' (camdyn {__version__})")
+
+
 def preset_files() -> list[Path]:
     """The shipped rig files, as files on disk (the package's data folder)."""
     folder = Path(str(resources.files("camdyn.model.data")))

@@ -199,10 +199,10 @@ def tangent(model: Model, t_span, y0, phi0=None, mode: int | None = None,
     growth = np.zeros(2) if renormalise else None
     for sw in records:
         t_sw, after = float(sw["t"]), int(sw["after"])
-        _, phi, d, growth = _flow(model, m, t, t_sw, x, phi, settings, compiled, growth)
+        x_before, phi, d, growth = _flow(model, m, t, t_sw, x, phi, settings, compiled, growth)
         divergence += d
         x = np.array([sw["alpha"], sw["alpha_dot"]], dtype=float)
-        S, surface = record_saltation(model, sw)
+        S, surface = record_saltation(model, sw, x_before)
         if not np.all(np.isfinite(S)):
             raise TangentFailure(f"the switch at t = {t_sw:g} s across {model.kernels.SURFACES[surface]!r} grazes it "
                                  "(the field is tangent to the surface): no saltation matrix")

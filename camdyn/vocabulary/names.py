@@ -114,6 +114,11 @@ JAC_D_ALPHA, JAC_D_ALPHA_DOT = range(len(JACOBIAN))
 #: is differentiated through the alpha_ddot it contains
 SURFACE_GRADIENT = JACOBIAN + ("d_t",)
 GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T = range(len(SURFACE_GRADIENT))
+#: the entries the generated ``reset_jacobian`` kernel (a scene with resets: the rigid law's impacts)
+#: writes to ``out``, in order: the derivatives of the state after reset j, (q+, q_dot+), by the state
+#: before it (in the order of STATE) and by t at a fixed state: the reset's part of a saltation matrix
+RESET_JACOBIAN = ("dq_dq", "dq_dq_dot", "dq_dot_dq", "dq_dot_dq_dot", "dq_dt", "dq_dot_dt")
+RJ_Q_Q, RJ_Q_QD, RJ_QD_Q, RJ_QD_QD, RJ_Q_T, RJ_QD_T = range(len(RESET_JACOBIAN))
 #: the entries the generated ``surface_with_rate`` kernel writes to ``out``, in order: a
 #: surface's value and the value of its declared rate (the scene module's RATE_OF_SURFACE)
 SURFACE_WITH_RATE = ("value", "rate")

@@ -1,0 +1,137 @@
+"""camdyn's rigid scene beside Siconos's Moreau-Jean time stepping on the second rig (issue 28), from one
+script: time against the error of the impact times and of the Poincare section, both against the
+event-driven solution of benchmarks/second_rig_exact.py (closed-form flights, events bisected to 1e-13 s).
+
+    python benchmarks/second_rig_peers.py --speed-rpm 256 --revolutions 30 --run-siconos /tmp/siconos.json
+
+With ``--run-siconos`` the Siconos runs are made in the same run, before camdyn's (so that the times
+compare on the same machine, at the same load); with ``--siconos FILE`` they are read from the JSON
+that ``/usr/bin/python3 benchmarks/siconos_cam_follower.py --law flat ... --out FILE`` writes (Debian's python3-siconos runs under the system Python, not camdyn's venv); camdyn's
+are made here: ``camdyn.model.presets.second_rig()`` (the flat-faced follower on the six-arc cam,
+restitution 0.8) with ``Scene(follower="translating", contact="rigid", damping="none", friction="none",
+profile="arcs")`` at several tolerances, each timed as the least of three warm runs (compiled; its first
+run compiles).  Impacts are compared where the relative approach speed exceeds the JSON's ``v_min`` (the
+peer's threshold: below it Moreau-Jean's chattering is not resolved impact by impact); each exact impact's
+error is its distance to the nearest impact of the run.  camdyn's start is a quarter turn before the
+peer's (its 0-state is mid-base-circle, 90 degrees before the rise; both at rest on the dwell), so its
+times are shifted by T/4.  Prints a Markdown table; ratios within this one run are what to compare.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+import warnings
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from second_rig_exact import Rig as ExactRig, sample, solve  # noqa: E402
+
+import camdyn  # noqa: E402
+from camdyn.model.presets import second_rig  # noqa: E402
+
+SCENE = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
+RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
+#: camdyn's samples per cam revolution: every 10 degrees, so that its start (a quarter turn before the
+#: peer's) and the section fall on samples (no interpolation between them)
+SAMPLES_PER_TURN = 36
+
+
+def camdyn_run(rig, speed_rpm: float, revolutions: int, rtol: float, repeats: int = 3):
+    """The least wall time of ``repeats`` runs (after one to compile) and the last run."""
+    kw = dict(speed_rpm=speed_rpm, revolutions=revolutions, rtol=rtol, atol=rtol * 0.1,
+              sample_rate_Hz=SAMPLES_PER_TURN * speed_rpm / 60)
+    camdyn.simulate(rig, SCENE, **kw)
+    best, result = math.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = camdyn.simulate(rig, SCENE, **kw)
+        best = min(best, time.perf_counter() - start)
+    return best, result
+
+
+def approach_speeds(rig, result) -> tuple[np.ndarray, np.ndarray]:
+    """The impacts' times and their relative approach speeds (Newton's law: psi_i_dot- = -psi_i_dot+ / xi,
+    the rate after read from the switch's state under the free mode's laws)."""
+    model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(result.meta["cam"].speed_rpm))
+    K = SCENE.kernels()
+    times, speeds = [], []
+    for s in result.switches:
+        if s.surface == "gap" and s.before == "free":
+            after = model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s.t, s.alpha, s.alpha_dot)
+            times.append(s.t)
+            speeds.append(-after / rig.xi if s.after == "free" else 0.0)
+    return np.array(times), np.array(speeds)
+
+
+def errors(reference: np.ndarray, times: np.ndarray) -> tuple[float, float]:
+    """Median and largest distance of each reference impact to the nearest of ``times`` (s)."""
+    if times.size == 0:
+        return math.inf, math.inf
+    d = np.min(np.abs(reference[:, None] - times[None, :]), axis=1)
+    return float(np.median(d)), float(np.max(d))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--speed-rpm", type=float, default=256.0)
+    ap.add_argument("--revolutions", type=int, default=30)
+    ap.add_argument("--siconos", help="a JSON of benchmarks/siconos_cam_follower.py (law flat, same speed)")
+    ap.add_argument("--run-siconos", metavar="JSON", help="run the Siconos peer now (/usr/bin/python3, its steps "
+                    "1e-3 .. 3e-6 s), in this run, into JSON, and compare with it")
+    args = ap.parse_args()
+    if args.run_siconos:
+        import subprocess
+        here = os.path.dirname(os.path.abspath(__file__))
+        subprocess.run(["/usr/bin/python3", os.path.join(here, "siconos_cam_follower.py"), "--law", "flat",
+                        "--speed-rpm", f"{args.speed_rpm:g}", "--revolutions", str(args.revolutions), "--steps",
+                        "1e-3", "3e-4", "1e-4", "3e-5", "1e-5", "3e-6", "--out", args.run_siconos], check=True,
+                       stdout=subprocess.DEVNULL)
+        args.siconos = args.run_siconos
+    warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
+    exact = ExactRig("flat", args.speed_rpm)
+    period = 60.0 / args.speed_rpm
+    impacts, pieces = solve(exact, args.revolutions * period)
+    rig = second_rig()
+    v_min = 0.5
+    siconos = None
+    if args.siconos:
+        siconos = json.load(open(args.siconos))
+        meta = siconos["meta"]
+        if (meta["law"], meta["speed_rpm"], meta["revolutions"]) != ("flat", args.speed_rpm, args.revolutions):
+            raise SystemExit(f"{args.siconos} is not the flat law at {args.speed_rpm} rev/min over {args.revolutions}")
+        v_min = meta["v_min"]
+    reference = np.array([t for t, v, _ in impacts if v < -v_min])
+    section_deg = siconos["meta"]["section_deg"] if siconos else 130.0
+    print(f"second rig, flat face, {args.speed_rpm:g} rev/min, {args.revolutions} revolutions: {reference.size} exact "
+          f"impacts faster than {v_min} m/s; section at {section_deg:g} deg; load {os.getloadavg()[0]:.2f}")
+    print("| peer | setting | wall (s) | impacts | impact-time error median (s) | max (s) | section y error max (m) |")
+    print("|---|---|---|---|---|---|---|")
+    for rtol in RTOLS:
+        wall, result = camdyn_run(rig, args.speed_rpm, args.revolutions, rtol)
+        times, speeds = approach_speeds(rig, result)
+        fast = times[speeds < -v_min] - period / 4
+        median, largest = errors(reference, fast)
+        sec_t = (np.arange(args.revolutions) + section_deg / 360) * period
+        exact_u, _ = sample(exact, pieces, sec_t)
+        index = np.rint((sec_t + period / 4) / period * SAMPLES_PER_TURN).astype(int)
+        run_u = result.y[index]
+        print(f"| camdyn (rigid, DOP853) | rtol {rtol:g} | {wall:.3g} | {fast.size} | {median:.2g} | {largest:.2g} | "
+              f"{np.max(np.abs(run_u - exact_u)):.2g} |")
+    if siconos:
+        for run in siconos["runs"]:
+            times = np.array([i["t"] for i in run["impacts"]])
+            median, largest = errors(reference, times)
+            sec_t = [x["t"] for x in run["section"]]
+            exact_u, _ = sample(exact, pieces, sec_t)
+            du = max(abs(x["u"] - a) for x, a in zip(run["section"], exact_u))
+            print(f"| Siconos (Moreau-Jean) | h {run['h']:g} s | {run['wall_s']:.3g} | {times.size} | {median:.2g} | "
+                  f"{largest:.2g} | {du:.2g} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -170,3 +170,27 @@ def test_the_second_rig_leaves_its_arc_cam_at_the_inverse_kinematics_speed_and_c
     phase = np.mod(leaves - leaves[0] + 0.5 * above.period, above.period) - 0.5 * above.period
     assert np.max(np.abs(phase)) < 1e-9  # every revolution at the same corner (the junction or the force's jump
     # there: the two surfaces cross at the same instant, which one is found first is rounding)
+
+
+def test_the_compliant_orbit_converges_to_the_rigid_one_as_the_contact_stiffens():
+    """The translating follower's impacting period-1 orbit at 1.2 x its jump speed: with a line contact
+    and the viscous damping A of the same restitution (a linear spring-dashpot contact leaves at
+    exp(-zeta pi / sqrt(1 - zeta^2)) of its approach speed: zeta = 0.0709 for xi = 0.8), the orbit's section
+    state tends to the rigid scene's as the contact stiffness k (proportional to l_lambda) grows, its
+    distance falling as k^(-1/2) (the contact's duration): by sqrt(10) per decade (measured 3.1-3.2 over
+    l_lambda 1e-2 .. 1 m), and the Floquet multipliers with it."""
+    zeta = -math.log(XI) / math.sqrt(math.pi**2 + math.log(XI) ** 2)
+    rig = RIG.replace(zeta_A=zeta)
+    speed = 1.2 * contact_loss_speed(rig)
+    rigid = camdyn.periodic_orbit(rig, SCENE, speed_rpm=speed)
+    soft = camdyn.Scene(follower="translating", contact="line", damping="A", friction="none")
+    distances, multipliers = [], []
+    for length in (1e-2, 1e-1, 1.0):
+        orbit = camdyn.periodic_orbit(rig.replace(l_lambda=length), soft, speed_rpm=speed, y0=rigid.state,
+                                      warmup_revolutions=2)
+        assert orbit.ok
+        distances.append(abs(orbit.state[0] - rigid.state[0]))
+        multipliers.append(np.max(np.abs(np.sort_complex(orbit.multipliers) - np.sort_complex(rigid.multipliers))))
+    ratios = np.array(distances[:-1]) / np.array(distances[1:])
+    assert np.all((ratios > 2.5) & (ratios < 4.0)), ratios  # sqrt(10) = 3.16
+    assert multipliers[0] > multipliers[1] > multipliers[2] and multipliers[2] < 1e-3

@@ -138,9 +138,12 @@ def _rigid_field(spec: SceneSpec) -> tuple[Definition, ...]:
     """The rigid law's constrained mode: the gap rate's partials and the acceleration that keeps the
     follower on the cam (derive.rigid.constrained_acceleration)."""
     q = coordinate(spec)
+    psi = plain(dynamics.gap(spec.profile, spec.follower), spec.motion)
     psi_dot = plain(dynamics.gap_rate(spec.profile, spec.follower), spec.motion)
-    return rigid.gap_rate_partials(psi_dot, q) + (
-        Definition(q.acceleration, rigid.constrained_acceleration(q), "riding the cam: psi_i_ddot = 0 (rigid contact)"),)
+    return (Definition(Q.psi_i, psi, "gap (Eq. 6)"), Definition(Q.psi_i_dot, psi_dot, "gap rate (Eq. 8)")) + \
+        rigid.gap_rate_partials(psi_dot, q) + (
+        Definition(q.acceleration, rigid.constrained_acceleration(q, Q.psi_i, Q.psi_i_dot),
+                   "riding the cam: psi_i_ddot = 0, stabilized (rigid contact)"),)
 
 
 def _rigid_contact_force(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
@@ -152,7 +155,8 @@ def _rigid_contact_force(spec: SceneSpec, mode: Mode) -> tuple[Definition, ...]:
         spec.follower, spec.profile), "spring force (Eq. 11)")], spec.motion)
     force = Definition(Q.F_n, plain(rigid.contact_force(r, q.acceleration), spec.motion),
                        "normal force of the rigid contact: keeps the follower on the cam")
-    return geometry + _rigid_field(spec) + (force,)
+    defined = {d.symbol for d in geometry}
+    return geometry + tuple(d for d in _rigid_field(spec) if d.symbol not in defined) + (force,)
 
 
 def field(spec: SceneSpec, mode: Mode) -> Kernel:

@@ -161,15 +161,17 @@ class Settings(NamedTuple):
     ledger: bool
 
 
-def settings(options: SolverOptions, contact_frequency: float, coordinate_limit: float = ANGLE_LIMIT) -> Settings:
+def settings(options: SolverOptions, contact_frequency: float, coordinate_limit: float = ANGLE_LIMIT,
+             step_cap: float = math.inf) -> Settings:
     """The loop's settings for ``options`` on a model whose contact mode has ``contact_frequency``
     (rad/s: the undamped linearized frequency vartheta, Eq. 23) and whose follower's coordinate must
     stay within +-``coordinate_limit`` (the model's ``coordinate_limit``: ANGLE_LIMIT for the paper's
-    follower, where Eq. 11 is singular at 90 degrees; inf for a coordinate without a singularity)."""
+    follower, where Eq. 11 is singular at 90 degrees; inf for a coordinate without a singularity), its
+    steps no longer than ``step_cap`` (s; the model's ``step_cap``) nor ``options.max_step``."""
     ev = options.events
     step = CONTACT_STEP_RADIANS / contact_frequency if contact_frequency > 0 else 0.0
     a, b = options.step_control.a, options.step_control.b
-    return Settings(rtol=float(options.rtol), atol=float(options.atol), max_step=float(options.max_step),
+    return Settings(rtol=float(options.rtol), atol=float(options.atol), max_step=float(min(options.max_step, step_cap)),
                     control_a=a, control_b=b, xtol=float(ev.xtol), interior_points=int(ev.interior_points),
                     reach_factor=float(ev.reach_factor), max_events=int(ev.max_events), angle_limit=float(coordinate_limit),
                     chatter_switches=CHATTER_SWITCHES, chatter_window=CHATTER_WINDOW, contact_step=step,

@@ -115,7 +115,7 @@ def integrate(model, t_span: tuple[float, float], y0, t_eval: np.ndarray,
     the automaton's initial rule chooses it from the state."""
     prob = _problem(model, backend, options.ledger)
     method = method_of(options.method)
-    cfg = settings(options, model.equilibrium.vartheta, model.coordinate_limit)
+    cfg = settings(options, model.equilibrium.vartheta, model.coordinate_limit, model.step_cap)
     t0, t_end = map(float, t_span)
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     samples = Samples(t_eval, np.empty((LEDGER_ROWS if options.ledger else STATE_ROWS, t_eval.size)),

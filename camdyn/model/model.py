@@ -251,6 +251,17 @@ class Model:
         translating follower, whose laws have no singularity."""
         return ANGLE_LIMIT if self.scene.follower == _OSCILLATING else math.inf
 
+    @property
+    def step_cap(self) -> float:
+        """The longest step a run may take (s): on a cam of arcs, half the turn time of its shortest arc, so
+        that no step spans two of its junctions (their surface alternates its sign from arc to arc: a step
+        across two would see none; a field that barely changes, a rigid follower on a dwell, otherwise grows
+        the steps past them); no cap (inf) on any other cam or a cam at rest."""
+        if self.rig.profile is None or self.rig.profile.kind != "arcs" or self.cam.kind != "constant":
+            return math.inf
+        omega = abs(self.cam.Omega_c)
+        return math.inf if omega == 0 else float(np.min(np.diff(self.rig.profile.angles))) / (2 * omega)
+
     @cached_property
     def period(self) -> float:
         return self.cam.period

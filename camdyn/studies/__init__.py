@@ -16,7 +16,7 @@ From Python::
     out.numbers, out.figures, out.markdown
 
 Studies: reference-rig (identify the reference rig; writes the presets reference*.toml into the
-checkout's camdyn/model/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers.
+checkout's camdyn/model/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers, second-rig.
 """
 from __future__ import annotations
 
@@ -40,6 +40,7 @@ STUDIES = {
     "fig12-15": ("fig12_15", "v_r, F_f, N_x: Coulomb vs smoothed friction, printed and kinematic v_r"),
     "fig16": ("fig16", "alpha spectra: linearized vs non-linear model"),
     "numbers": ("numbers_report", "every reported number: paper, camdyn, relative difference"),
+    "second-rig": ("second_rig", "the second published rig (issue 28): detachment, bifurcation diagram, corners"),
 }
 assert list(STUDIES) == ORDER
 

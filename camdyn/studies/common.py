@@ -232,7 +232,8 @@ The paper compares several results with measurements of Alzate et al. (2007); th
 measurements are not available here, so no section plots them and none is invented.
 """
 
-ORDER = ["reference-rig", "fig4-5", "chaos-scan", "fig6", "fig7-8", "fig9", "fig10", "fig11", "fig12-15", "fig16", "numbers"]
+ORDER = ["reference-rig", "fig4-5", "chaos-scan", "fig6", "fig7-8", "fig9", "fig10", "fig11", "fig12-15", "fig16", "numbers",
+         "second-rig"]
 
 
 def _markers(name):

@@ -1,0 +1,117 @@
+"""The second published rig (issue 28): a flat-faced translating follower on a cam of six circular arcs,
+with rigid impacts (camdyn.model.presets.second_rig, docs/second-rig.md): its detachment speed, its
+bifurcation diagram against the cam speed, and where on the cam the follower leaves and lands, beside the
+cam's corners (the arcs' junctions, where the curvature jumps: the corner-impact scenario)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import camdyn
+from camdyn.analysis.statics import contact_loss_speed
+from camdyn.model.presets import second_rig
+
+from .common import Context, StudyOutput, figure, fmt, md_table, parallel_map, save, simulate
+
+NAME, TITLE = "second-rig", "The second rig: a flat face on a cam of arcs, rigid impacts"
+SCENE = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
+
+
+def _cam_angle_deg(rig, t: np.ndarray, speed_rpm: float) -> np.ndarray:
+    """The cam angle from the start of the rise (deg, in [0, 360)): the rise starts a quarter turn after the
+    0-state (the preset's theta0, mid-base-circle)."""
+    turns = t * speed_rpm / 60.0 - 0.25
+    return np.mod(turns, 1.0) * 360.0
+
+
+def _run(args) -> dict:
+    """One speed: the section (y at the start of each revolution after the transient), and the cam angles of
+    the impacts faster than 0.5 m/s and of the separations over the kept revolutions."""
+    rig, speed, revolutions, kept = args
+    per_turn = 36
+    r = simulate(rig, SCENE, speed_rpm=speed, revolutions=revolutions, sample_rate_Hz=per_turn * speed / 60)
+    keep_from = (revolutions - kept) * 60.0 / speed
+    section = r.q[::per_turn][revolutions - kept:revolutions].tolist()
+    model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(speed))
+    K = SCENE.kernels()
+    impacts, leaves = [], []
+    for s in r.switches:
+        if s.t < keep_from:
+            continue
+        if s.surface == "gap" and s.before == "free" and s.after == "free":
+            approach = -model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s.t, s.alpha, s.alpha_dot) / rig.xi
+            if approach < -0.5:
+                impacts.append(s.t)
+        elif s.before == "contact" and s.after == "free":
+            leaves.append(s.t)
+    return {"speed_rpm": speed, "outcome": r.outcome.name, "section": section,
+            "impact_deg": _cam_angle_deg(rig, np.array(impacts), speed).tolist(),
+            "leave_deg": _cam_angle_deg(rig, np.array(leaves), speed).tolist()}
+
+
+def _junctions_deg(rig) -> list[float]:
+    """The cam angles (from the start of the rise) at which the flat face passes the arcs' junctions:
+    phi = gamma - Theta, the rise starting where phi = 90 degrees."""
+    angles = np.degrees(rig.profile.angles[:-1])
+    return sorted(float(np.mod(90.0 - a, 360.0)) for a in angles)
+
+
+def run(ctx: Context) -> StudyOutput:
+    rig = second_rig()
+    loss = contact_loss_speed(rig)
+    speeds = np.linspace(200.0, 700.0, 11 if ctx.fast else 201)
+    revolutions, kept = (12, 6) if ctx.fast else (60, 30)
+    rows = parallel_map(_run, [(rig, float(s), revolutions, kept) for s in speeds], ctx.fast)
+    junctions = _junctions_deg(rig)
+    fig, (ax, bx) = figure(1, 2, figsize=(11, 4.4))
+    for row in rows:
+        ax.plot(np.full(len(row["section"]), row["speed_rpm"]), 1e3 * np.asarray(row["section"]), ",k")
+        bx.plot(np.full(len(row["impact_deg"]), row["speed_rpm"]), row["impact_deg"], ".", color="tab:red", ms=2)
+        bx.plot(np.full(len(row["leave_deg"]), row["speed_rpm"]), row["leave_deg"], ".", color="tab:blue", ms=2)
+    for ax_ in (ax, bx):
+        ax_.axvline(loss, color="0.5", lw=0.8, ls="--")
+    for j in junctions:
+        bx.axhline(j, color="0.7", lw=0.6)
+    ax.set(xlabel="cam speed (rev/min)", ylabel="y at each revolution's start (mm)",
+           title=f"sections after the transient (detachment {loss:.4g} rev/min, dashed)")
+    bx.set(xlabel="cam speed (rev/min)", ylabel="cam angle from the rise (deg)", ylim=(0, 360),
+           title="impacts > 0.5 m/s (red), leaving the cam (blue); corners (grey)")
+    png = save(fig, ctx.png(NAME))
+    at_corner = [row for row in rows if row["leave_deg"] and all(
+        min(abs(a - j) for j in junctions) < 1e-3 for a in row["leave_deg"])]
+    periods = [_period(row["section"]) for row in rows]
+    table = [[fmt(row["speed_rpm"], 4), row["outcome"], p or "none within the kept revolutions",
+              len(row["impact_deg"]) // kept if kept else 0,
+              "corner" if row in at_corner else ("smooth" if row["leave_deg"] else "never leaves")]
+             for row, p in zip(rows, periods)]
+    md = "\n\n".join([
+        f"![second rig](img/{png.name})",
+        "The papers (Alzate et al. 2007; Osorio, di Bernardo & Santini 2008): their detachment speed, bifurcation "
+        "diagram and corner-impact speeds could not be read here (docs/second-rig.md, *Sources read*), so this "
+        "section states camdyn's results on the rig as the Siconos example gives it, to be set beside the papers'.",
+        f"camdyn: the rigid follower leaves the cam above {loss:.6g} rev/min (inverse kinematics, the flat-face "
+        "law; the preset `second_rig`, scene `contact='rigid'`, restitution 0.8). The right panel shows where it "
+        "leaves and where it lands against the cam's corners (the arcs' junctions, at "
+        + ", ".join(f"{j:.2f}" for j in junctions) + " degrees from the rise; blue: where it leaves, red: where "
+        "impacts faster than 0.5 m/s land). Where it leaves at a corner (the table's last column), the curvature's "
+        "jump there turns the contact force it needs negative at once; an impact landing on a corner as the speed "
+        "changes is the corner-impact scenario.",
+        md_table(["speed (rev/min)", "outcome", "period of the section", "impacts > 0.5 m/s per revolution",
+                  "leaves the cam at"], table),
+    ])
+    numbers = {"detachment_rpm": loss, "junctions_deg": junctions,
+               "speeds": [{"speed_rpm": row["speed_rpm"], "outcome": row["outcome"], "period": p,
+                           "impacts_per_revolution": len(row["impact_deg"]) / kept,
+                           "leaves": "corner" if row in at_corner else ("smooth" if row["leave_deg"] else "never")}
+                          for row, p in zip(rows, periods)]}
+    return StudyOutput(NAME, TITLE, md, numbers, [png])
+
+
+def _period(section: list[float], tol: float = 1e-7) -> int | None:
+    """The smallest period (in revolutions) of the kept sections, within ``tol`` m, or None."""
+    x = np.asarray(section)
+    for p in range(1, x.size // 2 + 1):
+        if np.all(np.abs(x[p:] - x[:-p]) <= tol):
+            return p
+    return None

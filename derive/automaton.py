@@ -190,10 +190,13 @@ def _rigid(spec: SceneSpec) -> Automaton:
     """The rigid contact law (derive.rigid): free flight bounces off the cam at the gap with Newton's
     impact law (a reset; the follower flies on), and a chatter of impacts converging geometrically ends
     in the constrained mode ``contact`` (the plastic reset) where its contact force is compressive; the
-    follower leaves the constrained mode where the contact force turns negative."""
+    follower leaves the constrained mode where the contact force turns negative (with the plastic reset:
+    it leaves with no relative velocity)."""
     free, contact = Mode("free", False), Mode(mode_name(True), True)
+    # leaving the cam, the follower rode it: its relative velocity is 0, the plastic reset makes it so exactly
+    # (the constrained mode's numerical drift, ~1e-9 m/s, would otherwise start a flight approaching the cam)
     transitions = (Transition("free", "gap", -1, (Target("free"),), IMPACT),
-                   Transition(contact.name, "contact_force", -1, (Target("free"),)))
+                   Transition(contact.name, "contact_force", -1, (Target("free"),), PLASTIC))
     riding = Target(contact.name, (Condition("contact_force", +1),))
     chatter = Transition("free", "gap", -1, (riding, Target("free")), PLASTIC)
     initial = (Target(contact.name, (Condition("gap", -1), Condition("contact_force", +1))), Target("free"))
@@ -201,7 +204,7 @@ def _rigid(spec: SceneSpec) -> Automaton:
     if spec.profile == "arcs":  # the constrained acceleration jumps with the curvature: restart there, and
         # leave where the contact force it needs jumps below zero (a corner of the cam flings the follower)
         surfaces += ("junction",)
-        transitions += tuple(Transition(contact.name, "junction", d, (riding, Target("free"))) for d in (+1, -1))
+        transitions += tuple(Transition(contact.name, "junction", d, (riding, Target("free")), PLASTIC) for d in (+1, -1))
     return Automaton((free, contact), surfaces, {"gap": "gap_rate"}, initial, transitions,
                      ("identity", IMPACT, PLASTIC), chatter)
 

@@ -16,8 +16,10 @@ def rig_for(scene: camdyn.Scene) -> camdyn.Rig:
     example, on the eccentric circle or on a cycloidal cam (a spline: camdyn.model.presets)."""
     from camdyn.model import presets
     if scene.follower == "translating":
-        return presets.translating_cam_example_rig() if scene.profile == "spline" else presets.translating_example_rig()
-    return presets.cam_example_rig() if scene.profile == "spline" else RIG
+        rig = presets.translating_cam_example_rig() if scene.profile == "spline" else presets.translating_example_rig()
+    else:
+        rig = presets.cam_example_rig() if scene.profile == "spline" else RIG
+    return rig.replace(xi=0.8) if scene.contact == "rigid" and rig.xi is None else rig  # the rigid law's restitution
 
 
 def scene_from_slug(slug: str) -> camdyn.Scene:

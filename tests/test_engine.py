@@ -89,9 +89,9 @@ def test_tables_encode_the_generated_automaton(slug):
                 (int(data["condition_surface"][q]), int(data["condition_sign"][q]))
                 for q in range(data["condition_start"][c], data["condition_start"][c + 1])))
                 for c in range(data["target_start"][w], data["target_start"][w + 1]))
-            rows.append((m, int(data["surface"][w]), int(data["direction"][w]), targets))
-            assert data["reset"][w] == IDENTITY
-    assert rows == [tr[:4] for tr in K.TRANSITIONS]
+            rows.append((m, int(data["surface"][w]), int(data["direction"][w]), targets, int(data["reset"][w])))
+    resets = [IDENTITY if K.RESETS[tr[4]] == "identity" else tr[4] for tr in K.TRANSITIONS]  # the rigid law's impacts
+    assert rows == [tr[:4] + (j,) for tr, j in zip(K.TRANSITIONS, resets)]
     n = tab.n_transitions
     initial = [int(data["target_mode"][c]) for c in range(data["target_start"][n], data["target_start"][n + 1])]
     assert initial == [c[0] for c in K.INITIAL]

@@ -237,8 +237,10 @@ def turned_back(prob, m, s, rate, direction, t, h, y0, y1, Q, ta, tb, ga, ra, rb
     """Start (t, g) of the bracket of a sign change of surface s over (ta, tb], and whether it
     is a crossing: if s moves away from the watched direction at ta it can reach zero only
     after its rate turns (the bracket then starts at the turn); if the rate never turns, the
-    sign change is rounding noise."""
-    if ra * direction >= 0.0:
+    sign change is rounding noise.  A rate exactly 0 at ta (a restart with no relative velocity: the rigid
+    law's plastic reset as the follower leaves the cam) moves towards the watched direction only if the
+    rate at tb does."""
+    if ra * direction > 0.0 or (ra == 0.0 and rb * direction >= 0.0):
         return ta, ga, True
     if rb * direction < 0.0:
         return ta, ga, False

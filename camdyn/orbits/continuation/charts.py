@@ -1,0 +1,149 @@
+"""Design charts: the curve of grazing orbits in two parameters (:func:`continue_grazing`) and
+the jump chart, the jump (contact-loss) speed against a rig parameter beside its quasi-static
+limit (:func:`jump_chart`).
+
+:func:`continue_grazing` starts from the grazing that the one-parameter continuation
+:func:`camdyn.continue_orbit` locates in the free parameter lambda1 (``free``, by default the
+cam speed) over ``search`` at lambda2 = ``start``: its ``grazing`` event, or, where the
+branch's corrector stops short of the grazing (the step past it is not smooth: a stiff contact),
+its last contact orbit when its largest gap is within :data:`NEAR` of the static deflection
+from zero.  From there it solves the extended system of :mod:`.grazing` at lambda2 = start and
+follows it (:mod:`.grazing_curve`) to lambda2 = ``end``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._checks import finite, real
+from ...engine import SolverOptions
+from ...errors import CamdynError, ParameterError
+from ...model.rig import PARAMETERS, Rig
+from ...model.scene import Scene
+from ..section_map import DEFAULT_OPTIONS
+from ..tangent import variational
+from . import continue_orbit
+from .events import EVENTS
+from .grazing import GrazingSystem, Layout, gap_maximum
+from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
+from .grazing_dataset import grazing_dataset
+from .problem import SPEED
+
+#: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
+#: when that orbit's largest gap is within this fraction of the static deflection from zero
+NEAR = 0.05
+
+
+def _names() -> list[str]:
+    return [SPEED] + [p.name for p in PARAMETERS]
+
+
+def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction, settings) -> None:
+    if not isinstance(rig, Rig):
+        raise ParameterError("rig", rig, "a camdyn.Rig")
+    if not isinstance(scene, Scene) or scene.motion != "constant":
+        raise ParameterError("scene", scene, "a camdyn.Scene with motion 'constant' (a cam at constant speed)")
+    names = _names()
+    for name, value in (("parameter", parameter), ("free", free)):
+        if value not in names:
+            raise ParameterError(name, value, f"'{SPEED}' or a rig parameter ({', '.join(names[1:])})")
+    if parameter == free:
+        raise ParameterError("free", free, f"a parameter other than parameter ({parameter!r}): two parameters vary")
+    finite("start", start)
+    finite("end", end)
+    if start == end:
+        raise ParameterError("end", end, f"a value other than start ({start})")
+    if not (isinstance(search, (tuple, list)) and len(search) == 2):
+        raise ParameterError("search", search, f"(low, high): the range of {free} the first grazing is searched in")
+    lo, hi = (finite("search", v, f"two finite values of {free}, low != high") for v in search)
+    if lo == hi:
+        raise ParameterError("search", search, f"two finite values of {free}, low != high")
+    if SPEED in (free, parameter):
+        values = (lo, hi) if free == SPEED else (start, end)
+        if speed_rpm is not None:
+            raise ParameterError("speed_rpm", speed_rpm, f"None: the speed is one of the two parameters")
+        if not values[0] * values[1] > 0:
+            raise ParameterError("search" if free == SPEED else "end", values[1],
+                                 "speeds of one sign, neither zero (rev/min)")
+    else:
+        real("speed_rpm", speed_rpm, "a nonzero cam speed (rev/min) for two rig parameters",
+             lambda v: v != 0 and math.isfinite(v))
+    real("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)", lambda v: 0 <= v < 1)
+    if not isinstance(settings, GrazingSettings):
+        raise ParameterError("settings", settings, "a camdyn.orbits.continuation.GrazingSettings")
+
+
+def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple,
+                     free: str = SPEED, speed_rpm: float | None = None, phase_fraction: float = 0.5,
+                     warmup_revolutions: int = 20, settings: GrazingSettings = GrazingSettings(),
+                     options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
+    """The curve of grazing period-1 orbits (the follower first leaving the cam) in two
+    parameters: ``free`` (lambda1, default the cam speed ``speed_rpm``, rev/min) and
+    ``parameter`` (lambda2, a rig parameter, SI; or the speed) from ``start`` to ``end``, by
+    pseudo-arclength continuation of the extended system of :mod:`.grazing`, with the
+    codimension-2 points where a Floquet multiplier at grazing passes -1 or +1.
+
+    ``search``: (low, high) of ``free``, over which :func:`camdyn.continue_orbit` (at lambda2 =
+    start, from the orbit at low) finds the first grazing; ``speed_rpm``: the cam speed when
+    neither parameter is the speed; ``phase_fraction``: the section's time in the period (choose it
+    away from the gap's maximum).  The scene needs the tangent dynamics (not damping C or E:
+    :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
+    result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
+    """
+    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction, settings)
+    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), float(search[0]), speed_rpm,
+                           float(phase_fraction), options, backend, settings.continuation.tol, settings.gap_tol)
+    system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
+    system.model(float(search[1]), system.end)
+    curve, layout, system = _curve(system, search, settings, warmup_revolutions)
+    return grazing_dataset(system, curve, layout, settings)
+
+
+def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
+    """(curve, layout, the system with lambda1 at the first grazing) from the start's search."""
+    found = _search(system, search, settings, warmup_revolutions)
+    if isinstance(found, str):
+        return Curve([], [], GrazingOutcome.START_FAILED, found), None, system
+    x, free, mode, scale = found
+    system = dataclasses.replace(system, free_start=free)
+    layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
+    leg = Leg(system, layout, settings.continuation)
+    try:
+        phase = gap_maximum(system, x, free, mode)
+    except CamdynError as failure:
+        return Curve([], [], GrazingOutcome.START_FAILED, f"the start orbit cannot be run: {failure}"), layout, system
+    p = first(leg, x, phase, free, mode)
+    if isinstance(p, str):
+        return Curve([], [], GrazingOutcome.START_FAILED, p), layout, system
+    return follow(leg, p), layout, system
+
+
+def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
+    """(x, lambda1, mode, the motion's scale) of the grazing (or near-grazing) orbit that the
+    one-parameter continuation in lambda1 finds at lambda2 = start; or why there is none."""
+    rig = system.rig if system.parameter == SPEED else system.rig.replace(**{system.parameter: system.start})
+    speed = system.start if system.parameter == SPEED else system.speed_rpm
+    ds = continue_orbit(rig, system.scene, system.free, float(search[0]), float(search[1]),
+                        speed_rpm=None if system.free == SPEED else speed, phase_fraction=system.phase_fraction,
+                        warmup_revolutions=warmup_revolutions, settings=settings.continuation,
+                        options=system.options, jacobian=variational, backend=system.backend)
+    scale = (ds.attrs["scale_alpha"], ds.attrs["scale_alpha_dot"])
+    on_first = ds["event_branch"].values == 0
+    grazing = np.flatnonzero(on_first & (ds["event_kind"].values == EVENTS.index("grazing")))
+    if grazing.size:
+        k = int(grazing[0])
+        x = np.array([ds["event_alpha"].values[k], ds["event_alpha_dot"].values[k]])
+        return x, float(ds["event_lambda"].values[k]), int(ds["mode"].values[ds["event_point"].values[k]]), scale
+    points = np.flatnonzero(ds["point_branch"].values == 0)
+    why = ds.attrs.get("branch_0_message", "")
+    if not points.size:
+        return f"no orbit at {system.free} = {search[0]:.8g}: {why}"
+    k = int(points[-1])
+    gap = float(ds["max_gap"].values[k])
+    if not (gap < 0 and -gap <= NEAR * system.deflection):
+        return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no grazing: its last orbit's "
+                f"largest gap is {gap:.3g} m ({why})")
+    x = np.array([ds["alpha"].values[k], ds["alpha_dot"].values[k]])
+    return x, float(ds["lambda"].values[k]), int(ds["mode"].values[k]), scale

@@ -4,10 +4,11 @@ limit (:func:`jump_chart`).
 
 :func:`continue_grazing` starts from the grazing that the one-parameter continuation
 :func:`camdyn.continue_orbit` locates in the free parameter lambda1 (``free``, by default the
-cam speed) over ``search`` at lambda2 = ``start``: its ``grazing`` event, or, where the
-branch's corrector stops short of the grazing (the step past it is not smooth: a stiff contact),
-its last contact orbit when its largest gap is within :data:`NEAR` of the static deflection
-from zero.  From there it solves the extended system of :mod:`.grazing` at lambda2 = start and
+cam speed) over ``search`` at lambda2 = ``start``: its ``grazing`` event's orbit on the contact
+side (the orbit located before it, or the branch's point before it when the event's orbit is the
+one past it, lifted off), or, where the branch's corrector stops short of the grazing (the step past it is not smooth: a stiff contact),
+its last contact orbit when its largest gap is within :data:`NEAR` of the first orbit's from
+zero.  From there it solves the extended system of :mod:`.grazing` at lambda2 = start and
 follows it (:mod:`.grazing_curve`) to lambda2 = ``end``.
 """
 from __future__ import annotations
@@ -32,7 +33,7 @@ from .grazing_dataset import grazing_dataset
 from .problem import SPEED
 
 #: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
-#: when that orbit's largest gap is within this fraction of the static deflection from zero
+#: when that orbit's largest gap is within this fraction of the branch's first orbit's from zero
 NEAR = 0.05
 
 
@@ -93,8 +94,9 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
     """
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction, settings)
-    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), float(search[0]), speed_rpm,
-                           float(phase_fraction), options, backend, settings.continuation.tol, settings.gap_tol)
+    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), float(search[0]), math.nan,
+                           speed_rpm, float(phase_fraction), options, backend, settings.continuation.tol,
+                           settings.gap_tol)
     system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
     system.model(float(search[1]), system.end)
     curve, layout, system = _curve(system, search, settings, warmup_revolutions)
@@ -107,13 +109,13 @@ def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revo
     if isinstance(found, str):
         return Curve([], [], GrazingOutcome.START_FAILED, found), None, system
     x, free, mode, scale = found
-    system = dataclasses.replace(system, free_start=free)
     layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
-    leg = Leg(system, layout, settings.continuation)
     try:
-        phase = gap_maximum(system, x, free, mode)
+        phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
     except CamdynError as failure:
         return Curve([], [], GrazingOutcome.START_FAILED, f"the start orbit cannot be run: {failure}"), layout, system
+    system = dataclasses.replace(system, free_start=free, deflection=deflection)
+    leg = Leg(system, layout, settings.continuation)
     p = first(leg, x, phase, free, mode)
     if isinstance(p, str):
         return Curve([], [], GrazingOutcome.START_FAILED, p), layout, system
@@ -132,18 +134,70 @@ def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_rev
     scale = (ds.attrs["scale_alpha"], ds.attrs["scale_alpha_dot"])
     on_first = ds["event_branch"].values == 0
     grazing = np.flatnonzero(on_first & (ds["event_kind"].values == EVENTS.index("grazing")))
-    if grazing.size:
+    if grazing.size:                        # the event's orbit on its contact side, else the point before it
         k = int(grazing[0])
-        x = np.array([ds["event_alpha"].values[k], ds["event_alpha_dot"].values[k]])
-        return x, float(ds["event_lambda"].values[k]), int(ds["mode"].values[ds["event_point"].values[k]]), scale
+        if ds["event_max_gap"].values[k] < 0:
+            x = np.array([ds["event_alpha"].values[k], ds["event_alpha_dot"].values[k]])
+            return x, float(ds["event_lambda"].values[k]), int(ds["mode"].values[ds["event_point"].values[k]]), scale
+        k = int(ds["event_point"].values[k])
+        x = np.array([ds["alpha"].values[k], ds["alpha_dot"].values[k]])
+        return x, float(ds["lambda"].values[k]), int(ds["mode"].values[k]), scale
     points = np.flatnonzero(ds["point_branch"].values == 0)
     why = ds.attrs.get("branch_0_message", "")
     if not points.size:
         return f"no orbit at {system.free} = {search[0]:.8g}: {why}"
     k = int(points[-1])
-    gap = float(ds["max_gap"].values[k])
-    if not (gap < 0 and -gap <= NEAR * system.deflection):
+    gap, deep = float(ds["max_gap"].values[k]), float(ds["max_gap"].values[points[0]])
+    if not (gap < 0 and -gap <= NEAR * -deep):
         return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no grazing: its last orbit's "
                 f"largest gap is {gap:.3g} m ({why})")
     x = np.array([ds["alpha"].values[k], ds["alpha_dot"].values[k]])
     return x, float(ds["lambda"].values[k]), int(ds["mode"].values[k]), scale
+
+
+#: the default search range of the jump chart's first grazing, in units of the
+#: inverse-kinematics contact-loss speed at the start: the grazing lies below it by the
+#: contact's compliance (:func:`camdyn.analysis.compliance_shift`: 2e-6 to 5e-8 of it on the
+#: shipped rigs), and the contact orbit exists from the low end
+JUMP_SEARCH = (0.9, 1.05)
+
+
+def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple | None = None,
+               phase_fraction: float = 0.5, warmup_revolutions: int = 20,
+               settings: GrazingSettings = GrazingSettings(), options: SolverOptions = DEFAULT_OPTIONS,
+               backend: str = "compiled"):
+    """The jump chart: the jump speed (the grazing speed, where the follower first leaves the
+    cam) against the rig parameter ``parameter`` from ``start`` to ``end``
+    (:func:`continue_grazing` in (``speed_rpm``, ``parameter``)), beside its quasi-static
+    limit, the inverse-kinematics contact-loss speed (:func:`camdyn.analysis.contact_loss_speed`)
+    at each point's parameter value, and the first-order shift between them by the contact's
+    compliance (:func:`camdyn.analysis.compliance_shift`).
+
+    ``search``: the speeds (rev/min) the first grazing is searched between; default
+    :data:`JUMP_SEARCH` times the contact-loss speed at ``start``.  Returns the Dataset of
+    :func:`continue_grazing` with ``contact_loss_rpm`` and ``compliance_shift`` per point.
+    """
+    from ...analysis.statics import compliance_shift, contact_loss_speed
+
+    if parameter == SPEED or parameter not in _names():
+        raise ParameterError("parameter", parameter, f"a rig parameter ({', '.join(_names()[1:])}): the jump "
+                                                     "speed is charted against it")
+    if search is None:
+        finite("start", start)
+        loss = contact_loss_speed(rig.replace(**{parameter: float(start)}))
+        if not (math.isfinite(loss) and loss > 0):
+            raise ParameterError("start", start, f"a value of {parameter} at which the follower leaves the cam "
+                                                 f"at some speed (contact-loss speed {loss} rev/min there)")
+        search = (JUMP_SEARCH[0] * loss, JUMP_SEARCH[1] * loss)
+    ds = continue_grazing(rig, scene, parameter, start, end, search=search, phase_fraction=phase_fraction,
+                          warmup_revolutions=warmup_revolutions, settings=settings, options=options,
+                          backend=backend)
+    rigs = [rig.replace(**{parameter: float(v)}) for v in ds[parameter].values]
+    ds["contact_loss_rpm"] = ("point", np.array([contact_loss_speed(r) for r in rigs]),
+                              {"units": "rev/min", "long_name": "contact-loss speed by inverse kinematics "
+                                                                "(the quasi-static limit)"})
+    ds["compliance_shift"] = ("point", np.array([compliance_shift(r, scene) for r in rigs]),
+                              {"units": "1", "long_name": "first-order relative shift of the contact-loss speed "
+                                                          "by the contact's compliance"})
+    ds.attrs["title"] = f"camdyn jump chart: the jump speed against {parameter}, rig {rig.name}"
+    return ds

@@ -14,13 +14,13 @@ the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) s
 and appended to the orbit's equations, as for the grazing bifurcation curves of Kuznetsov,
 Gragnani & Rinaldi, Int. J. Bifurcation Chaos 13 (2003) 2157, and of di Bernardo et al.,
 *Piecewise-smooth Dynamical Systems*, Springer 2008, Sec. 8.4).  ``margin`` is
-``gap_tol`` times the deflection scale d: the orbit is converged on the contact side, so its
+``gap_tol`` times the gap's scale d, the largest deflection over the first orbit: the orbit is converged on the contact side, so its
 run never lifts off and its derivatives are the contact flow's.
 
 **Scaling.**  z = (x / s, phi_g, lambda1 / sigma1, lambda2 / sigma2): s the motion's size (as
 in :mod:`camdyn.orbits.shooting`), phi_g the fraction of the period, sigma2 the range of
 lambda2 and sigma1 the magnitude of lambda1 at the start.  The residual's rows are (P - x) / s,
-psi / d and psi_dot / (d 2 pi / T), with d = |psi_i*| the static deflection (m), the last two
+psi / d and psi_dot / (d 2 pi / T), with d the largest deflection over the first orbit (m), the last two
 multiplied by tol / gap_tol and tol / (RATE_TOL sqrt(gap_tol)): one tolerance ``tol`` on the
 scaled residual is then gap_tol of the deflection on the gap, and RATE_TOL sqrt(gap_tol) on its
 rate (an error e in psi_dot moves t_g by e / psi_ddot and psi(t_g) only by ~e^2 / (2 psi_ddot):
@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -82,9 +81,6 @@ WINDOW = 1e-2
 #: the rate row's tolerance, RATE_TOL sqrt(gap_tol) of its scale: a rate error e moves t_g by
 #: e / psi_i'' and psi_i(t_g) from the maximum by only ~e^2 / (2 psi_i''), second order
 RATE_TOL = 0.1
-#: another maximum of the gap over the orbit overtakes the grazing's when it exceeds psi_i(t_g)
-#: by more than this fraction of the deflection scale (more than the parabola's refinement error)
-MAXIMUM_SLACK = 1e-3
 
 
 @dataclass(frozen=True)
@@ -102,6 +98,7 @@ class GrazingSystem:
     start: float
     end: float
     free_start: float
+    deflection: float
     speed_rpm: float | None = None
     phase_fraction: float = 0.5
     options: SolverOptions = DEFAULT_OPTIONS
@@ -122,11 +119,6 @@ class GrazingSystem:
     def section_map(self, free: float, lam: float, mode: int | None) -> StroboscopicMap:
         model = self.model(free, lam)
         return StroboscopicMap(model, 1, self.phase_fraction * model.period, mode, self.options, self.backend)
-
-    @cached_property
-    def deflection(self) -> float:
-        """d (m): the static deflection |psi_i*| of the rig at the start, the gap's scale."""
-        return abs(self.model(self.free_start, self.start).equilibrium.psi_i)
 
 
 class Layout(NamedTuple):
@@ -217,12 +209,13 @@ class Derivatives(NamedTuple):
 
 
 def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Evaluation,
-                previous: np.ndarray | None = None) -> Derivatives:
+                previous: np.ndarray | None = None, strict: bool = True) -> Derivatives:
     """The derivatives of the residual at z (see the module docstring; raises MapFailure where
     the tangent dynamics or a difference cannot be evaluated).  ``previous``: the lambda steps
     of the last point's derivatives; each difference then starts SHRINK times above its step
     (not at the rule's first step, which a grazing orbit lifts off at on both sides: two runs
-    per column instead of ~6)."""
+    per column instead of ~6); ``strict``: False at a corrector's iterate
+    (:func:`contact_side_difference`)."""
     A = np.zeros((N_STATE + 2, G_SIZE))
     *window, M = _fundamental(base, layout.split(z)[0])
     A[:, G_STATE] = _state_columns(system, layout, base, M, window)
@@ -230,7 +223,7 @@ def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Eval
     steps, notes = np.empty(2), []
     for column, index, sigma in ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range)):
         first = None if previous is None else SHRINK * float(previous[column])
-        d, steps[column], note = _parameter_column(system, layout, z, base, index, first)
+        d, steps[column], note = _parameter_column(system, layout, z, base, index, first, strict)
         A[:, index] = d * sigma
         if note:
             notes.append(f"d/d{(system.free, system.parameter)[column]}: {note}")
@@ -292,7 +285,7 @@ def _phase_column(system: GrazingSystem, base: Evaluation) -> np.ndarray:
 
 
 def _parameter_column(system: GrazingSystem, layout: Layout, z, base: Evaluation, index: int,
-                      first: float | None):
+                      first: float | None, strict: bool):
     """d(residual)/d(lambda) in the parameter's unit (:func:`contact_side_difference`), the step
     from ``first``, or the rule's ``rtol^(1/3) max(|lambda|, sigma)``, down to its floor."""
     sigma = layout.sigma_free if index == G_FREE else layout.sigma_range
@@ -305,16 +298,19 @@ def _parameter_column(system: GrazingSystem, layout: Layout, z, base: Evaluation
     column = Column.of(max(abs(lam), sigma), np.ones(N_STATE + 2), system.options.rtol)
     if first is not None and column.floor <= first < column.first:
         column = column._replace(first=first)
-    return contact_side_difference(value, base.value, column)
+    return contact_side_difference(value, base.value, column, strict)
 
 
-def contact_side_difference(evaluate_at, base: MapValue, column: Column):
+def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict: bool = True):
     """The derivative of ``evaluate_at`` (the value at a signed offset) at 0, under the rule of
     :mod:`camdyn.orbits.derivatives` as far as a grazing orbit allows: from ``column.first``,
     the central difference where the runs at +-h both take ``base``'s path; where one of them
     leaves it (it lifts off: the other side is the contact side), the one-sided difference
     from the side that kept it; h divided by SHRINK while neither keeps it, down to
-    ``column.floor``.  Returns (derivative, h, note: '' or why one-sided); raises
+    ``column.floor``.  Without ``strict`` (a corrector's iterate, which may lie past the
+    grazing, lifted off), where neither run keeps the base path the one with fewer switches
+    (the contact side) gives the one-sided difference: a direction for the corrector, no
+    derivative.  Returns (derivative, h, note: '' or why one-sided); raises
     :class:`~camdyn.orbits.derivatives.Unresolved` when no step works."""
     h = column.first
     while h >= column.floor:
@@ -327,6 +323,9 @@ def contact_side_difference(evaluate_at, base: MapValue, column: Column):
                     raise
                 values.append(None)
         kept = [v is not None and same_path(v, base) for v in values]
+        if not (strict or any(kept) or None in values):
+            fewer = len(values[0].transitions) - len(values[1].transitions)
+            kept = [fewer < 0, fewer > 0]
         if all(kept):
             return (values[0].state - values[1].state) / (2 * h), h, ""
         if any(kept):
@@ -338,10 +337,11 @@ def contact_side_difference(evaluate_at, base: MapValue, column: Column):
     raise Unresolved(f"no step down to {column.floor:.3g} keeps the grazing orbit's path on either side")
 
 
-def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> float:
-    """phi_g of the largest psi_i over one period from x at lambda1 = ``free``, lambda2 = start:
-    the largest of :func:`gap_samples` samples, refined by the parabola through it and its
-    neighbours (the first guess of the extended system's phase; raises MapFailure)."""
+def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> tuple[float, float]:
+    """phi_g of the largest psi_i over one period from x at lambda1 = ``free``, lambda2 = start
+    (the largest of :func:`gap_samples` samples, refined by the parabola through it and its
+    neighbours: the first guess of the extended system's phase), and the largest deflection
+    -min psi_i over the period (m: the gap's scale d).  Raises MapFailure."""
     sm = system.section_map(free, system.start, mode)
     t0, t1 = sm.t_span
     samples = np.linspace(t0, t1, gap_samples(sm.model) + 1)
@@ -350,11 +350,12 @@ def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> floa
     k = int(np.argmax(psi))
     a, b, c = psi[k - 1], psi[k], psi[(k + 1) % psi.size]
     shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0
-    return float(((k + shift) / psi.size) % 1.0)
+    return float(((k + shift) / psi.size) % 1.0), float(-np.min(psi))
 
 
-def is_largest(evaluation: Evaluation, system: GrazingSystem) -> bool:
+def is_largest(evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
-    parabola) exceeds psi_i(t_g) by at most MAXIMUM_SLACK of the deflection scale (else another
-    maximum of the gap has overtaken it: the follower would first leave the cam elsewhere)."""
-    return evaluation.max_gap <= evaluation.psi_g + MAXIMUM_SLACK * system.deflection
+    parabola) stays below zero, the orbit in contact throughout (else another maximum of the gap
+    has overtaken the one at t_g, which is at -margin: the follower first leaves the cam
+    elsewhere)."""
+    return evaluation.max_gap < 0.0

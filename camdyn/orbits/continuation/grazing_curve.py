@@ -65,7 +65,8 @@ class GrazingSettings:
     """``continuation``: the step control, the corrector's tolerance ``tol`` and ``locate_tol``
     (scaled arclength: lambda2's range is 1), used for the curve and for the one-parameter
     search of its first point; ``gap_tol``: the gap's tolerance, a fraction of the static
-    deflection (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it)."""
+    deflection over the first orbit (the grazing orbit is converged to psi_i(t_g) within [-2, 0]
+    gap_tol of it)."""
 
     continuation: ContinuationSettings = ContinuationSettings(switch_depth=0)
     gap_tol: float = 1e-6
@@ -74,7 +75,7 @@ class GrazingSettings:
         if not isinstance(self.continuation, ContinuationSettings):
             raise ParameterError("continuation", self.continuation,
                                  "a camdyn.orbits.continuation.ContinuationSettings")
-        real("gap_tol", self.gap_tol, "1e-12 <= gap_tol <= 1e-2 (of the static deflection)",
+        real("gap_tol", self.gap_tol, "1e-12 <= gap_tol <= 1e-2 (of the largest deflection over the orbit)",
              lambda v: 1e-12 <= v <= 1e-2)
 
 
@@ -159,7 +160,7 @@ def corrected(leg: Leg, p: GrazingPoint, ds: float):
     z_pred = p.z + ds * p.tangent
     mode = p.evaluation.value.start_mode
     steps = p.derivatives.steps
-    return chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(leg.system, leg.layout, z, e, steps).A,
+    return chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
                  z_pred, p.tangent, p.derivatives.A, leg.settings)
 
 
@@ -176,7 +177,7 @@ def step(leg: Leg, p: GrazingPoint, ds: float):
     if found is None:
         return None
     z, e, iterations = found
-    if not is_largest(e, leg.system):
+    if not is_largest(e):
         return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} m over the orbit "
                                                    f"against {e.psi_g:.3g} m at the grazing's t_g")
     try:
@@ -203,13 +204,14 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
         A0 = derivatives(system, layout, z0, e0).A
     except CamdynError as failure:
         return f"the start orbit cannot be evaluated: {failure}"
-    found = chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(system, layout, z, e).A, z0, along,
+    found = chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(system, layout, z, e, None, False).A, z0,
+                  along,
                   A0, dataclasses.replace(leg.settings, max_corrector=max(20, leg.settings.max_corrector)))
     if found is None:
         return (f"the extended system's corrector did not converge from the near-grazing orbit at "
                 f"{system.free} = {free:.8g}")
     z, e, iterations = found
-    if not is_largest(e, system):
+    if not is_largest(e):
         return f"the located orbit's largest gap is not at its t_g ({e.max_gap:.3g} m against {e.psi_g:.3g} m)"
     try:
         return _point(leg, z, e, along, iterations)

@@ -353,6 +353,18 @@ def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> tupl
     return float(((k + shift) / psi.size) % 1.0), float(-np.min(psi))
 
 
+def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A: np.ndarray) -> float:
+    """lambda1 where the orbit at z, converged at psi_i(t_g) = -margin, would touch zero gap at
+    the same lambda2: one Newton step of the system without the margin, ``[A; e_lambda2] dz =
+    -(residual without the margin)`` (the error is second order in the margin, gap_tol^2 d)."""
+    margin = np.zeros(N_STATE + 2)
+    margin[N_STATE] = system.gap_tol * _row_weights(system)[N_STATE]
+    along = np.zeros(G_SIZE)
+    along[G_RANGE] = 1.0
+    dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))
+    return layout.split(z + dz)[2]
+
+
 def is_largest(evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
     parabola) stays below zero, the orbit in contact throughout (else another maximum of the gap

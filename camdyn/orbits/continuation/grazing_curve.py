@@ -31,8 +31,8 @@ from ..shooting import sorted_multipliers
 from .corrector import chord, tangent
 from .events import MAX_BISECTIONS, Bracket, trial
 from .follow import GROWTH, clipped, left_range
-from .grazing import (G_FREE, G_RANGE, G_SIZE, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
-                      is_largest)
+from .grazing import (G_RANGE, G_SIZE, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
+                      free_at_zero_gap, is_largest)
 from .problem import ContinuationSettings
 
 #: the codimension-2 points' kinds and their test functions of the monodromy matrix M
@@ -82,7 +82,9 @@ class GrazingSettings:
 class GrazingPoint(NamedTuple):
     """One grazing orbit: z (scaled), lambda1 and lambda2, x at the section, the grazing's phase
     phi_g (t_g = t0 + phi_g T), M = dP/dx (contact side), the unit tangent (scaled), the
-    derivatives, the evaluation that converged there (t_g, psi_i there...), the corrector's iterations."""
+    derivatives, the evaluation that converged there (t_g, psi_i there...), the corrector's
+    iterations, and ``grazing``: lambda1 at zero gap (:func:`.grazing.free_at_zero_gap`; the
+    orbit's own lambda1, ``free``, is at psi_i(t_g) = -margin)."""
 
     z: np.ndarray
     free: float
@@ -94,6 +96,7 @@ class GrazingPoint(NamedTuple):
     derivatives: Derivatives
     evaluation: Evaluation
     iterations: int
+    grazing: float
 
     @property
     def tests(self) -> dict[str, float]:
@@ -151,17 +154,29 @@ def _point(leg: Leg, z, e: Evaluation, direction, iterations: int, previous=None
     last point's lambda steps) and tangent."""
     d = derivatives(leg.system, leg.layout, z, e, previous)
     x, phase, free, lam = leg.layout.split(z)
-    return GrazingPoint(z, free, lam, x, phase, d.M, tangent(d.A, direction), d, e, iterations)
+    return GrazingPoint(z, free, lam, x, phase, d.M, tangent(d.A, direction), d, e, iterations,
+                        free_at_zero_gap(leg.system, leg.layout, z, e, d.A))
 
 
-def corrected(leg: Leg, p: GrazingPoint, ds: float):
+def corrected(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
     """The grazing orbit at arclength ds from p along its tangent (chord corrector), without
-    its derivatives: (z, evaluation, iterations), or None when the corrector fails."""
+    its derivatives: (z, evaluation, iterations), or None when the corrector fails.  ``final``:
+    the step is clipped to the range's end, and the corrector holds lambda2 at the predicted
+    value (the end) instead of the arclength condition."""
     z_pred = p.z + ds * p.tangent
     mode = p.evaluation.value.start_mode
     steps = p.derivatives.steps
-    return chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
-                 z_pred, p.tangent, p.derivatives.A, leg.settings)
+    direction = _along(1.0) if final else p.tangent
+    return chord(lambda z: _residual(leg, z, mode),
+                 lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
+                 z_pred, direction, p.derivatives.A, leg.settings)
+
+
+def _along(sign: float) -> np.ndarray:
+    """A z-direction along lambda2 alone."""
+    t = np.zeros(G_SIZE)
+    t[G_RANGE] = sign
+    return t
 
 
 def _residual(leg: Leg, z, mode):
@@ -170,10 +185,11 @@ def _residual(leg: Leg, z, mode):
     return e.residual, e
 
 
-def step(leg: Leg, p: GrazingPoint, ds: float):
-    """The point at arclength ds from p: a GrazingPoint, None when the corrector fails, or
-    :class:`Ended` (MAXIMUM_MOVED, NO_DERIVATIVES) with where and why."""
-    found = corrected(leg, p, ds)
+def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
+    """The point at arclength ds from p (``final``: at the range's end, :func:`corrected`): a
+    GrazingPoint, None when the corrector fails, or :class:`Ended` (MAXIMUM_MOVED,
+    NO_DERIVATIVES) with where and why."""
+    found = corrected(leg, p, ds, final)
     if found is None:
         return None
     z, e, iterations = found
@@ -197,8 +213,7 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
     its tangent oriented toward the end.  Or why there is none."""
     layout, system = leg.layout, leg.system
     z0 = layout.z(x, phase, free, system.start)
-    along = np.zeros(G_SIZE)
-    along[G_RANGE] = math.copysign(1.0, system.end - system.start)
+    along = _along(math.copysign(1.0, system.end - system.start))
     try:
         e0 = evaluate(system, layout, z0, mode)
         A0 = derivatives(system, layout, z0, e0).A
@@ -228,7 +243,7 @@ def follow(leg: Leg, p: GrazingPoint) -> Curve:
             curve.outcome = GrazingOutcome.MAX_POINTS
             return curve
         h = clipped(leg.start, leg.end, leg.span, p.lam, p.tangent[G_RANGE], ds)
-        q = step(leg, p, h)
+        q = step(leg, p, h, final=h < ds and _toward_end(leg, p))
         if isinstance(q, Ended):
             curve.outcome, curve.message = q
             return curve
@@ -247,6 +262,11 @@ def follow(leg: Leg, p: GrazingPoint) -> Curve:
         if q.iterations <= settings.easy_iterations:
             ds = min(GROWTH * ds, settings.max_step)
         p = q
+
+
+def _toward_end(leg: Leg, p: GrazingPoint) -> bool:
+    """Whether p's tangent moves lambda2 toward the range's end."""
+    return p.tangent[G_RANGE] * (leg.end - leg.start) > 0
 
 
 def located(leg: Leg, p: GrazingPoint, q: GrazingPoint, ds: float, index: int) -> list[Codim2]:

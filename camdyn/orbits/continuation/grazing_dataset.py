@@ -30,7 +30,8 @@ def grazing_dataset(system, curve, layout, settings):
 
     Dims ``point`` (every grazing orbit, in the order continued), ``multiplier`` (2, by
     decreasing modulus), ``codim2`` (the codimension-2 points).  Per point: the two parameters
-    by their names (attrs ``free``: lambda1, ``parameter``: lambda2), ``alpha``, ``alpha_dot``
+    by their names (attrs ``free``: lambda1, at zero gap; ``parameter``: lambda2), lambda1 of
+    the orbit itself, converged at psi_i(t_g) = -margin (``<free>_orbit``), ``alpha``, ``alpha_dot``
     at the section, ``grazing_time`` (t_g - t0, s after the section) and ``grazing_phase``
     (its fraction of T), ``grazing_gap`` (psi_i at t_g, m: within [-2, 0] gap_tol of the
     deflection scale, the contact side), ``multiplier_real``/``_imag``/``_modulus`` (the
@@ -54,8 +55,12 @@ def _point_variables(system, points) -> dict:
     T = np.array([p.evaluation.section_map.model.period for p in points])
     phase = np.array([p.phase for p in points])
     return {
-        system.free: (P, np.array([p.free for p in points]), {"units": unit(system.free),
-                                                              "long_name": _long_name(system.free)}),
+        system.free: (P, np.array([p.grazing for p in points]),
+                      {"units": unit(system.free), "long_name": f"{_long_name(system.free)} at grazing (zero gap, "
+                                                                "one Newton step from the orbit at -margin)"}),
+        f"{system.free}_orbit": (P, np.array([p.free for p in points]),
+                                 {"units": unit(system.free), "long_name": f"{_long_name(system.free)} of the "
+                                                                           "orbit converged at psi_i(t_g) = -margin"}),
         system.parameter: (P, np.array([p.lam for p in points]), {"units": unit(system.parameter),
                                                                   "long_name": _long_name(system.parameter)}),
         "alpha": (P, np.array([p.x[STATE_ALPHA] for p in points]), {"units": "rad", "long_name": "alpha at the section"}),
@@ -88,7 +93,7 @@ def _codim2_variables(system, found) -> dict:
     return {
         "codim2_kind": (C, np.array([kinds.index(c.kind) for c in found], dtype=int),
                         {"long_name": "kind (index into the attribute codim2_kinds)"}),
-        f"codim2_{system.free}": (C, np.array([c.at.free for c in found]), {"units": unit(system.free)}),
+        f"codim2_{system.free}": (C, np.array([c.at.grazing for c in found]), {"units": unit(system.free)}),
         f"codim2_{system.parameter}": (C, np.array([c.at.lam for c in found]), {"units": unit(system.parameter)}),
         "codim2_point": (C, np.array([c.point for c in found], dtype=int),
                          {"long_name": "index of the point just before it"}),

@@ -124,3 +124,43 @@ def test_no_grazing_in_the_search_range_ends_the_curve_at_its_start():
     ds = continue_grazing(RIG, SCENE, "k_s", 2000.0, 2400.0, search=(800.0, 850.0))
     assert ds.attrs["outcome"] == GrazingOutcome.START_FAILED.name and ds.sizes["point"] == 0
     assert "no grazing" in ds.attrs["outcome_message"]
+
+
+def test_the_chart_plots_and_saves(chart, tmp_path):
+    pytest.importorskip("matplotlib")
+    from camdyn.io import plots
+
+    fig = plots.jump_chart(chart, title="jump chart")
+    assert len(fig.axes) == 2                                   # the chart, and the quasi-static panel
+    assert fig.axes[0].get_ylabel() == "jump speed (rev/min)" and fig.axes[1].get_xlabel() == "k_s (N/m)"
+    fig.savefig(tmp_path / "chart.png")
+    path = tmp_path / "chart.nc"
+    chart.to_netcdf(path, engine="scipy")
+    import xarray as xr
+    with xr.open_dataset(path, engine="scipy") as back:
+        assert np.array_equal(back["speed_rpm"].values, chart["speed_rpm"].values)
+        assert back.attrs["outcome"] == chart.attrs["outcome"]
+
+
+def test_the_chart_command_prints_csv_and_writes_files(tmp_path, capsys):
+    from camdyn.cli.app import main
+
+    nc, png = tmp_path / "jump.nc", tmp_path / "jump.png"
+    code = main(["--no-progress", "chart", "--param", "k_s", "--start", "2000", "--end", "2040", "--contact", "line",
+                 "--damping", "D", "--friction", "coulomb", "--netcdf", str(nc)]
+                + (["--plot", str(png)] if _has_matplotlib() else []))
+    out = capsys.readouterr().out
+    assert code == 0, out
+    rows = [line.split(",") for line in out.splitlines() if line[:1].isdigit()]
+    assert float(rows[0][0]) == 2000.0 and float(rows[-1][0]) == pytest.approx(2040.0)
+    assert all(float(r[1]) < float(r[2]) for r in rows)          # the jump below the quasi-static limit
+    assert nc.exists() and (png.exists() or not _has_matplotlib())
+    assert main(["chart", "--param", "k_s", "--start", "2000", "--end", "2000"]) == 2
+
+
+def _has_matplotlib() -> bool:
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True

@@ -25,12 +25,11 @@ from ...model.rig import PARAMETERS, Rig
 from ...model.scene import Scene
 from ..section_map import DEFAULT_OPTIONS
 from ..tangent import variational
-from . import continue_orbit
-from .events import EVENTS
+from .follow import run
 from .grazing import GrazingSystem, Layout, gap_maximum
 from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
 from .grazing_dataset import grazing_dataset
-from .problem import SPEED
+from .problem import SPEED, Problem
 
 #: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
 #: when that orbit's largest gap is within this fraction of the branch's first orbit's from zero
@@ -104,55 +103,55 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
 
 
 def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
-    """(curve, layout, the system with lambda1 at the first grazing) from the start's search."""
+    """(curve, layout, the system with lambda1 at the first grazing) from the start's search:
+    the extended system solved from each candidate orbit in turn until one converges."""
     found = _search(system, search, settings, warmup_revolutions)
     if isinstance(found, str):
         return Curve([], [], GrazingOutcome.START_FAILED, found), None, system
-    x, free, mode, scale = found
-    layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
-    try:
-        phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
-    except CamdynError as failure:
-        return Curve([], [], GrazingOutcome.START_FAILED, f"the start orbit cannot be run: {failure}"), layout, system
-    system = dataclasses.replace(system, free_start=free, deflection=deflection)
-    leg = Leg(system, layout, settings.continuation)
-    p = first(leg, x, phase, free, mode)
-    if isinstance(p, str):
-        return Curve([], [], GrazingOutcome.START_FAILED, p), layout, system
-    return follow(leg, p), layout, system
+    candidates, scale = found
+    why = []
+    for x, free, mode in candidates:
+        layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
+        try:
+            phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
+        except CamdynError as failure:
+            why.append(f"the orbit at {system.free} = {free:.8g} cannot be run: {failure}")
+            continue
+        at = dataclasses.replace(system, free_start=free, deflection=deflection)
+        leg = Leg(at, layout, settings.continuation)
+        p = first(leg, x, phase, free, mode)
+        if not isinstance(p, str):
+            return follow(leg, p), layout, at
+        why.append(p)
+    return Curve([], [], GrazingOutcome.START_FAILED, "; ".join(why)), None, system
 
 
 def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
-    """(x, lambda1, mode, the motion's scale) of the grazing (or near-grazing) orbit that the
-    one-parameter continuation in lambda1 finds at lambda2 = start; or why there is none."""
+    """The candidate first orbits, (x, lambda1, mode) each, and the motion's scale, from the
+    branch the one-parameter continuation in lambda1 follows at lambda2 = start (its first; the
+    derivatives by the tangent dynamics, as the extended system's); or why there are none.  The
+    candidates: the located grazing's orbit and the branch's point before it (the one on the
+    contact side first); without a grazing, the branch's last orbit when it is within NEAR."""
     rig = system.rig if system.parameter == SPEED else system.rig.replace(**{system.parameter: system.start})
     speed = system.start if system.parameter == SPEED else system.speed_rpm
-    ds = continue_orbit(rig, system.scene, system.free, float(search[0]), float(search[1]),
-                        speed_rpm=None if system.free == SPEED else speed, phase_fraction=system.phase_fraction,
-                        warmup_revolutions=warmup_revolutions, settings=settings.continuation,
-                        options=system.options, jacobian=variational, backend=system.backend)
-    scale = (ds.attrs["scale_alpha"], ds.attrs["scale_alpha_dot"])
-    on_first = ds["event_branch"].values == 0
-    grazing = np.flatnonzero(on_first & (ds["event_kind"].values == EVENTS.index("grazing")))
-    if grazing.size:                        # the event's orbit on its contact side, else the point before it
-        k = int(grazing[0])
-        if ds["event_max_gap"].values[k] < 0:
-            x = np.array([ds["event_alpha"].values[k], ds["event_alpha_dot"].values[k]])
-            return x, float(ds["event_lambda"].values[k]), int(ds["mode"].values[ds["event_point"].values[k]]), scale
-        k = int(ds["event_point"].values[k])
-        x = np.array([ds["alpha"].values[k], ds["alpha_dot"].values[k]])
-        return x, float(ds["lambda"].values[k]), int(ds["mode"].values[k]), scale
-    points = np.flatnonzero(ds["point_branch"].values == 0)
-    why = ds.attrs.get("branch_0_message", "")
-    if not points.size:
+    problem = Problem(rig, system.scene, system.free, float(search[0]), float(search[1]),
+                      None if system.free == SPEED else speed, 1, system.phase_fraction, system.options, variational,
+                      system.backend)
+    branches, events, scale = run(problem, settings.search, warmup_revolutions)
+    points = branches[0].points
+    grazing = [e for e in events if e.branch == 0 and e.kind == "grazing"]
+    if grazing:
+        e, before = grazing[0], points[grazing[0].point]
+        pair = [(e.x, e.lam, before.mode), (before.x, before.lam, before.mode)]
+        return (pair if e.max_gap < 0 else pair[::-1]), scale
+    why = f"{branches[0].outcome.message if branches[0].outcome else ''} {branches[0].message}".strip()
+    if not points:
         return f"no orbit at {system.free} = {search[0]:.8g}: {why}"
-    k = int(points[-1])
-    gap, deep = float(ds["max_gap"].values[k]), float(ds["max_gap"].values[points[0]])
-    if not (gap < 0 and -gap <= NEAR * -deep):
+    last = points[-1]
+    if not (last.max_gap < 0 and -last.max_gap <= NEAR * -points[0].max_gap):
         return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no grazing: its last orbit's "
-                f"largest gap is {gap:.3g} m ({why})")
-    x = np.array([ds["alpha"].values[k], ds["alpha_dot"].values[k]])
-    return x, float(ds["lambda"].values[k]), int(ds["mode"].values[k]), scale
+                f"largest gap is {last.max_gap:.3g} m ({why})")
+    return [(last.x, last.lam, last.mode)], scale
 
 
 #: the default search range of the jump chart's first grazing, in units of the

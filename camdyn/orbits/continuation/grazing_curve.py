@@ -62,19 +62,21 @@ class GrazingOutcome(ActionableOutcome):
 
 @dataclass(frozen=True)
 class GrazingSettings:
-    """``continuation``: the step control, the corrector's tolerance ``tol`` and ``locate_tol``
-    (scaled arclength: lambda2's range is 1), used for the curve and for the one-parameter
-    search of its first point; ``gap_tol``: the gap's tolerance, a fraction of the static
-    deflection over the first orbit (the grazing orbit is converged to psi_i(t_g) within [-2, 0]
-    gap_tol of it)."""
+    """``continuation``: the curve's step control, the corrector's tolerance ``tol`` and
+    ``locate_tol`` of its codimension-2 points (scaled arclength: lambda2's range is 1);
+    ``search``: the one-parameter continuation that finds the first grazing (its orbit only
+    starts the extended system's Newton, which locates the grazing itself: a coarse one);
+    ``gap_tol``: the gap's tolerance, a fraction of the largest deflection over the first orbit
+    (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it)."""
 
     continuation: ContinuationSettings = ContinuationSettings(switch_depth=0)
     gap_tol: float = 1e-6
+    search: ContinuationSettings = ContinuationSettings(max_step=0.1, locate_tol=1e-5, switch_depth=0)
 
     def __post_init__(self):
-        if not isinstance(self.continuation, ContinuationSettings):
-            raise ParameterError("continuation", self.continuation,
-                                 "a camdyn.orbits.continuation.ContinuationSettings")
+        for name in ("continuation", "search"):
+            if not isinstance(getattr(self, name), ContinuationSettings):
+                raise ParameterError(name, getattr(self, name), "a camdyn.orbits.continuation.ContinuationSettings")
         real("gap_tol", self.gap_tol, "1e-12 <= gap_tol <= 1e-2 (of the largest deflection over the orbit)",
              lambda v: 1e-12 <= v <= 1e-2)
 
@@ -216,7 +218,7 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
     along = _along(math.copysign(1.0, system.end - system.start))
     try:
         e0 = evaluate(system, layout, z0, mode)
-        A0 = derivatives(system, layout, z0, e0).A
+        A0 = derivatives(system, layout, z0, e0, None, False).A
     except CamdynError as failure:
         return f"the start orbit cannot be evaluated: {failure}"
     found = chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(system, layout, z, e, None, False).A, z0,

@@ -105,7 +105,8 @@ def _codim2_variables(system, found) -> dict:
 def _attributes(system, curve, layout, settings) -> dict:
     outcome = curve.outcome or GrazingOutcome.STEP_TOO_SMALL
     scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
-    plain = {**dataclasses.asdict(settings.continuation), "gap_tol": settings.gap_tol}
+    plain = {**dataclasses.asdict(settings.continuation), "gap_tol": settings.gap_tol,
+             **{f"search_{k}": v for k, v in dataclasses.asdict(settings.search).items()}}
     return {
         "title": f"camdyn grazing curve in ({system.free}, {system.parameter}), rig {system.rig.name}",
         "source": f"camdyn {__version__}", "camdyn_version": __version__,

@@ -3,19 +3,20 @@
 A period-1 orbit *grazes* where its largest gap psi_i (Eq. 6) reaches zero: the follower, in
 permanent contact, touches zero deflection once per revolution and leaves the cam beyond it.
 With two parameters lambda = (lambda1, lambda2) (the cam speed ``speed_rpm`` or rig parameters)
-the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) solving
+the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) solving::
 
     P(x; lambda) - x = 0            (the periodic orbit, x the state at the section t0)
     psi_i(t_g) + margin = 0         (it touches zero gap at t_g = t0 + phi_g T)
     psi_i_dot(t_g) = 0              (t_g is the gap's maximum; the rate as a central
                                      difference over t_g +- WINDOW T, see WINDOW)
 
-(4 equations, 5 unknowns: a curve; the test functions of a codimension-1 boundary set to zero
-and appended to the orbit's equations, as for the grazing bifurcation curves of Kuznetsov,
-Gragnani & Rinaldi, Int. J. Bifurcation Chaos 13 (2003) 2157, and of di Bernardo et al.,
-*Piecewise-smooth Dynamical Systems*, Springer 2008, Sec. 8.4).  ``margin`` is
-``gap_tol`` times the gap's scale d, the largest deflection over the first orbit: the orbit is converged on the contact side, so its
-run never lifts off and its derivatives are the contact flow's.
+4 equations in 5 unknowns: a curve.  This is the defining system of a codimension-1 boundary
+continued in two parameters, the boundary's test functions appended to the orbit's equations
+(Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10), here
+the grazing conditions of a periodic orbit of a hybrid system (Thota & Dankowicz, TC-HAT, SIAM
+J. Appl. Dyn. Syst. 7 (2008) 1283).  ``margin`` is ``gap_tol`` times the gap's scale d, the
+largest deflection over the first orbit: the orbit is converged on the contact side, so its run
+never lifts off and its derivatives are the contact flow's.
 
 **Scaling.**  z = (x / s, phi_g, lambda1 / sigma1, lambda2 / sigma2): s the motion's size (as
 in :mod:`camdyn.orbits.shooting`), phi_g the fraction of the period, sigma2 the range of

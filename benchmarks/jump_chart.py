@@ -3,7 +3,7 @@ cost of its brute-force answer (a speed x k_s grid of simulations).
 
 Run from the repository root:
 
-    python benchmarks/jump_chart.py [--points 30] [--resolution 1e-6] [--window 0.01]
+    python benchmarks/jump_chart.py [--points 30] [--resolution 1e-6] [--window 0.01] [--netcdf chart.nc]
 
 The rig: ``reference-experiment`` (line contact 16 mm, damping D, Coulomb friction), k_s from its
 own value to ten times it.  camdyn.orbits.continuation.jump_chart follows the grazing orbit in
@@ -64,11 +64,14 @@ def main(argv=None):
     ap.add_argument("--resolution", type=float, default=1e-6, help="the grid's relative speed spacing")
     ap.add_argument("--window", type=float, default=0.01, help="the grid's half-width, relative to the speed")
     ap.add_argument("--revolutions", type=int, default=3)
+    ap.add_argument("--netcdf", help="save the chart here")
     args = ap.parse_args(argv)
     warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
     rig = camdyn.load_rig("reference-experiment")
     camdyn.simulate(rig, SCENE, speed_rpm=100.0, revolutions=1)                  # load the compiled loop
     ds, seconds = chart(rig, args.points)
+    if args.netcdf:
+        ds.to_netcdf(args.netcdf, engine="scipy")
     ratio = ds["speed_rpm"].values / ds["contact_loss_rpm"].values - 1.0
     shift = ds["compliance_shift"].values
     print(f"jump chart, reference-experiment, k_s {rig.k_s:.6g} -> {10 * rig.k_s:.6g} N/m: {seconds:.1f} s, "

@@ -164,3 +164,23 @@ def _has_matplotlib() -> bool:
     except ImportError:
         return False
     return True
+
+
+def test_a_multiplier_through_minus_one_at_grazing_is_located_in_arclength(monkeypatch):
+    """The codimension-2 locator on a curve of made-up orbits whose multiplier at grazing is
+    -1 + 3 (s - s*) along the arclength s: found, named, and within locate_tol of s*; the
+    multiplier through +1 (det(M - I)) changes sign nowhere here and is not reported."""
+    from camdyn.orbits.continuation import grazing_curve as C
+
+    root, settings = 0.0123, ContinuationSettings(locate_tol=1e-6)
+
+    def orbit(s: float):
+        M = np.diag([-1.0 + 3.0 * (s - root), 0.5])
+        return C.GrazingPoint(np.full(5, s), 1000.0 + s, 2000.0 + s, np.zeros(2), 0.5, M, np.eye(5)[4], None, None,
+                              1, 1000.0 + s, np.zeros(5))
+    monkeypatch.setattr(C, "step", lambda leg, p, s, final=False: orbit(float(p.z[0]) + s))
+    leg = C.Leg(None, None, settings)
+    found = C.located(leg, orbit(0.0), orbit(0.03), 0.03, 7)
+    assert [f.kind for f in found] == ["grazing_period_doubling"] and found[0].point == 7
+    assert abs(float(found[0].at.z[0]) - root) <= settings.locate_tol
+    assert C.located(leg, orbit(0.0), orbit(0.01), 0.01, 7) == []          # no sign change before s*

@@ -184,3 +184,19 @@ def test_a_multiplier_through_minus_one_at_grazing_is_located_in_arclength(monke
     assert [f.kind for f in found] == ["grazing_period_doubling"] and found[0].point == 7
     assert abs(float(found[0].at.z[0]) - root) <= settings.locate_tol
     assert C.located(leg, orbit(0.0), orbit(0.01), 0.01, 7) == []          # no sign change before s*
+
+
+def test_two_rig_parameters_at_a_fixed_speed_keep_the_jump_at_that_speed():
+    """The grazing curve in (L_us, k_s) at 1000 rev/min: at every point the rig's jump speed is
+    1000 rev/min, so its inverse-kinematics contact-loss speed is 1000 rev/min less the compliance
+    shift (as in the chart above, to a tenth of the shift)."""
+    from camdyn.analysis.statics import compliance_shift
+
+    ds = continue_grazing(RIG, SCENE, "k_s", 2000.0, 2100.0, free="L_us", speed_rpm=1000.0,
+                          search=(1.02 * RIG.L_us, 0.98 * RIG.L_us))
+    assert ds.attrs["outcome"] == GrazingOutcome.END_REACHED.name, ds.attrs["outcome_message"]
+    assert ds["L_us"].attrs["units"] == "m" and np.all(np.diff(ds["L_us"].values) < 0)   # stiffer: less preload
+    for L_us, k_s in zip(ds["L_us"].values[::6], ds["k_s"].values[::6]):
+        rig = RIG.replace(L_us=float(L_us), k_s=float(k_s))
+        ratio, shift = 1000.0 / contact_loss_speed(rig) - 1.0, compliance_shift(rig, SCENE)
+        assert abs(ratio - shift) < 0.1 * abs(shift)

@@ -3,13 +3,13 @@ the jump chart, the jump (contact-loss) speed against a rig parameter beside its
 limit (:func:`jump_chart`).
 
 :func:`continue_grazing` starts from the grazing that the one-parameter continuation
-:func:`camdyn.continue_orbit` locates in the free parameter lambda1 (``free``, by default the
-cam speed) over ``search`` at lambda2 = ``start``: its ``grazing`` event's orbit on the contact
-side (the orbit located before it, or the branch's point before it when the event's orbit is the
-one past it, lifted off), or, where the branch's corrector stops short of the grazing (the step past it is not smooth: a stiff contact),
-its last contact orbit when its largest gap is within :data:`NEAR` of the first orbit's from
-zero.  From there it solves the extended system of :mod:`.grazing` at lambda2 = start and
-follows it (:mod:`.grazing_curve`) to lambda2 = ``end``.
+(:func:`camdyn.orbits.continuation.follow.run`, the engine of :func:`camdyn.continue_orbit`)
+locates in the free parameter lambda1 (``free``, by default the cam speed) over ``search`` at
+lambda2 = ``start``: the located orbit and the branch's point before it, the one on the contact
+side first; or, where the branch's corrector stops short of the grazing (the step past it is
+not smooth: a stiff contact), its last orbit when that orbit's largest gap is within
+:data:`NEAR` of the first orbit's from zero.  From there it solves the extended system of
+:mod:`.grazing` at lambda2 = start and follows it (:mod:`.grazing_curve`) to lambda2 = ``end``.
 """
 from __future__ import annotations
 
@@ -63,7 +63,7 @@ def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fra
     if SPEED in (free, parameter):
         values = (lo, hi) if free == SPEED else (start, end)
         if speed_rpm is not None:
-            raise ParameterError("speed_rpm", speed_rpm, f"None: the speed is one of the two parameters")
+            raise ParameterError("speed_rpm", speed_rpm, "None: the speed is one of the two parameters")
         if not values[0] * values[1] > 0:
             raise ParameterError("search" if free == SPEED else "end", values[1],
                                  "speeds of one sign, neither zero (rev/min)")

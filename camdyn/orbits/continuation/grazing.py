@@ -164,7 +164,8 @@ class Evaluation(NamedTuple):
 def _row_weights(system: GrazingSystem) -> np.ndarray:
     """The residual rows' factors: 1 on the orbit's, tol / gap_tol on the gap's and
     tol / (RATE_TOL sqrt(gap_tol)) on its rate's (see the module docstring)."""
-    return np.array([1.0] * N_STATE + [system.tol / system.gap_tol, system.tol / (RATE_TOL * math.sqrt(system.gap_tol))])
+    rate = system.tol / (RATE_TOL * math.sqrt(system.gap_tol))
+    return np.array([1.0] * N_STATE + [system.tol / system.gap_tol, rate])
 
 
 def _gap_rows(system: GrazingSystem, T: float, psi: np.ndarray) -> np.ndarray:
@@ -216,8 +217,8 @@ def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Eval
     of the last point's derivatives; each difference then starts SHRINK times above its step
     (not at the rule's first step, which a grazing orbit lifts off at on both sides: 2-4 runs
     per column instead of ~6; starting at the step itself, the steps only shrink along the
-    curve, and on reference-experiment against k_s the curve took 48 orbits instead of 38); ``strict``: False at a corrector's iterate
-    (:func:`contact_side_difference`)."""
+    curve, and on reference-experiment against k_s the curve took 48 orbits instead of 38);
+    ``strict``: False at a corrector's iterate (:func:`contact_side_difference`)."""
     A = np.zeros((N_STATE + 2, G_SIZE))
     *window, M = _fundamental(base, layout.split(z)[0])
     A[:, G_STATE] = _state_columns(system, layout, base, M, window)

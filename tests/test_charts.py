@@ -200,3 +200,29 @@ def test_two_rig_parameters_at_a_fixed_speed_keep_the_jump_at_that_speed():
         rig = RIG.replace(L_us=float(L_us), k_s=float(k_s))
         ratio, shift = 1000.0 / contact_loss_speed(rig) - 1.0, compliance_shift(rig, SCENE)
         assert abs(ratio - shift) < 0.1 * abs(shift)
+
+
+@pytest.mark.parametrize("kind, rig, search, window", [
+    ("period_doubling", camdyn.example_rig(), (1650.0, 1750.0), (1700.0, 1850.0)),
+    ("fold", RIG, (1600.0, 900.0), (1600.0, 900.0)),
+])
+def test_the_fold_and_period_doubling_curves_meet_the_one_parameter_ones(kind, rig, search, window):
+    """The curve of a period doubling (example rig, 1.6 mm line contact: 1710.2 rev/min at k_s =
+    2000) and of a fold (16 mm: the impacting branch turns back at 1289.6 rev/min) in (speed, k_s)
+    up to k_s = 2200: the critical multiplier is -1 or +1 within DET_TOL along it, and at its end
+    continue_orbit in speed locates the same bifurcation to twice its bracket (measured: 6e-5 and
+    7e-7 rev/min)."""
+    from camdyn.orbits.continuation import continue_bifurcation
+    from camdyn.orbits.continuation.codim1 import DET_TOL, SIGNS
+
+    ds = continue_bifurcation(rig, SCENE, kind, "k_s", 2000.0, 2200.0, search=search)
+    assert ds.attrs["outcome"] == GrazingOutcome.END_REACHED.name, ds.attrs["outcome_message"]
+    assert ds["k_s"].values[-1] == 2200.0
+    critical = ds["multiplier_real"].values[:, 0]
+    assert np.all(np.abs(critical + SIGNS[kind]) < 10 * DET_TOL) and np.all(ds["multiplier_imag"].values == 0)
+    settings = ContinuationSettings(switch_depth=0)
+    branch = continue_orbit(rig.replace(k_s=2200.0), SCENE, "speed_rpm", *window, settings=settings)
+    located = [float(lam) for k, lam in zip(branch["event_kind"].values, branch["event_lambda"].values)
+               if EVENTS[k] == kind]
+    assert located, branch.attrs["branch_0_message"]
+    assert abs(ds["speed_rpm"].values[-1] - located[0]) <= 2 * settings.locate_tol * abs(window[1] - window[0])

@@ -42,6 +42,7 @@ MODULES = [
     "orbits.lyapunov",
     "orbits.continuation",
     "orbits.continuation.charts",
+    "orbits.continuation.codim1",
     "orbits.continuation.grazing",
     "orbits.continuation.grazing_curve",
     "orbits.continuation.grazing_dataset",

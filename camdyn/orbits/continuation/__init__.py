@@ -158,8 +158,8 @@ def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: fl
     return branch_dataset(problem, branches, events, scale)
 
 
-from .charts import continue_grazing, jump_chart  # noqa: E402  (it calls continue_orbit, defined above)
+from .charts import continue_bifurcation, continue_grazing, jump_chart  # noqa: E402  (it calls continue_orbit, defined above)
 from .grazing_curve import GrazingOutcome, GrazingSettings  # noqa: E402
 
-__all__ = ["continue_grazing", "jump_chart", "GrazingSettings", "GrazingOutcome", "continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
+__all__ = ["continue_grazing", "jump_chart", "continue_bifurcation", "GrazingSettings", "GrazingOutcome", "continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
            "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES"]

@@ -23,13 +23,16 @@ from ...engine import SolverOptions
 from ...errors import CamdynError, ParameterError
 from ...model.rig import PARAMETERS, Rig
 from ...model.scene import Scene
+from ..derivatives import finite_differences
 from ..section_map import DEFAULT_OPTIONS
 from ..tangent import variational
 from .follow import run
 from .grazing import GrazingSystem, Layout, gap_maximum
 from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
+from .codim1 import SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset
+from .codim1 import first as codim1_first
 from .grazing_dataset import grazing_dataset
-from .problem import SPEED, Problem
+from .problem import SPEED, ContinuationSettings, Problem
 
 #: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
 #: when that orbit's largest gap is within this fraction of the branch's first orbit's from zero
@@ -40,7 +43,7 @@ def _names() -> list[str]:
     return [SPEED] + [p.name for p in PARAMETERS]
 
 
-def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction, settings) -> None:
+def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction) -> None:
     if not isinstance(rig, Rig):
         raise ParameterError("rig", rig, "a camdyn.Rig")
     if not isinstance(scene, Scene) or scene.motion != "constant":
@@ -71,8 +74,11 @@ def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fra
         real("speed_rpm", speed_rpm, "a nonzero cam speed (rev/min) for two rig parameters",
              lambda v: v != 0 and math.isfinite(v))
     real("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)", lambda v: 0 <= v < 1)
-    if not isinstance(settings, GrazingSettings):
-        raise ParameterError("settings", settings, "a camdyn.orbits.continuation.GrazingSettings")
+
+
+def _settings(settings, kind) -> None:
+    if not isinstance(settings, kind):
+        raise ParameterError("settings", settings, f"a camdyn.orbits.continuation.{kind.__name__}")
 
 
 def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple,
@@ -92,7 +98,8 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
     result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
     """
-    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction, settings)
+    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
+    _settings(settings, GrazingSettings)
     system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), float(search[0]), math.nan,
                            speed_rpm, float(phase_fraction), options, backend, settings.continuation.tol,
                            settings.gap_tol)
@@ -204,3 +211,38 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
                                                           "by the contact's compliance"})
     ds.attrs["title"] = f"camdyn jump chart: the jump speed against {parameter}, rig {rig.name}"
     return ds
+
+
+def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, start: float, end: float, *,
+                         search: tuple, free: str = SPEED, speed_rpm: float | None = None,
+                         phase_fraction: float = 0.0, warmup_revolutions: int = 20,
+                         settings: ContinuationSettings = ContinuationSettings(switch_depth=0),
+                         options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
+                         backend: str = "compiled"):
+    """The curve of a ``kind`` (``"fold"`` or ``"period_doubling"``) of period-1 orbits in two
+    parameters, ``free`` (lambda1, default the cam speed) and ``parameter`` (lambda2) from
+    ``start`` to ``end``: pseudo-arclength on the extended system of :mod:`.codim1`, from the
+    bifurcation that the one-parameter continuation in ``free`` over ``search`` locates at
+    lambda2 = start.  ``jacobian``: the provider of dP/dx (as :func:`camdyn.continue_orbit`'s).
+    Raises only on bad input; how the curve ended is in the result's ``outcome``.  Returns the
+    ``xarray.Dataset`` of :func:`.codim1.codim1_dataset`."""
+    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
+    _settings(settings, ContinuationSettings)
+    if kind not in SIGNS:
+        raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}")
+    system = Codim1System(rig, scene, kind, free, parameter, float(start), float(end), speed_rpm,
+                          float(phase_fraction), options, jacobian, backend)
+    problem = system.along(free, float(search[0]), float(start), float(search[1]) - float(search[0]))
+    problem.model(float(search[1]))                            # a rig value the rig refuses raises here
+    branches, events, scale = run(problem, settings, warmup_revolutions)
+    found = [e for e in events if e.branch == 0 and e.kind == kind]
+    if not found:
+        why = f"no {kind} of the branch in {free} over {search[0]:.8g} to {search[1]:.8g} ({branches[0].message})"
+        return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, why), None)
+    e = found[0]
+    layout = Codim1Layout(np.asarray(scale, dtype=float), abs(e.lam), system.span)
+    leg = CurveLeg(system, layout, settings)
+    p = codim1_first(leg, e.x, e.lam, branches[0].points[e.point].mode)
+    if isinstance(p, str):
+        return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, p), layout)
+    return codim1_dataset(system, follow(leg, p, advance, lambda *_: []), layout)

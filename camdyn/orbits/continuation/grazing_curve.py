@@ -245,26 +245,33 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
         return f"no derivatives at the first grazing orbit: {failure}"
 
 
-def follow(leg: Leg, p: GrazingPoint) -> Curve:
+def follow(leg, p, advance=None, detect=None) -> Curve:
     """The curve from its first point ``p`` until lambda2 leaves the range, or it ends (see
-    :class:`GrazingOutcome`); codimension-2 points located on the way."""
+    :class:`GrazingOutcome`); codimension-2 points located on the way.  ``advance(leg, p, ds,
+    final)`` takes a step (default :func:`step`), ``detect(leg, p, q, ds, index)`` lists the
+    points found between two (default :func:`located`): another extended system's curve
+    (:mod:`.codim1`) is followed by the same loop; its points have ``free``, ``lam``, ``z``,
+    ``tangent``, ``curvature`` and ``iterations``, lambda2 last in z, and its leg ``start``,
+    ``end``, ``span``, ``settings``, ``system`` and ``layout.sigma_range``."""
+    advance, detect = advance or step, detect or located
     settings, curve, ds = leg.settings, Curve([p], []), leg.settings.step
     while True:
         if len(curve.points) >= settings.max_points:
             curve.outcome = GrazingOutcome.MAX_POINTS
             return curve
-        h = clipped(leg.start, leg.end, leg.span, p.lam, p.tangent[G_RANGE], ds)
-        q = step(leg, p, h, final=_reaches_end(leg, p, h))
+        h = clipped(leg.start, leg.end, leg.span, p.lam, p.tangent[-1], ds)
+        q = advance(leg, p, h, _reaches_end(leg, p, h))
         if isinstance(q, Ended):
             curve.outcome, curve.message = q
             return curve
         if q is None:
             if ds <= settings.min_step:
-                curve.outcome, curve.message = GrazingOutcome.STEP_TOO_SMALL, f"at {_where(leg, p.z)}"
+                curve.outcome = GrazingOutcome.STEP_TOO_SMALL
+                curve.message = f"at {leg.system.free} = {p.free:.8g}, {leg.system.parameter} = {p.lam:.8g}"
                 return curve
             ds = max(ds / 2.0, settings.min_step)
             continue
-        curve.found += located(leg, p, q, h, len(curve.points) - 1)
+        curve.found += detect(leg, p, q, h, len(curve.points) - 1)
         curve.points.append(q)
         done = left_range(leg.start, leg.end, leg.span, q.lam)
         if done is not None:
@@ -275,9 +282,10 @@ def follow(leg: Leg, p: GrazingPoint) -> Curve:
         p = q
 
 
-def _reaches_end(leg: Leg, p: GrazingPoint, ds: float) -> bool:
-    """Whether the prediction ds from p reaches lambda2's end (within AT_END of the range)."""
-    lam = p.lam + leg.layout.sigma_range * (ds * p.tangent[G_RANGE] + 0.5 * ds * ds * p.curvature[G_RANGE])
+def _reaches_end(leg, p, ds: float) -> bool:
+    """Whether the prediction ds from p reaches lambda2's end (within AT_END of the range;
+    lambda2 is z's last component)."""
+    lam = p.lam + leg.layout.sigma_range * (ds * p.tangent[-1] + 0.5 * ds * ds * p.curvature[-1])
     return (lam - leg.end) * math.copysign(1.0, leg.end - leg.start) >= -AT_END * leg.span
 
 

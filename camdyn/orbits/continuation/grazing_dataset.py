@@ -103,27 +103,36 @@ def _codim2_variables(system, found) -> dict:
     }
 
 
-def _attributes(system, curve, layout, settings) -> dict:
+def common_attributes(system, curve, scale) -> dict:
+    """The attributes every two-parameter curve's Dataset has: the parameters, their units and
+    range, the section, the scene, the outcome, the scales, the solver, the rig's parameters,
+    camdyn's version."""
     outcome = curve.outcome or GrazingOutcome.STEP_TOO_SMALL
-    scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
-    plain = {**dataclasses.asdict(settings.continuation), "gap_tol": settings.gap_tol,
-             **{f"search_{k}": v for k, v in dataclasses.asdict(settings.search).items()}}
     return {
-        "title": f"camdyn grazing curve in ({system.free}, {system.parameter}), rig {system.rig.name}",
         "source": f"camdyn {__version__}", "camdyn_version": __version__,
         "free": system.free, "free_units": unit(system.free), "parameter": system.parameter,
         "parameter_units": unit(system.parameter), "start": system.start, "end": system.end,
         "speed_rpm": math.nan if system.speed_rpm is None else float(system.speed_rpm),
         "phase_fraction": system.phase_fraction, "scene": system.scene.slug,
         "outcome": outcome.name, "outcome_message": outcome.message + (f" ({curve.message})" if curve.message else ""),
-        "outcomes": " ".join(o.name for o in GrazingOutcome), "codim2_kinds": " ".join(CODIM2),
-        "deflection_scale_m": system.deflection,
+        "outcomes": " ".join(o.name for o in GrazingOutcome),
         **{f"scale_{name}": float(scale[i]) for i, name in enumerate(STATE)},
-        **{f"settings_{k}": v for k, v in plain.items()},
         "solver_method": system.options.method, "solver_rtol": system.options.rtol,
         "solver_atol": system.options.atol, "backend": system.backend,
         "rig_name": system.rig.name,
         **{f"rig_{p.name}": float(getattr(system.rig, p.name)) for p in PARAMETERS
            if getattr(system.rig, p.name) is not None},
         "rig_units": "; ".join(f"{p.name} {p.unit}" for p in PARAMETERS),
+    }
+
+
+def _attributes(system, curve, layout, settings) -> dict:
+    scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
+    plain = {**dataclasses.asdict(settings.continuation), "gap_tol": settings.gap_tol,
+             **{f"search_{k}": v for k, v in dataclasses.asdict(settings.search).items()}}
+    return {
+        "title": f"camdyn grazing curve in ({system.free}, {system.parameter}), rig {system.rig.name}",
+        **common_attributes(system, curve, scale),
+        "codim2_kinds": " ".join(CODIM2), "deflection_scale_m": system.deflection,
+        **{f"settings_{k}": v for k, v in plain.items()},
     }

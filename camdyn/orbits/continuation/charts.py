@@ -100,9 +100,9 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     """
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
     _settings(settings, GrazingSettings)
-    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), float(search[0]), math.nan,
-                           speed_rpm, float(phase_fraction), options, backend, settings.continuation.tol,
-                           settings.gap_tol)
+    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
+                           options, backend, free_start=float(search[0]), deflection=math.nan,
+                           tol=settings.continuation.tol, gap_tol=settings.gap_tol)
     system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
     system.model(float(search[1]), system.end)
     curve, layout, system = _curve(system, search, settings, warmup_revolutions)
@@ -230,8 +230,8 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
     _settings(settings, ContinuationSettings)
     if kind not in SIGNS:
         raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}")
-    system = Codim1System(rig, scene, kind, free, parameter, float(start), float(end), speed_rpm,
-                          float(phase_fraction), options, jacobian, backend)
+    system = Codim1System(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
+                          options, backend, kind=kind, jacobian=jacobian)
     problem = system.along(free, float(search[0]), float(start), float(search[1]) - float(search[0]))
     problem.model(float(search[1]))                            # a rig value the rig refuses raises here
     branches, events, scale = run(problem, settings, warmup_revolutions)

@@ -26,15 +26,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ...engine import SolverOptions
 from ...errors import CamdynError
-from ...model.rig import Rig
-from ...model.scene import Scene
 from ..derivatives import finite_differences
-from ..section_map import DEFAULT_OPTIONS, derivative_at
+from ..section_map import derivative_at
+from ..shooting import sorted_multipliers
 from .corrector import chord, d_lambda, evaluate, orbit_run, tangent
 from .grazing_curve import Ended, GrazingOutcome
-from .problem import N_STATE, SPEED, ContinuationSettings, Leg as BranchLeg, Problem
+from .grazing_dataset import common_attributes, unit
+from .problem import N_STATE, SPEED, ContinuationSettings, Leg as BranchLeg, Problem, TwoParameters
 
 #: the sign s of det(M + s I) per kind
 SIGNS = {"fold": -1.0, "period_doubling": 1.0}
@@ -46,28 +45,13 @@ DET_TOL = 1e-5
 DET_STEP = 1e-3
 
 
-@dataclass(frozen=True)
-class Codim1System:
-    """The curve's problem: the rig, scene, kind (``fold`` or ``period_doubling``), the free
-    parameter lambda1, the parameter followed from ``start`` to ``end`` (lambda2), the speed when
-    neither is ``speed_rpm``, the section's phase, the options, the Jacobian provider, the backend."""
+@dataclass(frozen=True, kw_only=True)
+class Codim1System(TwoParameters):
+    """What is continued (:class:`.problem.TwoParameters`), with the ``kind`` (``fold`` or
+    ``period_doubling``) and the Jacobian provider of dP/dx."""
 
-    rig: Rig
-    scene: Scene
     kind: str
-    free: str
-    parameter: str
-    start: float
-    end: float
-    speed_rpm: float | None = None
-    phase_fraction: float = 0.0
-    options: SolverOptions = DEFAULT_OPTIONS
     jacobian: object = finite_differences
-    backend: str = "compiled"
-
-    @property
-    def span(self) -> float:
-        return abs(self.end - self.start)
 
     def along(self, name: str, free: float, lam: float, sigma: float) -> Problem:
         """The branch problem in ``name`` (lambda1 or lambda2) with the other held, its span sigma."""
@@ -227,9 +211,6 @@ def codim1_dataset(system: Codim1System, curve, layout):
     ``free``, ``parameter``, their units, the range, the scene, ``outcome`` and
     ``outcome_message``, the rig's parameters, ``camdyn_version`` (as :func:`.grazing_dataset.grazing_dataset`)."""
     import xarray as xr
-
-    from .grazing_dataset import common_attributes, unit
-    from ..shooting import sorted_multipliers
 
     points, P, PM = curve.points, ("point",), ("point", "multiplier")
     mu = np.array([sorted_multipliers(p.M) for p in points], dtype=complex).reshape(len(points), N_STATE)

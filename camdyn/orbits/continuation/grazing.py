@@ -48,17 +48,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ...engine import SolverOptions
-from ...model.cam import ConstantSpeed
 from ...model.model import Model
-from ...model.rig import Rig
-from ...model.scene import Scene
 from ..derivatives import SHRINK, Column, Unresolved, same_path
-from ..section_map import DEFAULT_OPTIONS, MapFailure, MapValue, StroboscopicMap
+from ..section_map import MapFailure, MapValue, StroboscopicMap
 from ..shooting import newton_matrix
 from ..tangent import TangentFailure, tangent
 from .corrector import gap_samples, refined_max
-from .problem import N_STATE, SPEED
+from .problem import N_STATE, TwoParameters
 
 #: the layout of z: x's components, the grazing's phase phi_g, lambda1 (the free parameter),
 #: lambda2 (the one whose range is followed)
@@ -84,38 +80,17 @@ WINDOW = 1e-2
 RATE_TOL = 0.1
 
 
-@dataclass(frozen=True)
-class GrazingSystem:
-    """What is continued: the rig and scene, the free parameter ``free`` (lambda1) and the one
-    followed from ``start`` to ``end`` (lambda2), the cam speed when neither is ``speed_rpm``,
-    the section's phase (a fraction of T), the solver options, the backend, ``tol`` (the
-    corrector's, on the scaled residual) and ``gap_tol`` (the gap's, a fraction of the
-    deflection scale)."""
+@dataclass(frozen=True, kw_only=True)
+class GrazingSystem(TwoParameters):
+    """What is continued (:class:`.problem.TwoParameters`), with lambda1 at the start
+    (``free_start``), the gap's scale d (``deflection``, m, :func:`gap_maximum`), the
+    corrector's tolerance ``tol`` on the scaled residual and the gap's ``gap_tol`` (a fraction
+    of d)."""
 
-    rig: Rig
-    scene: Scene
-    free: str
-    parameter: str
-    start: float
-    end: float
     free_start: float
     deflection: float
-    speed_rpm: float | None = None
-    phase_fraction: float = 0.5
-    options: SolverOptions = DEFAULT_OPTIONS
-    backend: str = "compiled"
     tol: float = 1e-8
     gap_tol: float = 1e-6
-
-    @property
-    def span(self) -> float:
-        return abs(self.end - self.start)
-
-    def model(self, free: float, lam: float) -> Model:
-        """The model at lambda1 = ``free``, lambda2 = ``lam``."""
-        values = {self.free: free, self.parameter: lam}
-        speed = values.pop(SPEED, self.speed_rpm)
-        return Model(self.rig.replace(**values) if values else self.rig, self.scene, ConstantSpeed(speed))
 
     def section_map(self, free: float, lam: float, mode: int | None) -> StroboscopicMap:
         model = self.model(free, lam)

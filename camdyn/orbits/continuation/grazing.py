@@ -151,10 +151,13 @@ def _gap_rows(system: GrazingSystem, T: float, psi: np.ndarray) -> np.ndarray:
     return np.array([psi[1] / d, (psi[2] - psi[0]) / (2 * delta) * T / (2 * math.pi * d)])
 
 
-def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | None) -> Evaluation:
+def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | None,
+             dense: bool = True) -> Evaluation:
     """The scaled residual at z by one run of P from x (raises MapFailure, or the rig's error for
-    a value it refuses), sampled over the window at t_g and :func:`gap_samples` times per period
-    for the largest gap."""
+    a value it refuses), sampled over the window at t_g and, ``dense``, :func:`gap_samples` times
+    per period for the largest gap (else NaN: a parameter difference's run needs only the
+    residual and its path, which the samples do not change, bit for bit:
+    :meth:`camdyn.orbits.section_map.StroboscopicMap.run`)."""
     x, phase, free, lam = layout.split(z)
     sm = system.section_map(free, lam, mode)
     t0, t1 = sm.t_span
@@ -163,7 +166,7 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
         raise MapFailure(f"the grazing's phase {phase:.6g} left the period (0, 1)")
     t_g = t0 + phase * T
     times = t_g + WINDOW * T * np.array([-1.0, 0.0, 1.0])
-    samples = np.linspace(t0, t1, gap_samples(sm.model) + 1)
+    samples = np.linspace(t0, t1, gap_samples(sm.model) + 1) if dense else np.array([t1])
     value, tr = sm.run(x, np.unique(np.concatenate([samples, times])))
     k = np.searchsorted(tr.t, times)
     psi_all = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I]
@@ -171,8 +174,9 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     gap = _gap_rows(system, T, psi) + np.array([system.gap_tol, 0.0])          # psi_i(t_g) = -margin
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
+    largest = refined_max(psi_all[np.isin(tr.t, samples)]) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
-                      tr.mode[k].astype(int), psi, refined_max(psi_all[np.isin(tr.t, samples)]), sm)
+                      tr.mode[k].astype(int), psi, largest, sm)
 
 
 class Derivatives(NamedTuple):
@@ -272,7 +276,7 @@ def _parameter_column(system: GrazingSystem, layout: Layout, z, base: Evaluation
     def value(offset: float) -> MapValue:
         shifted = z.copy()
         shifted[index] = (lam + offset) / sigma
-        return evaluate(system, layout, shifted, base.value.start_mode).value
+        return evaluate(system, layout, shifted, base.value.start_mode, dense=False).value
     column = Column.of(max(abs(lam), sigma), np.ones(N_STATE + 2), system.options.rtol)
     if first is not None and column.floor <= first < column.first:
         column = column._replace(first=first)

@@ -71,7 +71,7 @@ class GrazingSettings:
 
     continuation: ContinuationSettings = ContinuationSettings(switch_depth=0)
     gap_tol: float = 1e-6
-    search: ContinuationSettings = ContinuationSettings(max_step=0.1, locate_tol=1e-5, switch_depth=0)
+    search: ContinuationSettings = ContinuationSettings(step=0.05, max_step=0.25, locate_tol=1e-5, switch_depth=0)
 
     def __post_init__(self):
         for name in ("continuation", "search"):

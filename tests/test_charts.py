@@ -3,7 +3,7 @@
 
 The case: the example rig with a 16 mm line contact (stiff: its contact-loss speed moves by
 only -2.3e-6 of itself for the contact's compliance, camdyn.analysis.compliance_shift), damping
-D, Coulomb friction, the jump speed against k_s from 2000 to 2400 N/m (24 grazing orbits, ~7 s
+D, Coulomb friction, the jump speed against k_s from 2000 to 2400 N/m (24 grazing orbits, ~5 s
 here).  Measured while writing it: the grazing speed lies below the inverse-kinematics
 contact-loss speed by 2.23e-6 to 2.69e-6 of it, against the first-order compliance shift of
 2.30e-6 to 2.76e-6: the remainder, 7e-8, is 3 % of the shift.

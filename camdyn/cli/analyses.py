@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import json
 
-from .common import (EXIT_INCOMPLETE, EXIT_OK, UsageError, _built, _busy, _check_outputs, _in_flags, _parse_values,
+from .common import (EXIT_INCOMPLETE, EXIT_OK, UsageError, _busy, _check_outputs, _in_flags, _parse_values,
                      _plot_modules, _save_figure)
-from .options import (_MAP_OPTIONS, _add_cam, _add_file, _add_physics, _add_solver, _backend, _cam, _rig,
-                      _scene, _solver_options)
+from .options import (_MAP_OPTIONS, _add_arclength, _add_cam, _add_file, _add_physics, _add_solver, _backend, _cam,
+                      _continuation_settings, _rig, _scene, _solver_options)
 from .parser import add_command
 
 
@@ -67,7 +67,7 @@ def cmd_lyapunov(args) -> int:
 
 
 def cmd_continue(args) -> int:
-    from ..orbits.continuation import SPEED, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
+    from ..orbits.continuation import SPEED, ContinuationOutcome, continue_orbit, events_table
 
     rig, scene = _rig(args), _scene(args)
     if args.param != SPEED and args.speed_rpm is None:
@@ -76,11 +76,7 @@ def cmd_continue(args) -> int:
         raise UsageError("--speed-rpm is for a rig parameter's continuation; the speed itself runs from --start "
                          "to --end")
     _check_outputs(args, "netcdf", "plot")
-    settings = _built(ContinuationSettings, {"step": "arclength_step", "min_step": "min_arclength_step",
-                                             "max_step": "max_arclength_step", "max_corrector": "max_iterations"},
-                      args, step=args.arclength_step, min_step=args.min_arclength_step,
-                      max_step=args.max_arclength_step, max_points=args.max_points, tol=args.tol,
-                      max_corrector=args.max_iterations, switch_depth=args.switch_depth)
+    settings = _continuation_settings(args, switch_depth=args.switch_depth)
     kwargs = dict(speed_rpm=args.speed_rpm, periods=args.periods, phase_fraction=args.phase_fraction,
                   warmup_revolutions=args.warmup, settings=settings, options=_solver_options(args),
                   backend=_backend(args))
@@ -180,18 +176,7 @@ def add_continue(sub) -> None:
                    help="the section's time after each revolution's start, a fraction of T (default: 0)")
     g.add_argument("--warmup", type=int, default=20, metavar="N",
                    help="revolutions from the static equilibrium before the first orbit's search (default: 20)")
-    g.add_argument("--max-points", type=int, default=400, dest="max_points", metavar="N",
-                   help="at most this many orbits per branch (default: 400)")
-    g.add_argument("--arclength-step", type=float, default=0.01, dest="arclength_step", metavar="DS",
-                   help="first step in scaled arclength (the parameter range is 1) (default: 0.01)")
-    g.add_argument("--min-arclength-step", type=float, default=1e-5, dest="min_arclength_step", metavar="DS",
-                   help="the branch ends where the corrector fails at this arclength step (default: 1e-5)")
-    g.add_argument("--max-arclength-step", type=float, default=0.05, dest="max_arclength_step", metavar="DS",
-                   help="largest step in scaled arclength (default: 0.05)")
-    g.add_argument("--tol", type=float, default=1e-8,
-                   help="scaled residual the corrector and the first orbit's Newton stop at (default: 1e-8)")
-    g.add_argument("--max-iterations", type=int, default=8, dest="max_iterations", metavar="N",
-                   help="corrector iterations per step (default: 8; the first orbit's Newton takes 20)")
+    _add_arclength(g)
     g.add_argument("--switch-depth", type=int, default=1, dest="switch_depth", metavar="N",
                    help="how many period doublings deep to switch branches: 1 follows period 2 from a "
                         "period-1 branch, 2 also period 4 (default: 1)")

@@ -1,7 +1,7 @@
 """The ``camdyn`` command: simulate, analyse, sweep, regenerate and reproduce from a shell.
 
 This module assembles the parser from the command modules (run: simulate, spectrum; analyses:
-equilibrium, contact-loss, lyapunov, continue; sweep; basins; model: regenerate, scenes, cache;
+equilibrium, contact-loss, lyapunov, continue; chart; sweep; basins; model: regenerate, scenes, cache;
 reproduce), each adding its own subparser, and runs the command: :func:`main`.
 
 Run ``camdyn --help`` for the commands and ``camdyn <command> --help`` for each one's
@@ -32,14 +32,15 @@ import sys
 import warnings
 
 from ..errors import CamdynError
-from . import analyses, basins, model, reproduce, run, sweep
+from . import analyses, basins, chart, model, reproduce, run, sweep
 from .common import (EXIT_BROKEN_PIPE, EXIT_CODES_HELP, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_MISSING, EXIT_USAGE,
                      MissingPart, _flags, _in_flags, _parameter_line, _version)
 from .parser import _Formatter, _Parser
 
 #: the commands, in the order ``camdyn --help`` lists them: each adds its subparser
 COMMANDS = (run.add_simulate, run.add_spectrum, analyses.add_equilibrium, analyses.add_contact_loss,
-            analyses.add_lyapunov, sweep.add_sweep, basins.add_basins, analyses.add_continue, model.add_regenerate,
+            analyses.add_lyapunov, sweep.add_sweep, basins.add_basins, analyses.add_continue, chart.add_chart,
+            model.add_regenerate,
             reproduce.add_reproduce, model.add_scenes, model.add_cache)
 
 

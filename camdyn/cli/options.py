@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-from .common import UsageError, _plot_modules
+from .common import UsageError, _built, _plot_modules
 from ..vocabulary import ECCENTRIC
 
 
@@ -245,6 +245,35 @@ def _span(args, cam):
 
 # --- file options: their kind is checked while the command line is read, before any work -------
 _KINDS = {"csv": "a CSV file", "netcdf": "a NetCDF file", "plot": "a figure", "run": "a saved run"}
+
+
+# --------------------------------------------------------------------------- continuation
+def _add_arclength(g) -> None:
+    """The step control and corrector options of a continuation (continue, chart)."""
+    g.add_argument("--max-points", type=int, default=400, dest="max_points", metavar="N",
+                   help="at most this many orbits per branch or curve (default: 400)")
+    g.add_argument("--arclength-step", type=float, default=0.01, dest="arclength_step", metavar="DS",
+                   help="first step in scaled arclength (the parameter range is 1) (default: 0.01)")
+    g.add_argument("--min-arclength-step", type=float, default=1e-5, dest="min_arclength_step", metavar="DS",
+                   help="the branch ends where the corrector fails at this arclength step (default: 1e-5)")
+    g.add_argument("--max-arclength-step", type=float, default=0.05, dest="max_arclength_step", metavar="DS",
+                   help="largest step in scaled arclength (default: 0.05)")
+    g.add_argument("--tol", type=float, default=1e-8,
+                   help="scaled residual the corrector and the first orbit's Newton stop at (default: 1e-8)")
+    g.add_argument("--max-iterations", type=int, default=8, dest="max_iterations", metavar="N",
+                   help="corrector iterations per step (default: 8; the first orbit's Newton takes 20)")
+
+
+def _continuation_settings(args, **extra):
+    """The ContinuationSettings of the options of :func:`_add_arclength` (and ``extra`` fields),
+    a bad value told by its flag."""
+    from ..orbits.continuation import ContinuationSettings
+
+    return _built(ContinuationSettings, {"step": "arclength_step", "min_step": "min_arclength_step",
+                                         "max_step": "max_arclength_step", "max_corrector": "max_iterations"},
+                  args, step=args.arclength_step, min_step=args.min_arclength_step,
+                  max_step=args.max_arclength_step, max_points=args.max_points, tol=args.tol,
+                  max_corrector=args.max_iterations, **extra)
 
 
 def _plot_formats() -> dict[str, str]:

@@ -13,6 +13,8 @@ without it, and a call says how to install it.
 * :func:`branches`      continued branches (stable solid, unstable dashed) and their events,
                         over a brute-force bifurcation diagram
 * :func:`contact_map`   sliding / impacting regimes over (cam speed, k_s) (Fig. 9)
+* :func:`jump_chart`    the jump (grazing) speed against a rig parameter beside the inverse-kinematics
+                        contact-loss speed, codimension-2 points marked
 * :func:`basin_map`     basins of attraction over the starts (alpha, alpha_dot), attractors marked
 * :func:`work_precision` error against run time, one line per solver set-up
 * :func:`mechanism`     the cam (any profile) turned to a cam angle, and the follower touching it (Fig. 1)
@@ -32,7 +34,7 @@ from .metadata import units as _units
 
 __all__ = ["PAPER_STYLE", "QUANTITIES", "MIN_FONT_PT", "REGIME_CODES", "style", "run_title", "time_history",
            "overview", "spectrum", "whole_period_samples", "poincare_section", "poincare", "bifurcation",
-           "branches", "contact_map", "basin_map", "work_precision"]
+           "branches", "contact_map", "jump_chart", "basin_map", "work_precision"]
 
 #: rcParams of the paper-like look: thin lines, inward ticks on all sides, no frame on legends.
 PAPER_STYLE = {
@@ -495,6 +497,58 @@ def _from_origin(ds, branch: int, lam: np.ndarray, alphas: np.ndarray, scale: fl
     at = ds["event_alpha_revolution"].values[origin, :parent] / scale
     first = np.tile(at, alphas.shape[1] // parent + 1)[:alphas.shape[1]]
     return np.concatenate([[ds["event_lambda"].values[origin]], lam]), np.vstack([first, alphas])
+
+
+def jump_chart(ds, *, ax=None, title: str | None = None):
+    """A grazing curve (:func:`camdyn.orbits.continuation.continue_grazing`, or the jump chart of
+    :func:`camdyn.orbits.continuation.jump_chart`): its free parameter (the jump speed) against
+    its parameter, solid where the grazing orbit is stable on its contact side, dashed where
+    not, codimension-2 points marked; with the chart's ``contact_loss_rpm``, the
+    inverse-kinematics contact-loss speed beside it (dotted) and, on a second axis below, the
+    relative difference between the two against the first-order compliance shift.  A parameter
+    spanning more than a decade is drawn on a log axis.  ``ax``: the (upper) axes to draw on.
+    """
+    free, parameter = ds.attrs["free"], ds.attrs["parameter"]
+    x, y = ds[parameter].values, ds[free].values
+    quasi_static = "contact_loss_rpm" in ds and ax is None
+    with _style():
+        fig, axes = _figure(ax, nrows=2 if quasi_static else 1, figsize=(6.4, 4.6 if quasi_static else 3.2),
+                            sharex=True)
+        top = axes[0]
+        for i, j, ok in stability_runs(ds["stable"].values.astype(bool)) if x.size else ():
+            top.plot(x[i:j + 1], y[i:j + 1], color="k", lw=1.1, ls="-" if ok else "--")
+        top.plot([], [], color="k", lw=1.1, label="grazing (dashed: unstable)")
+        if "contact_loss_rpm" in ds:
+            top.plot(x, ds["contact_loss_rpm"].values, color="#c0392b", lw=1.0, ls=":",
+                     label="contact loss, inverse kinematics")
+        kinds = ds.attrs.get("codim2_kinds", "").split()
+        for k, kind in enumerate(kinds):
+            sel = ds["codim2_kind"].values == k
+            if np.any(sel):
+                top.plot(ds[f"codim2_{parameter}"].values[sel], ds[f"codim2_{free}"].values[sel],
+                         "^" if "doubling" in kind else "s", mfc="none", color="#2e75b6", label=kind.replace("_", " "))
+        name = "jump speed" if free == "speed_rpm" else free
+        top.set(ylabel=f"{name} ({ds[free].attrs.get('units', '')})")
+        top.legend(loc="best", frameon=True, framealpha=0.9)
+        if quasi_static:
+            _quasi_static_panel(axes[1], ds, x)
+        axes[-1].set(xlabel=f"{parameter} ({ds[parameter].attrs.get('units', '')})")
+        if x.size and np.all(x > 0) and x.max() > 10 * x.min():
+            axes[-1].set_xscale("log")
+        if title:
+            top.set_title(title)
+    return fig
+
+
+def _quasi_static_panel(ax, ds, x):
+    """The jump speed relative to the contact-loss speed, minus one, beside the compliance shift."""
+    ratio = ds[ds.attrs["free"]].values / ds["contact_loss_rpm"].values - 1.0
+    ax.plot(x, ratio, color="k", lw=1.0, label="grazing / inverse kinematics - 1")
+    if "compliance_shift" in ds:
+        ax.plot(x, ds["compliance_shift"].values, color="#c0392b", lw=1.0, ls=":",
+                label="compliance shift (first order)")
+    ax.set(ylabel="relative shift")
+    ax.legend(loc="best", frameon=True, framealpha=0.9)
 
 
 def contact_map(speed_rpm, k_s, regime, *, loss_curve: tuple | None = None, log_k: bool = True, ax=None,

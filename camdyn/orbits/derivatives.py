@@ -33,7 +33,7 @@ from .section_map import MapDerivative, MapFailure, MapValue, StroboscopicMap, d
 from .tangent import Variational
 
 __all__ = ["finite_differences", "FiniteDifferences", "resolved_difference", "finite_difference_steps",
-           "step_floor", "Unresolved", "SHRINK"]
+           "step_floor", "Unresolved", "SHRINK", "same_path"]
 
 #: a step whose perturbed runs take another hybrid path than the base run (or leave the start
 #: mode's domain) is divided by SHRINK, down to :func:`step_floor`
@@ -92,15 +92,17 @@ class Column(NamedTuple):
         return cls(first, floor, np.asarray(weights, dtype=float), float(rtol) ** 0.5)
 
 
-def _same_path(a: MapValue, b: MapValue) -> bool:
+def same_path(a: MapValue, b: MapValue) -> bool:
+    """Whether two runs of the map took the same hybrid path: the same transitions, in the same
+    order, ending in the same mode (the rule's test)."""
     return a.transitions == b.transitions and a.end_mode == b.end_mode
 
 
 def _path_change(base: MapValue, plus: MapValue, minus: MapValue, h: float) -> str:
     """'' when both perturbed runs took the base run's path, else what differs."""
-    if _same_path(plus, base) and _same_path(minus, base):
+    if same_path(plus, base) and same_path(minus, base):
         return ""
-    other = minus if _same_path(plus, base) else plus
+    other = minus if same_path(plus, base) else plus
     if len(other.transitions) != len(base.transitions):
         return f"at step {h:.3g} a perturbed run made {len(other.transitions)} switches against the base run's " \
                f"{len(base.transitions)}"

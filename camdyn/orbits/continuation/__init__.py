@@ -73,6 +73,13 @@ The modules, one job each: ``problem`` (the problem, settings, outcomes, the rec
 orbit's run and gap, the derivatives, tangent, predictor and corrector), ``events`` (the event
 table, detection and location), ``switching`` (branch switching at a period doubling),
 ``follow`` (the first orbit, the steps along each branch) and ``dataset`` (the result).
+
+**Two parameters** (design charts, issue 29): :func:`continue_grazing` follows the grazing
+orbit in two parameters and :func:`jump_chart` gives the jump speed against a rig parameter
+beside the inverse-kinematics contact-loss speed (``charts``: the public functions and the
+start; ``grazing``: the extended system, its residual and derivatives; ``grazing_curve``: the
+steps, step control and codimension-2 points; ``grazing_dataset``: the result);
+:func:`continue_bifurcation` follows a fold or a period doubling (``codim1``).
 """
 from __future__ import annotations
 
@@ -158,5 +165,8 @@ def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: fl
     return branch_dataset(problem, branches, events, scale)
 
 
-__all__ = ["continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
+from .charts import continue_bifurcation, continue_grazing, jump_chart  # noqa: E402  (it calls continue_orbit, defined above)
+from .grazing_curve import GrazingOutcome, GrazingSettings  # noqa: E402
+
+__all__ = ["continue_grazing", "jump_chart", "continue_bifurcation", "GrazingSettings", "GrazingOutcome", "continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
            "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES"]

@@ -135,27 +135,45 @@ def tangent(A: np.ndarray, previous: np.ndarray) -> np.ndarray:
 
 
 def correct(leg: Leg, z_pred, direction, A, mode) -> Corrected | None:
-    """The chord method on G(z) = 0, direction . (z - z_pred) = 0, from the derivatives ``A`` of
-    the last point: one run per iteration while the residual shrinks by CHORD_CONTRACTION or
-    more, the derivatives evaluated anew at z when it does not (a Newton step, 2 n + 2 runs
-    more with finite differences, told P_n(x) from the iteration's run).  Returns the converged
-    orbit without its derivatives (:func:`completed` adds them), or None when it fails (a run
-    fails, the residual grows, a Newton step shrinks it by less than NEWTON_CONTRACTION, or
-    max_corrector is reached)."""
-    z, last, fresh = z_pred.copy(), math.inf, False
-    for it in range(leg.settings.max_corrector + 1):
+    """The chord method (:func:`chord`) on G(z) = 0, direction . (z - z_pred) = 0, from the
+    derivatives ``A`` of the last point, each iteration one run of P_n (:func:`orbit_run`), the
+    derivatives evaluated anew by :func:`evaluate` (2 n + 2 runs more with finite differences,
+    told P_n(x) from the iteration's run).  Returns the converged orbit without its derivatives
+    (:func:`completed` adds them), or None when it fails."""
+    def residual(z):
         lam, x = leg.split(z)
+        run = orbit_run(leg, lam, x, mode)
+        return (run.P - x) / leg.scale, run
+
+    def derivatives(z, run):
+        lam, x = leg.split(z)
+        return evaluate(leg, lam, x, mode, run.value).A
+    found = chord(residual, derivatives, z_pred, direction, A, leg.settings)
+    return None if found is None else Corrected(*found)
+
+
+def chord(residual, derivatives, z_pred, direction, A, settings):
+    """The pseudo-arclength corrector of any extended system: the chord method on
+    ``residual(z) = 0, direction . (z - z_pred) = 0`` from the derivatives ``A`` of the last
+    point, stopping at ``max |residual| <= settings.tol``.  It keeps ``A`` while each
+    iteration shrinks the residual by CHORD_CONTRACTION or more and evaluates it anew at z when
+    it does not (a Newton step); ``residual(z)`` gives (the scaled residual, a payload: the
+    run), ``derivatives(z, payload)`` the scaled Jacobian; both raise CamdynError where they
+    cannot be evaluated.  Returns (z, payload, iterations), or None when it fails (an
+    evaluation fails, the residual grows, a Newton step shrinks it by less than
+    NEWTON_CONTRACTION, or ``settings.max_corrector`` is reached)."""
+    z, last, fresh = z_pred.copy(), math.inf, False
+    for it in range(settings.max_corrector + 1):
         try:                           # MapFailure, or a rig value the rig refuses
-            run = orbit_run(leg, lam, x, mode)
-            G = (run.P - x) / leg.scale
+            G, payload = residual(z)
             r = float(np.max(np.abs(G)))
-            if r <= leg.settings.tol:
-                return Corrected(z, run, it)
+            if r <= settings.tol:
+                return z, payload, it
             if fresh and not r <= NEWTON_CONTRACTION * last:
                 return None
             fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
             if fresh:
-                A = evaluate(leg, lam, x, mode, run.value).A
+                A = derivatives(z, payload)
         except CamdynError:
             return None
         if not math.isfinite(r) or (it >= 2 and r > last):

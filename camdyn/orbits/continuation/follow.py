@@ -20,25 +20,36 @@ FLAT = 1e-12
 AT_END = 1e-9
 
 
-def _clipped(leg: Leg, p: Point, ds: float) -> float:
-    """ds shortened so that the predictor stops at the end of the range it moves toward."""
-    problem, t_lam = leg.problem, p.tangent[Z_LAMBDA]
+def clipped(start: float, end: float, span: float, lam: float, t_lam: float, ds: float) -> float:
+    """ds shortened so that a predictor from ``lam`` whose tangent moves lambda by ``t_lam``
+    (scaled by ``span``) per unit arclength stops at the end of the range [start, end] it moves
+    toward."""
     if abs(t_lam) < FLAT:
         return ds
-    bound = max(problem.start, problem.end) if t_lam > 0 else min(problem.start, problem.end)
-    reach = (bound - p.lam) / problem.span / t_lam
+    bound = max(start, end) if t_lam > 0 else min(start, end)
+    reach = (bound - lam) / span / t_lam
     return min(ds, reach) if reach > 0 else ds
+
+
+def left_range(start: float, end: float, span: float, lam: float) -> ContinuationOutcome | None:
+    """END_REACHED or LEFT_RANGE once lambda is at or past an end of the range (AT_END of it)."""
+    slack = AT_END * span
+    for bound, outcome in ((end, ContinuationOutcome.END_REACHED), (start, ContinuationOutcome.LEFT_RANGE)):
+        other = start if bound == end else end
+        if (lam - bound) * math.copysign(1.0, bound - other) >= -slack:
+            return outcome
+    return None
+
+
+def _clipped(leg: Leg, p: Point, ds: float) -> float:
+    """ds shortened so that the predictor stops at the end of the range it moves toward."""
+    problem = leg.problem
+    return clipped(problem.start, problem.end, problem.span, p.lam, p.tangent[Z_LAMBDA], ds)
 
 
 def _left(problem: Problem, lam: float) -> ContinuationOutcome | None:
     """END_REACHED or LEFT_RANGE once lambda is at or past an end of the range (AT_END of it)."""
-    slack = AT_END * problem.span
-    for bound, outcome in ((problem.end, ContinuationOutcome.END_REACHED),
-                           (problem.start, ContinuationOutcome.LEFT_RANGE)):
-        other = problem.start if bound == problem.end else problem.end
-        if (lam - bound) * math.copysign(1.0, bound - other) >= -slack:
-            return outcome
-    return None
+    return left_range(problem.start, problem.end, problem.span, lam)
 
 
 def follow(leg: Leg, branch: Branch, index: int, first: Point, events: list) -> None:

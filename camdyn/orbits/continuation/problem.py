@@ -116,6 +116,35 @@ class Problem:
                                self.options, self.backend)
 
 
+@dataclass(frozen=True)
+class TwoParameters:
+    """What a two-parameter curve is about: the rig and scene, the free parameter ``free``
+    (lambda1) and the one followed from ``start`` to ``end`` (``parameter``, lambda2), each
+    ``speed_rpm`` or a rig parameter, the cam speed when neither is the speed, the section's
+    phase (a fraction of T), the solver options and the backend."""
+
+    rig: Rig
+    scene: Scene
+    free: str
+    parameter: str
+    start: float
+    end: float
+    speed_rpm: float | None = None
+    phase_fraction: float = 0.0
+    options: SolverOptions = DEFAULT_OPTIONS
+    backend: str = "compiled"
+
+    @property
+    def span(self) -> float:
+        return abs(self.end - self.start)
+
+    def model(self, free: float, lam: float) -> Model:
+        """The model at lambda1 = ``free``, lambda2 = ``lam``."""
+        values = {self.free: free, self.parameter: lam}
+        speed = values.pop(SPEED, self.speed_rpm)
+        return Model(self.rig.replace(**values) if values else self.rig, self.scene, ConstantSpeed(speed))
+
+
 @dataclass(frozen=True, eq=False)
 class Leg:
     """What every step of one branch shares: the problem, the period n of the branch's orbits

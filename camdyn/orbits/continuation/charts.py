@@ -1,0 +1,248 @@
+"""Design charts: the curve of grazing orbits in two parameters (:func:`continue_grazing`) and
+the jump chart, the jump (contact-loss) speed against a rig parameter beside its quasi-static
+limit (:func:`jump_chart`).
+
+:func:`continue_grazing` starts from the grazing that the one-parameter continuation
+(:func:`camdyn.orbits.continuation.follow.run`, the engine of :func:`camdyn.continue_orbit`)
+locates in the free parameter lambda1 (``free``, by default the cam speed) over ``search`` at
+lambda2 = ``start``: the located orbit and the branch's point before it, the one on the contact
+side first; or, where the branch's corrector stops short of the grazing (the step past it is
+not smooth: a stiff contact), its last orbit when that orbit's largest gap is within
+:data:`NEAR` of the first orbit's from zero.  From there it solves the extended system of
+:mod:`.grazing` at lambda2 = start and follows it (:mod:`.grazing_curve`) to lambda2 = ``end``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._checks import finite, real
+from ...engine import SolverOptions
+from ...errors import CamdynError, ParameterError
+from ...model.rig import PARAMETERS, Rig
+from ...model.scene import Scene
+from ..derivatives import finite_differences
+from ..section_map import DEFAULT_OPTIONS
+from ..tangent import variational
+from .follow import run
+from .grazing import GrazingSystem, Layout, gap_maximum
+from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
+from .codim1 import SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset
+from .codim1 import first as codim1_first
+from .grazing_dataset import grazing_dataset
+from .problem import SPEED, ContinuationSettings, Problem
+
+#: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
+#: when that orbit's largest gap is within this fraction of the branch's first orbit's from zero
+NEAR = 0.05
+
+
+def _names() -> list[str]:
+    return [SPEED] + [p.name for p in PARAMETERS]
+
+
+def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction) -> None:
+    if not isinstance(rig, Rig):
+        raise ParameterError("rig", rig, "a camdyn.Rig")
+    if not isinstance(scene, Scene) or scene.motion != "constant":
+        raise ParameterError("scene", scene, "a camdyn.Scene with motion 'constant' (a cam at constant speed)")
+    names = _names()
+    for name, value in (("parameter", parameter), ("free", free)):
+        if value not in names:
+            raise ParameterError(name, value, f"'{SPEED}' or a rig parameter ({', '.join(names[1:])})")
+    if parameter == free:
+        raise ParameterError("free", free, f"a parameter other than parameter ({parameter!r}): two parameters vary")
+    finite("start", start)
+    finite("end", end)
+    if start == end:
+        raise ParameterError("end", end, f"a value other than start ({start})")
+    if not (isinstance(search, (tuple, list)) and len(search) == 2):
+        raise ParameterError("search", search, f"(low, high): the range of {free} the first grazing is searched in")
+    lo, hi = (finite("search", v, f"two finite values of {free}, low != high") for v in search)
+    if lo == hi:
+        raise ParameterError("search", search, f"two finite values of {free}, low != high")
+    if SPEED in (free, parameter):
+        values = (lo, hi) if free == SPEED else (start, end)
+        if speed_rpm is not None:
+            raise ParameterError("speed_rpm", speed_rpm, "None: the speed is one of the two parameters")
+        if not values[0] * values[1] > 0:
+            raise ParameterError("search" if free == SPEED else "end", values[1],
+                                 "speeds of one sign, neither zero (rev/min)")
+    else:
+        real("speed_rpm", speed_rpm, "a nonzero cam speed (rev/min) for two rig parameters",
+             lambda v: v != 0 and math.isfinite(v))
+    real("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)", lambda v: 0 <= v < 1)
+
+
+def _settings(settings, kind) -> None:
+    if not isinstance(settings, kind):
+        raise ParameterError("settings", settings, f"a camdyn.orbits.continuation.{kind.__name__}")
+
+
+def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple,
+                     free: str = SPEED, speed_rpm: float | None = None, phase_fraction: float = 0.5,
+                     warmup_revolutions: int = 20, settings: GrazingSettings = GrazingSettings(),
+                     options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
+    """The curve of grazing period-1 orbits (the follower first leaving the cam) in two
+    parameters: ``free`` (lambda1, default the cam speed ``speed_rpm``, rev/min) and
+    ``parameter`` (lambda2, a rig parameter, SI; or the speed) from ``start`` to ``end``, by
+    pseudo-arclength continuation of the extended system of :mod:`.grazing`, with the
+    codimension-2 points where a Floquet multiplier at grazing passes -1 or +1.
+
+    ``search``: (low, high) of ``free``, over which :func:`camdyn.continue_orbit` (at lambda2 =
+    start, from the orbit at low) finds the first grazing; ``speed_rpm``: the cam speed when
+    neither parameter is the speed; ``phase_fraction``: the section's time in the period (choose it
+    away from the gap's maximum).  The scene needs the tangent dynamics (not damping C or E:
+    :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
+    result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
+    """
+    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
+    _settings(settings, GrazingSettings)
+    system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
+                           options, backend, free_start=float(search[0]), deflection=math.nan,
+                           tol=settings.continuation.tol, gap_tol=settings.gap_tol)
+    system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
+    system.model(float(search[1]), system.end)
+    curve, layout, system = _curve(system, search, settings, warmup_revolutions)
+    return grazing_dataset(system, curve, layout, settings)
+
+
+def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
+    """(curve, layout, the system with lambda1 at the first grazing) from the start's search:
+    the extended system solved from each candidate orbit in turn until one converges."""
+    found = _search(system, search, settings, warmup_revolutions)
+    if isinstance(found, str):
+        return Curve([], [], GrazingOutcome.START_FAILED, found), None, system
+    candidates, scale = found
+    why = []
+    for x, free, mode in candidates:
+        layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
+        try:
+            phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
+        except CamdynError as failure:
+            why.append(f"the orbit at {system.free} = {free:.8g} cannot be run: {failure}")
+            continue
+        at = dataclasses.replace(system, free_start=free, deflection=deflection)
+        leg = Leg(at, layout, settings.continuation)
+        p = first(leg, x, phase, free, mode)
+        if not isinstance(p, str):
+            return follow(leg, p), layout, at
+        why.append(p)
+    return Curve([], [], GrazingOutcome.START_FAILED, "; ".join(why)), None, system
+
+
+def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
+    """The candidate first orbits, (x, lambda1, mode) each, and the motion's scale, from the
+    branch the one-parameter continuation in lambda1 follows at lambda2 = start (its first; the
+    derivatives by the tangent dynamics, as the extended system's); or why there are none.  The
+    candidates: the located grazing's orbit and the branch's point before it (the one on the
+    contact side first); without a grazing, the branch's last orbit when it is within NEAR."""
+    rig = system.rig if system.parameter == SPEED else system.rig.replace(**{system.parameter: system.start})
+    speed = system.start if system.parameter == SPEED else system.speed_rpm
+    problem = Problem(rig, system.scene, system.free, float(search[0]), float(search[1]),
+                      None if system.free == SPEED else speed, 1, system.phase_fraction, system.options, variational,
+                      system.backend)
+    branches, events, scale = run(problem, settings.search, warmup_revolutions)
+    points = branches[0].points
+    grazing = [e for e in events if e.branch == 0 and e.kind == "grazing"]
+    if grazing:
+        e, before = grazing[0], points[grazing[0].point]
+        pair = [(e.x, e.lam, before.mode), (before.x, before.lam, before.mode)]
+        return (pair if e.max_gap < 0 else pair[::-1]), scale
+    why = f"{branches[0].outcome.message if branches[0].outcome else ''} {branches[0].message}".strip()
+    if not points:
+        return f"no orbit at {system.free} = {search[0]:.8g}: {why}"
+    last = points[-1]
+    if not (last.max_gap < 0 and -last.max_gap <= NEAR * -points[0].max_gap):
+        return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no grazing: its last orbit's "
+                f"largest gap is {last.max_gap:.3g} m ({why})")
+    return [(last.x, last.lam, last.mode)], scale
+
+
+#: the default search range of the jump chart's first grazing, in units of the
+#: inverse-kinematics contact-loss speed at the start: the grazing lies below it by the
+#: contact's compliance (:func:`camdyn.analysis.compliance_shift`: 2e-6 to 5e-8 of it on the
+#: shipped rigs), and the contact orbit exists from the low end
+JUMP_SEARCH = (0.9, 1.05)
+#: cam angles of compliance_shift's search for the spring moment's minimum and its second
+#: difference there (its default, 20000, costs 0.18 s a point; with 3600, 0.1 degree apart, the
+#: second difference's truncation error is ~(0.1 degree)^2 of the curvature's scale, 3e-6)
+SHIFT_SAMPLES = 3600
+
+
+def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple | None = None,
+               phase_fraction: float = 0.5, warmup_revolutions: int = 20,
+               settings: GrazingSettings = GrazingSettings(), options: SolverOptions = DEFAULT_OPTIONS,
+               backend: str = "compiled"):
+    """The jump chart: the jump speed (the grazing speed, where the follower first leaves the
+    cam) against the rig parameter ``parameter`` from ``start`` to ``end``
+    (:func:`continue_grazing` in (``speed_rpm``, ``parameter``)), beside its quasi-static
+    limit, the inverse-kinematics contact-loss speed (:func:`camdyn.analysis.contact_loss_speed`)
+    at each point's parameter value, and the first-order shift between them by the contact's
+    compliance (:func:`camdyn.analysis.compliance_shift`).
+
+    ``search``: the speeds (rev/min) the first grazing is searched between; default
+    :data:`JUMP_SEARCH` times the contact-loss speed at ``start``.  Returns the Dataset of
+    :func:`continue_grazing` with ``contact_loss_rpm`` and ``compliance_shift`` per point.
+    """
+    from ...analysis.statics import compliance_shift, contact_loss_speed
+
+    if parameter == SPEED or parameter not in _names():
+        raise ParameterError("parameter", parameter, f"a rig parameter ({', '.join(_names()[1:])}): the jump "
+                                                     "speed is charted against it")
+    if search is None:
+        finite("start", start)
+        loss = contact_loss_speed(rig.replace(**{parameter: float(start)}))
+        if not (math.isfinite(loss) and loss > 0):
+            raise ParameterError("start", start, f"a value of {parameter} at which the follower leaves the cam "
+                                                 f"at some speed (contact-loss speed {loss} rev/min there)")
+        search = (JUMP_SEARCH[0] * loss, JUMP_SEARCH[1] * loss)
+    ds = continue_grazing(rig, scene, parameter, start, end, search=search, phase_fraction=phase_fraction,
+                          warmup_revolutions=warmup_revolutions, settings=settings, options=options,
+                          backend=backend)
+    rigs = [rig.replace(**{parameter: float(v)}) for v in ds[parameter].values]
+    ds["contact_loss_rpm"] = ("point", np.array([contact_loss_speed(r) for r in rigs]),
+                              {"units": "rev/min", "long_name": "contact-loss speed by inverse kinematics "
+                                                                "(the quasi-static limit)"})
+    ds["compliance_shift"] = ("point", np.array([compliance_shift(r, scene, samples=SHIFT_SAMPLES) for r in rigs]),
+                              {"units": "1", "long_name": "first-order relative shift of the contact-loss speed "
+                                                          "by the contact's compliance"})
+    ds.attrs["title"] = f"camdyn jump chart: the jump speed against {parameter}, rig {rig.name}"
+    return ds
+
+
+def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, start: float, end: float, *,
+                         search: tuple, free: str = SPEED, speed_rpm: float | None = None,
+                         phase_fraction: float = 0.0, warmup_revolutions: int = 20,
+                         settings: ContinuationSettings = ContinuationSettings(switch_depth=0),
+                         options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
+                         backend: str = "compiled"):
+    """The curve of a ``kind`` (``"fold"`` or ``"period_doubling"``) of period-1 orbits in two
+    parameters, ``free`` (lambda1, default the cam speed) and ``parameter`` (lambda2) from
+    ``start`` to ``end``: pseudo-arclength on the extended system of :mod:`.codim1`, from the
+    bifurcation that the one-parameter continuation in ``free`` over ``search`` locates at
+    lambda2 = start.  ``jacobian``: the provider of dP/dx (as :func:`camdyn.continue_orbit`'s).
+    Raises only on bad input; how the curve ended is in the result's ``outcome``.  Returns the
+    ``xarray.Dataset`` of :func:`.codim1.codim1_dataset`."""
+    _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
+    _settings(settings, ContinuationSettings)
+    if kind not in SIGNS:
+        raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}")
+    system = Codim1System(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
+                          options, backend, kind=kind, jacobian=jacobian)
+    problem = system.along(free, float(search[0]), float(start), float(search[1]) - float(search[0]))
+    problem.model(float(search[1]))                            # a rig value the rig refuses raises here
+    branches, events, scale = run(problem, settings, warmup_revolutions)
+    found = [e for e in events if e.branch == 0 and e.kind == kind]
+    if not found:
+        why = f"no {kind} of the branch in {free} over {search[0]:.8g} to {search[1]:.8g} ({branches[0].message})"
+        return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, why), None)
+    e = found[0]
+    layout = Codim1Layout(np.asarray(scale, dtype=float), abs(e.lam), system.span)
+    leg = CurveLeg(system, layout, settings)
+    p = codim1_first(leg, e.x, e.lam, branches[0].points[e.point].mode)
+    if isinstance(p, str):
+        return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, p), layout)
+    return codim1_dataset(system, follow(leg, p, advance, lambda *_: []), layout)

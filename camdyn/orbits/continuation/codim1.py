@@ -1,0 +1,231 @@
+"""Fold and period-doubling curves in two parameters: the extended system, its steps, its Dataset.
+
+A fold (a multiplier through +1) or a period doubling (through -1) of a period-1 orbit is a
+codimension-1 point: with two parameters they form curves, the unknowns z = (x, lambda1,
+lambda2) solving the defining system (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd
+ed., Springer 2004, Ch. 10: the test function appended to the orbit's equations)::
+
+    P(x; lambda) - x = 0
+    det(M -+ I) = 0          (M = dP/dx; - for a fold, + for a period doubling)
+
+scaled as the branch's z (x / s, lambda1 / sigma1, lambda2 / sigma2), the determinant's row
+multiplied by tol / DET_TOL.  Pseudo-arclength on it is the grazing curve's loop
+(:func:`.grazing_curve.follow`) with this module's step.
+
+**Derivatives.**  The orbit's rows are the branch's (:func:`.corrector.evaluate`: dP/dx from the
+problem's Jacobian provider, dP/dlambda1 and dP/dlambda2 by central differences under the rule
+of :mod:`camdyn.orbits.derivatives`); the determinant's row by central differences of det(M -+ I)
+with M from the provider at x +- h s_j and lambda +- h sigma, h = DET_STEP: second derivatives
+of P, whose noise (M's, ~rtol^(2/3) of its scale by finite differences) is divided by h.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from ...errors import CamdynError
+from ..derivatives import finite_differences
+from ..section_map import derivative_at
+from ..shooting import sorted_multipliers
+from .corrector import chord, d_lambda, evaluate, orbit_run, tangent
+from .grazing_curve import Ended, GrazingOutcome
+from .grazing_dataset import common_attributes, unit
+from .problem import N_STATE, SPEED, ContinuationSettings, Leg as BranchLeg, Problem, TwoParameters
+
+#: the sign s of det(M + s I) per kind
+SIGNS = {"fold": -1.0, "period_doubling": 1.0}
+#: the determinant's tolerance: M by finite differences carries ~rtol^(2/3) (2e-7) of its scale,
+#: a determinant of 2 x 2 entries of order one twice that; DET_TOL leaves a margin of 50
+DET_TOL = 1e-5
+#: the relative step of the determinant's differences (its truncation error ~DET_STEP^2, 1e-6;
+#: M's noise over it ~2e-4 of the derivative)
+DET_STEP = 1e-3
+
+
+@dataclass(frozen=True, kw_only=True)
+class Codim1System(TwoParameters):
+    """What is continued (:class:`.problem.TwoParameters`), with the ``kind`` (``fold`` or
+    ``period_doubling``) and the Jacobian provider of dP/dx."""
+
+    kind: str
+    jacobian: object = finite_differences
+
+    def along(self, name: str, free: float, lam: float, sigma: float) -> Problem:
+        """The branch problem in ``name`` (lambda1 or lambda2) with the other held, its span sigma."""
+        held = (self.parameter, lam) if name == self.free else (self.free, free)
+        value = free if name == self.free else lam
+        rig = self.rig if held[0] == SPEED else self.rig.replace(**{held[0]: held[1]})
+        speed = held[1] if held[0] == SPEED else (None if name == SPEED else self.speed_rpm)
+        return Problem(rig, self.scene, name, value, value + sigma, speed, 1, self.phase_fraction, self.options,
+                       self.jacobian, self.backend)
+
+
+class Layout(NamedTuple):
+    scale: np.ndarray
+    sigma_free: float
+    sigma_range: float
+
+    def z(self, x, free: float, lam: float) -> np.ndarray:
+        return np.concatenate([np.asarray(x) / self.scale, [free / self.sigma_free, lam / self.sigma_range]])
+
+    def split(self, z) -> tuple[np.ndarray, float, float]:
+        return z[:N_STATE] * self.scale, float(z[N_STATE] * self.sigma_free), float(z[N_STATE + 1] * self.sigma_range)
+
+
+@dataclass(frozen=True, eq=False)
+class CurveLeg:
+    """What every step shares (the interface of :func:`.grazing_curve.follow`)."""
+
+    system: Codim1System
+    layout: Layout
+    settings: ContinuationSettings
+    start: float = field(init=False)
+    end: float = field(init=False)
+    span: float = field(init=False)
+
+    def __post_init__(self):
+        for name in ("start", "end", "span"):
+            object.__setattr__(self, name, getattr(self.system, name))
+
+    def branch(self, name: str, free: float, lam: float) -> BranchLeg:
+        sigma = self.layout.sigma_free if name == self.system.free else self.layout.sigma_range
+        return BranchLeg(self.system.along(name, free, lam, sigma), 1, self.layout.scale, self.settings)
+
+
+class Evaluation(NamedTuple):
+    residual: np.ndarray
+    M: np.ndarray
+    run: object
+    mode: int
+
+
+class Codim1Point(NamedTuple):
+    """One orbit of the curve: z, lambda1, lambda2, x, M, the unit tangent, the scaled Jacobian
+    A, its evaluation, the corrector's iterations, the tangent's change per arclength."""
+
+    z: np.ndarray
+    free: float
+    lam: float
+    x: np.ndarray
+    M: np.ndarray
+    tangent: np.ndarray
+    A: np.ndarray
+    evaluation: Evaluation
+    iterations: int
+    curvature: np.ndarray
+
+
+def _det(system: Codim1System, M) -> float:
+    return float(np.linalg.det(M + SIGNS[system.kind] * np.eye(N_STATE)))
+
+
+def _monodromy(leg: CurveLeg, x, free: float, lam: float, mode, base=None) -> np.ndarray:
+    branch = leg.branch(leg.system.free, free, lam)
+    provider = leg.system.jacobian(branch.section_map(free, mode), leg.layout.scale)
+    return derivative_at(provider, x, base).jacobian
+
+
+def residual(leg: CurveLeg, z, mode) -> Evaluation:
+    """The scaled residual at z (raises CamdynError)."""
+    x, free, lam = leg.layout.split(z)
+    run = orbit_run(leg.branch(leg.system.free, free, lam), free, x, mode)
+    M = _monodromy(leg, x, free, lam, mode, run.value)
+    det = _det(leg.system, M) * leg.settings.tol / DET_TOL
+    return Evaluation(np.append((run.P - x) / leg.layout.scale, det), M, run, mode)
+
+
+def jacobian(leg: CurveLeg, z, e: Evaluation) -> np.ndarray:
+    """The scaled Jacobian (n + 1) x (n + 2) at z (see the module docstring)."""
+    x, free, lam = leg.layout.split(z)
+    A = np.zeros((N_STATE + 1, N_STATE + 2))
+    A[:N_STATE, :N_STATE + 1] = evaluate(leg.branch(leg.system.free, free, lam), free, x, e.mode, e.run.value).A
+    dP, _, _ = d_lambda(leg.branch(leg.system.parameter, free, lam), lam, x, e.mode, e.run.value)
+    A[:N_STATE, N_STATE + 1] = dP * leg.layout.sigma_range / leg.layout.scale
+    weight = leg.settings.tol / DET_TOL
+    for j in range(N_STATE + 2):
+        h = DET_STEP
+        plus, minus = z.copy(), z.copy()
+        plus[j] += h
+        minus[j] -= h
+        g = [_det(leg.system, _monodromy(leg, *leg.layout.split(w), e.mode)) for w in (plus, minus)]
+        A[N_STATE, j] = (g[0] - g[1]) / (2 * h) * weight
+    if not np.all(np.isfinite(A)):
+        raise CamdynError("the extended system's derivatives are not finite")
+    return A
+
+
+def _point(leg: CurveLeg, z, e: Evaluation, direction, iterations: int) -> Codim1Point:
+    A = jacobian(leg, z, e)
+    x, free, lam = leg.layout.split(z)
+    return Codim1Point(z, free, lam, x, e.M, tangent(A, direction), A, e, iterations, np.zeros(N_STATE + 2))
+
+
+def advance(leg: CurveLeg, p: Codim1Point, ds: float, final: bool = False):
+    """The point at arclength ds from p (the second-order predictor and the chord corrector, as
+    :func:`.grazing_curve.corrected`): a point, None, or :class:`.grazing_curve.Ended`."""
+    z_pred = p.z + ds * p.tangent + 0.5 * ds * ds * p.curvature
+    direction = p.tangent
+    if final:
+        z_pred[-1] = leg.end / leg.layout.sigma_range
+        direction = np.zeros(N_STATE + 2)
+        direction[-1] = 1.0
+    mode = p.evaluation.mode
+    found = chord(lambda z: (lambda e: (e.residual, e))(residual(leg, z, mode)), lambda z, e: jacobian(leg, z, e),
+                  z_pred, direction, p.A, leg.settings)
+    if found is None:
+        return None
+    z, e, iterations = found
+    try:
+        q = _point(leg, z, e, p.tangent, iterations)
+    except CamdynError as failure:
+        return Ended(GrazingOutcome.NO_DERIVATIVES, str(failure))
+    return q._replace(curvature=(q.tangent - p.tangent) / ds)
+
+
+def first(leg: CurveLeg, x, free: float, mode: int) -> Codim1Point | str:
+    """The bifurcation at lambda2 = start from the one-parameter branch's located orbit."""
+    along = np.zeros(N_STATE + 2)
+    along[-1] = math.copysign(1.0, leg.end - leg.start)
+    z0 = leg.layout.z(x, free, leg.start)
+    try:
+        e0 = residual(leg, z0, mode)
+        A0 = jacobian(leg, z0, e0)
+    except CamdynError as failure:
+        return f"the start orbit cannot be evaluated: {failure}"
+    found = chord(lambda z: (lambda e: (e.residual, e))(residual(leg, z, mode)), lambda z, e: jacobian(leg, z, e),
+                  z0, along, A0, leg.settings)
+    if found is None:
+        return f"the extended system's corrector did not converge from the orbit at {leg.system.free} = {free:.8g}"
+    try:
+        return _point(leg, found[0], found[1], along, found[2])
+    except CamdynError as failure:
+        return f"no derivatives at the first orbit: {failure}"
+
+
+def codim1_dataset(system: Codim1System, curve, layout):
+    """The curve as an ``xarray.Dataset``: per point the two parameters by their names,
+    ``alpha``, ``alpha_dot``, the multipliers, ``residual`` and ``iterations``; attrs ``kind``,
+    ``free``, ``parameter``, their units, the range, the scene, ``outcome`` and
+    ``outcome_message``, the rig's parameters, ``camdyn_version`` (as :func:`.grazing_dataset.grazing_dataset`)."""
+    import xarray as xr
+
+    points, P, PM = curve.points, ("point",), ("point", "multiplier")
+    mu = np.array([sorted_multipliers(p.M) for p in points], dtype=complex).reshape(len(points), N_STATE)
+    data = {
+        system.free: (P, np.array([p.free for p in points]), {"units": unit(system.free)}),
+        system.parameter: (P, np.array([p.lam for p in points]), {"units": unit(system.parameter)}),
+        "alpha": (P, np.array([p.x[0] for p in points]), {"units": "rad", "long_name": "alpha at the section"}),
+        "alpha_dot": (P, np.array([p.x[1] for p in points]), {"units": "rad/s",
+                                                             "long_name": "alpha_dot at the section"}),
+        "multiplier_real": (PM, mu.real, {"units": "1"}),
+        "multiplier_imag": (PM, mu.imag, {"units": "1"}),
+        "residual": (P, np.array([float(np.max(np.abs(p.evaluation.residual))) for p in points]), {"units": "1"}),
+        "iterations": (P, np.array([p.iterations for p in points], dtype=int)),
+    }
+    scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
+    attrs = {**common_attributes(system, curve, scale), "kind": system.kind,
+             "title": f"camdyn {system.kind} curve in ({system.free}, {system.parameter}), rig {system.rig.name}"}
+    return xr.Dataset(data, attrs=attrs)

@@ -1,0 +1,316 @@
+"""Following the curve of grazing orbits in two parameters: its settings and outcomes, the
+first point (from a one-parameter continuation's grazing), the steps with their step control,
+and the codimension-2 points on it.
+
+Pseudo-arclength on the extended system of :mod:`.grazing`: the predictor along the unit null
+vector of its scaled Jacobian (4 x 5, :func:`camdyn.orbits.continuation.corrector.tangent`), the
+corrector :func:`camdyn.orbits.continuation.corrector.chord` (chord/Newton with the arclength
+condition), the step halved when the corrector fails and grown by
+:data:`camdyn.orbits.continuation.follow.GROWTH` after an easy one, as for a branch.
+
+**Codimension-2 points.**  At each point the Floquet multipliers of the grazing orbit (contact
+side, M from :func:`.grazing.derivatives`) give det(M + I) and det(M - I); where one changes
+sign between two points a multiplier at grazing passes -1 (``grazing_period_doubling``: the
+grazing curve meets a period-doubling curve) or +1 (``grazing_fold``: it meets a fold curve),
+located by secant trials in arclength (:func:`camdyn.orbits.continuation.events.trial`) to
+``locate_tol``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from ..._checks import real
+from ...errors import CamdynError, ParameterError
+from ...outcome import ActionableOutcome
+from ..shooting import sorted_multipliers
+from .corrector import chord, tangent
+from .events import MAX_BISECTIONS, Bracket, trial
+from .follow import AT_END, GROWTH, clipped, left_range
+from .grazing import (G_RANGE, G_SIZE, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
+                      free_at_zero_gap, is_largest)
+from .problem import ContinuationSettings
+
+#: the codimension-2 points' kinds and their test functions of the monodromy matrix M
+CODIM2 = {"grazing_period_doubling": lambda M: float(np.linalg.det(M + np.eye(len(M)))),
+          "grazing_fold": lambda M: float(np.linalg.det(M - np.eye(len(M))))}
+
+
+class GrazingOutcome(ActionableOutcome):
+    """How a grazing curve ended (an actionable message each)."""
+
+    END_REACHED = "the curve reached the end value of the parameter"
+    LEFT_RANGE = ("the curve turned back and left the range at the start value (a fold of the grazing curve "
+                  "in the parameter); start from the other end to follow it further")
+    MAX_POINTS = "GrazingSettings.continuation.max_points grazing orbits were computed before the end: raise it"
+    STEP_TOO_SMALL = ("the corrector failed at the minimum step (the extended system is singular or not smooth "
+                      "there, or a run failed, see the message): the curve ends here; try another "
+                      "phase_fraction or a smaller min_step")
+    MAXIMUM_MOVED = ("another maximum of the gap over the orbit has overtaken the grazing one: the follower "
+                     "first leaves the cam at another cam angle beyond this point (a double grazing); start a "
+                     "new curve beyond it")
+    NO_DERIVATIVES = ("the grazing system's derivatives could not be evaluated (the tangent dynamics fail: "
+                      "damping C and E's impact laws; or no parameter step keeps the contact side): the curve "
+                      "ends here, see the message")
+    START_FAILED = ("no grazing orbit at the start value (see the message): widen the search range of the free "
+                    "parameter, or try another phase_fraction")
+
+
+@dataclass(frozen=True)
+class GrazingSettings:
+    """``continuation``: the curve's step control, the corrector's tolerance ``tol`` and
+    ``locate_tol`` of its codimension-2 points (scaled arclength: lambda2's range is 1);
+    ``search``: the one-parameter continuation that finds the first grazing (its orbit only
+    starts the extended system's Newton, which locates the grazing itself: a coarse one);
+    ``gap_tol``: the gap's tolerance, a fraction of the largest deflection over the first orbit
+    (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it)."""
+
+    continuation: ContinuationSettings = ContinuationSettings(switch_depth=0)
+    gap_tol: float = 1e-6
+    search: ContinuationSettings = ContinuationSettings(step=0.05, max_step=0.25, locate_tol=1e-5, switch_depth=0)
+
+    def __post_init__(self):
+        for name in ("continuation", "search"):
+            if not isinstance(getattr(self, name), ContinuationSettings):
+                raise ParameterError(name, getattr(self, name), "a camdyn.orbits.continuation.ContinuationSettings")
+        real("gap_tol", self.gap_tol, "1e-12 <= gap_tol <= 1e-2 (of the largest deflection over the orbit)",
+             lambda v: 1e-12 <= v <= 1e-2)
+
+
+class GrazingPoint(NamedTuple):
+    """One grazing orbit: z (scaled), lambda1 and lambda2, x at the section, the grazing's phase
+    phi_g (t_g = t0 + phi_g T), M = dP/dx (contact side), the unit tangent (scaled), the
+    derivatives, the evaluation that converged there (t_g, psi_i there...), the corrector's
+    iterations, ``grazing``: lambda1 at zero gap (:func:`.grazing.free_at_zero_gap`; the
+    orbit's own lambda1, ``free``, is at psi_i(t_g) = -margin), and ``curvature``: the change of
+    the unit tangent per unit arclength from the point before (zero at the first)."""
+
+    z: np.ndarray
+    free: float
+    lam: float
+    x: np.ndarray
+    phase: float
+    M: np.ndarray
+    tangent: np.ndarray
+    derivatives: Derivatives
+    evaluation: Evaluation
+    iterations: int
+    grazing: float
+    curvature: np.ndarray
+
+    @property
+    def tests(self) -> dict[str, float]:
+        return {kind: f(self.M) for kind, f in CODIM2.items()}
+
+
+class Ended(NamedTuple):
+    """A step that ends the curve: the outcome and where and why."""
+
+    outcome: GrazingOutcome
+    message: str
+
+
+class Codim2(NamedTuple):
+    """A located codimension-2 point: its kind, the grazing orbit there, and the index of the
+    curve's point just before it."""
+
+    kind: str
+    at: GrazingPoint
+    point: int
+
+
+@dataclass
+class Curve:
+    """A grazing curve: its points in order, the codimension-2 points, how it ended and why."""
+
+    points: list
+    found: list
+    outcome: GrazingOutcome | None = None
+    message: str = ""
+
+
+class Leg(NamedTuple):
+    """What every step shares: the system, the layout of z and the settings."""
+
+    system: GrazingSystem
+    layout: Layout
+    settings: ContinuationSettings
+
+    @property
+    def start(self) -> float:
+        return self.system.start
+
+    @property
+    def end(self) -> float:
+        return self.system.end
+
+    @property
+    def span(self) -> float:
+        return self.system.span
+
+
+def _point(leg: Leg, z, e: Evaluation, direction, iterations: int, previous=None) -> GrazingPoint:
+    """The grazing orbit at z as a point: its derivatives (raises MapFailure; ``previous``: the
+    last point's lambda steps) and tangent."""
+    d = derivatives(leg.system, leg.layout, z, e, previous)
+    x, phase, free, lam = leg.layout.split(z)
+    return GrazingPoint(z, free, lam, x, phase, d.M, tangent(d.A, direction), d, e, iterations,
+                        free_at_zero_gap(leg.system, leg.layout, z, e, d.A), np.zeros(G_SIZE))
+
+
+def corrected(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
+    """The grazing orbit at arclength ds from p (chord corrector), without its derivatives: (z,
+    evaluation, iterations), or None when the corrector fails.  The predictor is the second-order
+    one, ``z + ds t + ds^2 / 2 curvature``: the extended system is smooth only on the contact
+    side, and a prediction past the grazing lifts the follower off (the jump speed's curve bends:
+    the tangent's own error, ds^2 / 2 of the curvature, is 1e-3 of the deflection at ds = 0.01 on
+    reference-experiment against k_s); the arclength condition stays along the tangent.
+    ``final``: the step reaches the range's end, and the prediction and the corrector hold
+    lambda2 at it instead of the arclength condition."""
+    z_pred = p.z + ds * p.tangent + 0.5 * ds * ds * p.curvature
+    if final:
+        z_pred[G_RANGE] = leg.end / leg.layout.sigma_range
+    mode = p.evaluation.value.start_mode
+    steps = p.derivatives.steps
+    direction = _along(1.0) if final else p.tangent
+    return chord(lambda z: _residual(leg, z, mode),
+                 lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
+                 z_pred, direction, p.derivatives.A, leg.settings)
+
+
+def _along(sign: float) -> np.ndarray:
+    """A z-direction along lambda2 alone."""
+    t = np.zeros(G_SIZE)
+    t[G_RANGE] = sign
+    return t
+
+
+def _residual(leg: Leg, z, mode):
+    """The chord's residual: (the scaled residual, the evaluation)."""
+    e = evaluate(leg.system, leg.layout, z, mode)
+    return e.residual, e
+
+
+def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
+    """The point at arclength ds from p (``final``: at the range's end, :func:`corrected`): a
+    GrazingPoint, None when the corrector fails, or :class:`Ended` (MAXIMUM_MOVED,
+    NO_DERIVATIVES) with where and why."""
+    found = corrected(leg, p, ds, final)
+    if found is None:
+        return None
+    z, e, iterations = found
+    if not is_largest(e):
+        return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} m over the orbit "
+                                                   f"against {e.psi_g:.3g} m at the grazing's t_g")
+    try:
+        q = _point(leg, z, e, p.tangent, iterations, p.derivatives.steps)
+        return q._replace(curvature=(q.tangent - p.tangent) / ds)
+    except CamdynError as failure:
+        return Ended(GrazingOutcome.NO_DERIVATIVES, f"at {_where(leg, z)}: {failure}")
+
+
+def _where(leg: Leg, z) -> str:
+    _, _, free, lam = leg.layout.split(z)
+    return f"{leg.system.free} = {free:.8g}, {leg.system.parameter} = {lam:.8g}"
+
+
+def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | str:
+    """The grazing orbit at lambda2 = start from a near-grazing orbit (x, its gap's maximum at
+    ``phase``, lambda1 = ``free``): the corrector with the arclength condition fixing lambda2;
+    its tangent oriented toward the end.  Or why there is none."""
+    layout, system = leg.layout, leg.system
+    z0 = layout.z(x, phase, free, system.start)
+    along = _along(math.copysign(1.0, system.end - system.start))
+    try:
+        e0 = evaluate(system, layout, z0, mode)
+        A0 = derivatives(system, layout, z0, e0, None, False).A
+    except CamdynError as failure:
+        return f"the start orbit cannot be evaluated: {failure}"
+    found = chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(system, layout, z, e, None, False).A, z0,
+                  along,
+                  A0, dataclasses.replace(leg.settings, max_corrector=max(20, leg.settings.max_corrector)))
+    if found is None:
+        return (f"the extended system's corrector did not converge from the near-grazing orbit at "
+                f"{system.free} = {free:.8g}")
+    z, e, iterations = found
+    if not is_largest(e):
+        return f"the located orbit's largest gap is not at its t_g ({e.max_gap:.3g} m against {e.psi_g:.3g} m)"
+    try:
+        return _point(leg, z, e, along, iterations)
+    except CamdynError as failure:
+        return f"no derivatives at the first grazing orbit: {failure}"
+
+
+def follow(leg, p, advance=None, detect=None) -> Curve:
+    """The curve from its first point ``p`` until lambda2 leaves the range, or it ends (see
+    :class:`GrazingOutcome`); codimension-2 points located on the way.  ``advance(leg, p, ds,
+    final)`` takes a step (default :func:`step`), ``detect(leg, p, q, ds, index)`` lists the
+    points found between two (default :func:`located`): another extended system's curve
+    (:mod:`.codim1`) is followed by the same loop; its points have ``free``, ``lam``, ``z``,
+    ``tangent``, ``curvature`` and ``iterations``, lambda2 last in z, and its leg ``start``,
+    ``end``, ``span``, ``settings``, ``system`` and ``layout.sigma_range``."""
+    advance, detect = advance or step, detect or located
+    settings, curve, ds = leg.settings, Curve([p], []), leg.settings.step
+    while True:
+        if len(curve.points) >= settings.max_points:
+            curve.outcome = GrazingOutcome.MAX_POINTS
+            return curve
+        h = clipped(leg.start, leg.end, leg.span, p.lam, p.tangent[-1], ds)
+        q = advance(leg, p, h, _reaches_end(leg, p, h))
+        if isinstance(q, Ended):
+            curve.outcome, curve.message = q
+            return curve
+        if q is None:
+            if ds <= settings.min_step:
+                curve.outcome = GrazingOutcome.STEP_TOO_SMALL
+                curve.message = f"at {leg.system.free} = {p.free:.8g}, {leg.system.parameter} = {p.lam:.8g}"
+                return curve
+            ds = max(ds / 2.0, settings.min_step)
+            continue
+        curve.found += detect(leg, p, q, h, len(curve.points) - 1)
+        curve.points.append(q)
+        done = left_range(leg.start, leg.end, leg.span, q.lam)
+        if done is not None:
+            curve.outcome = GrazingOutcome[done.name]
+            return curve
+        if q.iterations <= settings.easy_iterations:
+            ds = min(GROWTH * ds, settings.max_step)
+        p = q
+
+
+def _reaches_end(leg, p, ds: float) -> bool:
+    """Whether the prediction ds from p reaches lambda2's end (within AT_END of the range;
+    lambda2 is z's last component)."""
+    lam = p.lam + leg.layout.sigma_range * (ds * p.tangent[-1] + 0.5 * ds * ds * p.curvature[-1])
+    return (lam - leg.end) * math.copysign(1.0, leg.end - leg.start) >= -AT_END * leg.span
+
+
+def located(leg: Leg, p: GrazingPoint, q: GrazingPoint, ds: float, index: int) -> list[Codim2]:
+    """The codimension-2 points between p and q (ds apart), each located in arclength to
+    ``locate_tol`` by secant trials with the Illinois rule (:class:`.events.Bracket`); the
+    located orbit is the last trial on p's side of the sign change."""
+    out = []
+    f0, f1 = p.tests, q.tests
+    for kind in CODIM2:
+        a, b = f0[kind], f1[kind]
+        if not (math.isfinite(a) and math.isfinite(b) and a * b < 0):
+            continue
+        bracket = Bracket(0.0, ds, a, b, p)
+        for _ in range(MAX_BISECTIONS):
+            if bracket.hi - bracket.lo <= leg.settings.locate_tol:
+                break
+            s = trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, leg.settings.locate_tol)
+            r = step(leg, p, s)
+            r = r if isinstance(r, GrazingPoint) else None
+            bracket.narrow(s, math.nan if r is None else CODIM2[kind](r.M), r)
+        out.append(Codim2(kind, bracket.before, index))
+    return out
+
+
+def multipliers(p: GrazingPoint) -> np.ndarray:
+    """The Floquet multipliers of the grazing orbit (contact side), by decreasing modulus."""
+    return sorted_multipliers(p.M)

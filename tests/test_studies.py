@@ -21,7 +21,7 @@ FIGURES = {
     "fig4-5": ["repro_fig4-5.png"], "fig6": ["repro_fig6.png"], "fig7-8": ["repro_fig7-8.png"],
     "fig9": ["repro_fig9.png"], "fig10": ["repro_fig10.png"], "fig11": ["repro_fig11.png"],
     "fig12-15": ["repro_fig12-13.png", "repro_fig14-15.png"], "fig16": ["repro_fig16.png"],
-    "second-rig": ["repro_second-rig.png"],
+    "second-rig": ["repro_second-rig.png"], "jump-chart": ["repro_jump-chart.png"],
 }
 
 

@@ -16,7 +16,7 @@ From Python::
     out.numbers, out.figures, out.markdown
 
 Studies: reference-rig (identify the reference rig; writes the presets reference*.toml into the
-checkout's camdyn/model/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers, second-rig.
+checkout's camdyn/model/data, or ``<out>/rigs`` for an installed camdyn, and ``<out>/reference-rig.md``), fig4-5, chaos-scan, fig6, fig7-8, fig9, fig10, fig11, fig12-15, fig16, numbers, second-rig, jump-chart.
 """
 from __future__ import annotations
 
@@ -41,6 +41,7 @@ STUDIES = {
     "fig16": ("fig16", "alpha spectra: linearized vs non-linear model"),
     "numbers": ("numbers_report", "every reported number: paper, camdyn, relative difference"),
     "second-rig": ("second_rig", "the second published rig (issue 28): detachment, bifurcation diagram, corners"),
+    "jump-chart": ("jump_chart", "the jump speed against k_s on the reference experiment rig (two-parameter continuation)"),
 }
 assert list(STUDIES) == ORDER
 

@@ -233,7 +233,7 @@ measurements are not available here, so no section plots them and none is invent
 """
 
 ORDER = ["reference-rig", "fig4-5", "chaos-scan", "fig6", "fig7-8", "fig9", "fig10", "fig11", "fig12-15", "fig16", "numbers",
-         "second-rig"]
+         "second-rig", "jump-chart"]
 
 
 def _markers(name):

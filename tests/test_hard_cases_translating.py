@@ -128,3 +128,45 @@ def test_the_reach_rule_changes_no_run_of_the_translating_follower(loss, eq, cas
     assert list(runs[1].switches) == list(runs[0].switches)
     np.testing.assert_array_equal(runs[1].y, runs[0].y)
     np.testing.assert_array_equal(runs[1].y_dot, runs[0].y_dot)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_pieces_join_into_the_same_run_of_the_translating_follower(loss, method, monkeypatch):
+    """A hopping run (1.1 x the jump speed, 340 impacts) cut into phase-wrapped pieces of one kernel period
+    equals the run in one piece: each piece restarts the step size, so the runs differ by local errors
+    (measured 5e-11 s and 2e-13 m; bounds those of tests/test_hard_cases.py, 1e-8 s and 1e-8 m).  At 1.3 x
+    the motion amplifies them (5e-7 s over 10 revolutions): that speed would test the motion, not the join."""
+    from camdyn.runs import pieces
+    kw = dict(speed_rpm=1.1 * loss, revolutions=10, sample_rate_Hz=5000, rtol=1e-10, atol=1e-14, method=method)
+    whole = camdyn.simulate(RIG, SCENE, **kw)
+    monkeypatch.setattr(pieces, "PIECE_PERIODS", 1)
+    cut = camdyn.simulate(RIG, SCENE, **kw)
+    assert whole.ok and cut.ok and cut.stats["pieces"] == 5 and whole.impacts().size > 5
+    assert [(s.surface, s.after) for s in cut.switches] == [(s.surface, s.after) for s in whole.switches]
+    np.testing.assert_allclose([s.t for s in cut.switches], [s.t for s in whole.switches], rtol=0, atol=1e-8)
+    assert np.abs(cut.y - whole.y).max() < 1e-8
+
+
+@pytest.mark.parametrize("method, order, steps", [("DOP853", 8, [1.6e-4, 1.2e-4, 8e-5, 5e-5]),
+                                                  ("RK45", 5, [8e-5, 5e-5, 3e-5, 2e-5])])
+def test_observed_order_on_the_translating_follower(eq, method, order, steps):
+    """Smooth contact (undamped, frictionless, cam at rest, 10 nm off equilibrium: the contact never
+    opens) with the step fixed: the error against a tight reference falls as h^p, at least at the method's
+    order less 0.5 (tests/test_hard_cases.py's bound) and at most one more (the field is linear here, where
+    RK45's error falls a little faster over these steps: measured slopes RK45 5.65, DOP853 7.79)."""
+    scene = camdyn.Scene(follower="translating", damping="none", friction="none", profile="spline")
+    kw = dict(speed_rpm=0, t_end=0.005, sample_rate_Hz=3000, y0=(eq.q + 1e-8, 0.0))
+    ref = camdyn.simulate(RIG, scene, rtol=1e-13, atol=1e-22, **kw).y
+    errors = [np.abs(camdyn.simulate(RIG, scene, method=method, rtol=1e-2, atol=1e-2, max_step=h, **kw).y - ref).max()
+              for h in steps]
+    slope = np.polyfit(np.log(steps), np.log(errors), 1)[0]
+    assert order - 0.5 <= slope <= order + 1.0
+
+
+def test_the_continued_grazing_of_the_translating_follower_is_its_jump(loss):
+    """The period-1 orbit continued in the speed from 0.8 x to 1.2 x the inverse-kinematics jump speed
+    locates its grazing within 1e-4 of that speed (the contact's compliance moves it by 1.1e-5 here)."""
+    from camdyn.orbits.continuation import events_table
+    branch = camdyn.continue_orbit(RIG, SCENE, "speed_rpm", 0.8 * loss, 1.2 * loss)
+    grazing = [speed for kind, speed, _, _ in events_table(branch) if kind == "grazing"]
+    assert grazing and abs(grazing[0] / loss - 1) < 1e-4

@@ -10,7 +10,6 @@ contact-loss speed by 2.23e-6 to 2.69e-6 of it, against the first-order complian
 """
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
@@ -26,11 +25,7 @@ SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
 K_S = (2000.0, 2400.0)
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

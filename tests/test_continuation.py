@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import warnings
 
 import numpy as np
 import pytest
@@ -38,11 +37,7 @@ TOL = ContinuationSettings().tol            # 1e-8: the corrector's scaled resid
 PD_RANGE = (1650.0, 1850.0)
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,6 @@ contact margin is small.  Bounds say where they come from."""
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -21,11 +20,7 @@ DEG = math.pi / 180
 SPLINE = camdyn.Scene(damping="D", friction="coulomb", profile="spline")
 
 
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,6 @@ line contact (k = 1.57 GN/m against a 1.2 kg follower: a contact mode at 36,000 
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -21,11 +20,7 @@ RIG = translating_cam_example_rig()
 SCENE = camdyn.Scene(follower="translating", friction="none", profile="spline")
 
 
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,6 @@ paper's, symbolically and in runs, and runs on cams that are not circles."""
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -17,11 +16,7 @@ RPM_CONTACT = 600     # the example rig stays in contact (one switch: the start)
 RPM_IMPACTING = 1100  # the example rig hops and re-impacts: hundreds of switches in 20 revolutions
 
 
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 def circle_as_arcs(rig) -> ArcProfile:

@@ -3,7 +3,6 @@ contact force, the chatter's end at its accumulation point, against closed forms
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -21,11 +20,7 @@ ROCKER = camdyn.example_rig().replace(xi=XI)
 ROCKER_SCENE = camdyn.Scene(contact="rigid", damping="none", friction="none")
 
 
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 @pytest.mark.parametrize("rig, scene", [(RIG, SCENE), (ROCKER, ROCKER_SCENE)], ids=["translating", "oscillating"])

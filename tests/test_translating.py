@@ -3,7 +3,6 @@ inverse kinematics against closed forms, and runs on the eccentric circle and on
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -19,11 +18,7 @@ RIG = translating_example_rig()
 SCENE = camdyn.Scene(follower="translating", friction="none")
 
 
-@pytest.fixture(autouse=True)
-def _quiet():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", camdyn.CompileNotice)
-        yield
+pytestmark = pytest.mark.usefixtures("quiet_compile")  # (tests/conftest.py)
 
 
 def loss_speed_closed_form(rig) -> float:

@@ -29,7 +29,7 @@ REQUIRED = ["r_c", "e", "w_b", "chi0", "alpha0", "theta0", "d_x", "d_y", "L_us",
 #: the translating follower's own parameters, required of its rigs (and refused by the others)
 TRANSLATING = ["m_f", "gamma", "offset", "F_p"]
 OSCILLATING_ONLY = ["w_b", "chi0", "alpha0", "d_x", "d_y", "L_us", "I_Pb"]
-OPTIONAL = ["face_start", "face_end", "l_lambda", "mu_m", "s", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
+OPTIONAL = ["face_start", "face_end", "l_lambda", "xi", "mu_m", "s", "zeta_A", "beta_B", "beta_C", "zeta_D", "beta_D",
             "zeta_E", "beta_E"]
 
 

@@ -203,3 +203,21 @@ def test_lyapunov_exponents_of_a_rigid_impacting_orbit_sum_to_its_multipliers():
     expected = math.log(abs(np.prod(orbit.multipliers))) / period
     assert np.all(exponents < 0)
     assert float(np.sum(exponents)) == pytest.approx(expected, rel=1e-2)  # the exponents' finite-time error
+
+
+def test_continuation_of_a_rigid_impacting_branch_finds_its_period_doubling():
+    """The translating follower's impacting period-1 branch, continued in the speed from 1.2 x to 3 x its
+    jump speed (saltation-free finite differences, the default provider): the first period doubling it
+    locates is where shooting finds a multiplier leaving the unit circle through -1 (1 % on either side:
+    |mu| < 1 below, a real mu < -1 above; measured -0.75 +- 0.28i and -1.28)."""
+    from camdyn.orbits.continuation import events_table
+    loss = contact_loss_speed(RIG)
+    branch = camdyn.continue_orbit(RIG, SCENE, "speed_rpm", 1.2 * loss, 3 * loss)
+    doublings = [speed for kind, speed, b, _ in events_table(branch) if kind == "period_doubling" and b == 0]
+    assert doublings
+    below = camdyn.periodic_orbit(RIG, SCENE, speed_rpm=0.99 * doublings[0])
+    above = camdyn.periodic_orbit(RIG, SCENE, speed_rpm=1.01 * doublings[0])
+    assert below.ok and above.ok
+    assert np.max(np.abs(below.multipliers)) < 1
+    real = above.multipliers[np.abs(above.multipliers.imag) < 1e-12].real
+    assert real.size and real.min() < -1

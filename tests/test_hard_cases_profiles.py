@@ -141,3 +141,24 @@ def test_the_continuation_s_grazing_on_a_cam_is_where_runs_start_to_let_go(cam_r
     above = camdyn.simulate(cam_rig, SPLINE, speed_rpm=1.0003 * grazing[0], revolutions=6, rtol=1e-10)
     assert below.after(2 * below.period).separations().size == 0
     assert above.after(2 * above.period).separations().size >= 4
+
+
+@pytest.mark.slow  # derives the oscillating cam's tanh scene on a spline on first use (SymPy)
+def test_tanh_friction_approaches_coulomb_as_s_grows_on_a_cam(cam_rig):
+    """On the cycloidal cam, the oscillating cam of Section 7.2: model II with a growing smoothing factor s
+    approaches model I (stick-slip included) around the first reversal, the difference shrinking
+    monotonically (tests/test_hard_cases.py's check on the circle)."""
+    preloaded = cam_rig.replace(L_us=0.2)
+    cam = camdyn.Oscillating(math.pi, 40)
+    kw = dict(t_end=0.45, sample_rate_Hz=100_000)
+    coulomb = camdyn.simulate(preloaded, camdyn.Scene(damping="D", friction="coulomb", motion="oscillating",
+                                                      profile="spline"), cam, **kw)
+    assert coulomb.ok
+    scene = camdyn.Scene(damping="D", friction="tanh", motion="oscillating", profile="spline")
+    window = (coulomb.t > 0.35) & (coulomb.t < 0.45)
+    errors = []
+    for s in (10.0, 100.0, 1000.0):
+        r = camdyn.simulate(preloaded.replace(s=s), scene, cam, **kw)
+        assert r.ok
+        errors.append(np.abs(r.alpha[window] - coulomb.alpha[window]).max())
+    assert errors[0] > errors[1] > errors[2]

@@ -162,3 +162,26 @@ def test_tanh_friction_approaches_coulomb_as_s_grows_on_a_cam(cam_rig):
         assert r.ok
         errors.append(np.abs(r.alpha[window] - coulomb.alpha[window]).max())
     assert errors[0] > errors[1] > errors[2]
+
+
+def test_the_rockers_quasi_static_orbit_on_a_cam_is_the_converged_run(cam_rig, loss):
+    """response='quasistatic' for the rocker on a profile, whose rigid angle is the root of the gap
+    (Model.rigid_kinematics, with its implicit derivatives): against the full model's run after 39
+    revolutions at 0.8 x the jump speed (rtol 1e-10), the same alpha to 1e-2 of the residual's amplitude
+    (measured: 1.0e-8 rad against 2.3e-6 rad, the ringing that the cycloidal cam's jerk steps start, which the
+    quasi-static orbit leaves out); the shooting started from it finds the orbit that a warm-up run finds, to
+    the shooting's tolerance (measured 2.5e-12 of the scale); above the jump it says where F_n turns tensile."""
+    quasi = camdyn.Scene(damping="D", friction="coulomb", profile="spline", response="quasistatic")
+    speed = 0.8 * loss
+    rate = 64 * speed / 60
+    q = camdyn.simulate(cam_rig, quasi, speed_rpm=speed, revolutions=1, sample_rate_Hz=rate)
+    d = camdyn.simulate(cam_rig, SPLINE, speed_rpm=speed, revolutions=40, sample_rate_Hz=rate, rtol=1e-10, atol=1e-14)
+    assert q.ok and d.ok
+    last = slice(39 * 64, 40 * 64)
+    assert np.max(np.abs(d.alpha[last] - q.alpha[:64])) <= 1e-2 * np.max(np.abs(d.alpha_r[last]))
+    started = camdyn.periodic_orbit(cam_rig, SPLINE, speed_rpm=speed, start="quasistatic")
+    warmed = camdyn.periodic_orbit(cam_rig, SPLINE, speed_rpm=speed)
+    assert started.outcome is warmed.outcome is camdyn.OrbitOutcome.CONVERGED
+    assert np.all(np.abs(started.state - warmed.state) <= 1e-8 * warmed.scale)  # ShootingSettings' default tol
+    above = camdyn.simulate(cam_rig, quasi, speed_rpm=1.1 * loss, revolutions=1, sample_rate_Hz=rate)
+    assert above.outcome is camdyn.Outcome.CONTACT_TENSILE and "cam angle" in above.stats["where"]

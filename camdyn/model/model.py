@@ -305,11 +305,29 @@ class Model:
         values = outputs_on_samples(kern, compiled, modes, t, alpha, alpha_dot, self.p, len(K.OUTPUTS))
         return self._with_rigid_contact(t, values)
 
+    @property
+    def _rigid_contact_in_closed_form(self) -> bool:
+        """The generated kernels hold q_i(Theta) in closed form (``rigid_contact``, ``OUT_ALPHA_I``):
+        Eq. 29 on the paper's circle, y_i = h(gamma - Theta) for the translating follower on any
+        cam.  The rocker on any other cam has none: its q_i is the root of the gap."""
+        return self.rig.profile is None or self.scene.follower != _OSCILLATING
+
+    def rigid_kinematics(self, theta: float) -> tuple[float, float, float]:
+        """The follower in rigid contact at the cam angle ``theta`` (rad): its coordinate q_i
+        (Eq. 29's alpha_i, or y_i) and its first and second derivatives in Theta (per rad and
+        rad^2): the generated ``rigid_contact`` where it is in closed form, else the root of the
+        gap and its implicit derivatives (camdyn.model.followers.rigid_contact)."""
+        if self._rigid_contact_in_closed_form:
+            q, dq, ddq, _ = self.kernels.rigid_contact(theta, self.p)
+            return float(q), float(dq), float(ddq)
+        found = rigid_contact(self.rig.profile, follower_of_rig(self.rig), np.array([theta], dtype=float))
+        return float(found.q[0]), float(found.q_dot[0]), float(found.q_ddot[0])
+
     def _with_rigid_contact(self, t, values: np.ndarray) -> np.ndarray:
         """On a cam other than the circle the generated ``outputs`` has no closed form of alpha_i
         (Eq. 29): it is the root of the gap at the cam angle Theta(t), solved here
         (camdyn.model.followers.rigid_contact) into row OUT_ALPHA_I."""
-        if self.rig.profile is None or self.scene.follower != _OSCILLATING:  # a closed form in the kernel
+        if self._rigid_contact_in_closed_form:
             return values
         theta = self.cam_state(np.asarray(t, dtype=float))[0]
         values[self.kernels.OUT_ALPHA_I] = rigid_contact(self.rig.profile, follower_of_rig(self.rig),

@@ -2,7 +2,8 @@
 
 In permanent contact the follower moves with the cam up to a contact deformation of a few
 1e-8 m.  The quasi-static orbit takes alpha_dot and alpha_ddot from the rigid kinematics,
-alpha_i(Theta) of Eq. 29 and its Theta derivatives (the generated ``rigid_contact``):
+alpha_i(Theta) of Eq. 29 and its Theta derivatives (``Model.rigid_kinematics``; on a cam
+profile, the rocker's root of the gap):
 
     alpha_dot = alpha_i' Theta_dot,   alpha_ddot = alpha_i'' Theta_dot^2 + alpha_i' Theta_ddot,
 
@@ -41,6 +42,10 @@ from ..model.scene import Scene
 MAX_NEWTON = 30
 #: a Newton step below this many ulps of alpha ends the iteration (rounding of alpha itself)
 ULPS = 4
+#: a Newton step that no longer shrinks, after one below this many ulps of alpha, also ends it:
+#: the residual's own rounding is reached (seen: a spline cam's rhs, whose steps then circle at
+#: 4-6 ulps of alpha)
+NOISE_ULPS = 1024
 
 
 class QuasiStaticOutcome(ActionableOutcome):
@@ -97,8 +102,8 @@ def rigid_kinematics(model: Model, t: float) -> tuple[float, float, float]:
     """(alpha_i, alpha_i_dot, alpha_i_ddot) at t: Eq. 29 and its Theta derivatives, chained."""
     cam = model.cam_state(t)
     theta, theta_dot, theta_ddot = (float(np.asarray(cam[i])) for i in (CAM_THETA, CAM_THETA_DOT, CAM_THETA_DDOT))
-    a, da, dda, _ = model.kernels.rigid_contact(theta, model.p)
-    return float(a), da * theta_dot, dda * theta_dot ** 2 + da * theta_ddot
+    a, da, dda = model.rigid_kinematics(theta)
+    return a, da * theta_dot, dda * theta_dot ** 2 + da * theta_ddot
 
 
 def solve_at(model: Model, t: float):
@@ -106,7 +111,7 @@ def solve_at(model: Model, t: float):
     Newton does not converge."""
     a_i, ad, add = rigid_kinematics(model, t)
     m = contact_mode(model, t, a_i, ad)
-    alpha = a_i
+    alpha, last = a_i, math.inf
     for _ in range(MAX_NEWTON):
         g = model.rhs(m, t, alpha, ad) - add
         dg, _ = model.jacobian(m, t, alpha, ad)
@@ -114,8 +119,10 @@ def solve_at(model: Model, t: float):
         alpha -= step
         if not math.isfinite(alpha):
             break
-        if abs(step) <= ULPS * np.spacing(abs(alpha)):
+        ulp = np.spacing(abs(alpha))
+        if abs(step) <= ULPS * ulp or (abs(step) >= abs(last) and abs(last) <= NOISE_ULPS * ulp):
             return alpha, ad, add, a_i, m
+        last = step
     return math.nan, ad, add, a_i, m
 
 

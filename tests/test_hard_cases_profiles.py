@@ -185,3 +185,17 @@ def test_the_rockers_quasi_static_orbit_on_a_cam_is_the_converged_run(cam_rig, l
     assert np.all(np.abs(started.state - warmed.state) <= 1e-8 * warmed.scale)  # ShootingSettings' default tol
     above = camdyn.simulate(cam_rig, quasi, speed_rpm=1.1 * loss, revolutions=1, sample_rate_Hz=rate)
     assert above.outcome is camdyn.Outcome.CONTACT_TENSILE and "cam angle" in above.stats["where"]
+
+
+def test_the_rockers_quasi_static_orbit_holds_up_to_the_inverse_kinematics_jump(cam_rig, loss):
+    """The quasi-static orbit carries the rigid kinematics' inertia, so F_n > 0 exactly while the rigid
+    contact force of the inverse kinematics is positive: it holds 1e-5 below the jump speed (F_n down to a
+    few mN, the contact deformation there ~1e-11 of the lengths whose rounding enters the gap, where Newton
+    has to stop at the residual's rounding) and turns tensile 1e-4 above it (F_n is checked at the samples
+    asked, 720 a revolution: 1e-5 above, the tensile window falls between them)."""
+    quasi = camdyn.Scene(damping="D", friction="coulomb", profile="spline", response="quasistatic")
+    rate = 720 * loss / 60
+    below = camdyn.simulate(cam_rig, quasi, speed_rpm=(1 - 1e-5) * loss, revolutions=1, sample_rate_Hz=rate)
+    above = camdyn.simulate(cam_rig, quasi, speed_rpm=(1 + 1e-4) * loss, revolutions=1, sample_rate_Hz=rate)
+    assert below.ok, below.stats["where"]
+    assert above.outcome is camdyn.Outcome.CONTACT_TENSILE

@@ -42,10 +42,13 @@ from ..model.scene import Scene
 MAX_NEWTON = 30
 #: a Newton step below this many ulps of alpha ends the iteration (rounding of alpha itself)
 ULPS = 4
-#: a Newton step that no longer shrinks, after one below this many ulps of alpha, also ends it:
-#: the residual's own rounding is reached (seen: a spline cam's rhs, whose steps then circle at
-#: 4-6 ulps of alpha)
+#: a Newton step that no longer shrinks, after one below this many ulps of alpha or below
+#: NOISE_FRACTION of the contact deformation alpha - alpha_i, also ends it: the residual's own
+#: rounding is reached (seen on a spline cam: steps that circle at 4-6 ulps of alpha = -0.025 rad,
+#: and at 1e-11 of the deformation where alpha = 1e-4 rad, the gap's rounding being that of its
+#: 0.1 m terms)
 NOISE_ULPS = 1024
+NOISE_FRACTION = 1e-9
 
 
 class QuasiStaticOutcome(ActionableOutcome):
@@ -120,7 +123,8 @@ def solve_at(model: Model, t: float):
         if not math.isfinite(alpha):
             break
         ulp = np.spacing(abs(alpha))
-        if abs(step) <= ULPS * ulp or (abs(step) >= abs(last) and abs(last) <= NOISE_ULPS * ulp):
+        noise = max(NOISE_ULPS * ulp, NOISE_FRACTION * abs(alpha - a_i))
+        if abs(step) <= ULPS * ulp or (abs(step) >= abs(last) and abs(last) <= noise):
             return alpha, ad, add, a_i, m
         last = step
     return math.nan, ad, add, a_i, m

@@ -163,7 +163,8 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     return math.sqrt(omega2) / RPM
 
 
-def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 20000) -> float:
+def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 20000,
+                     loss_rpm: float | None = None) -> float:
     """The relative shift of the contact-loss speed by the contact's compliance, to first order:
     ``(Omega_loss - Omega_ik) / Omega_ik`` (negative: a compliant contact lets go earlier).
 
@@ -176,9 +177,10 @@ def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 200
     the loss speed moves by ``-M_c''(Theta*) / (2 K |alpha_i''(Theta*)|)``, that is
     ``-(1/2) (Omega/vartheta)^2 m`` with ``m = M_c'' / (I_Pb |alpha_i''| Omega^2)``, a number of the
     cam's profile.  ``scene`` gives vartheta (default: line contact, damping D, Coulomb).
+    ``loss_rpm``: Omega_ik (rev/min) where the caller has it already, else :func:`contact_loss_speed`.
     Returns 0 when the follower never leaves the cam (no decelerating cam angle).
     """
-    loss = contact_loss_speed(rig)
+    loss = contact_loss_speed(rig) if loss_rpm is None else float(loss_rpm)
     if not math.isfinite(loss) or loss == 0:
         return 0.0
     scene = scene or Scene(contact="line", damping="D", friction="coulomb", profile=_static_scene("line", rig).profile)

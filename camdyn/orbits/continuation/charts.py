@@ -203,10 +203,12 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
                           warmup_revolutions=warmup_revolutions, settings=settings, options=options,
                           backend=backend)
     rigs = [rig.replace(**{parameter: float(v)}) for v in ds[parameter].values]
-    ds["contact_loss_rpm"] = ("point", np.array([contact_loss_speed(r) for r in rigs]),
+    losses = [contact_loss_speed(r) for r in rigs]
+    ds["contact_loss_rpm"] = ("point", np.array(losses),
                               {"units": "rev/min", "long_name": "contact-loss speed by inverse kinematics "
                                                                 "(the quasi-static limit)"})
-    ds["compliance_shift"] = ("point", np.array([compliance_shift(r, scene, samples=SHIFT_SAMPLES) for r in rigs]),
+    shifts = [compliance_shift(r, scene, samples=SHIFT_SAMPLES, loss_rpm=loss) for r, loss in zip(rigs, losses)]
+    ds["compliance_shift"] = ("point", np.array(shifts),
                               {"units": "1", "long_name": "first-order relative shift of the contact-loss speed "
                                                           "by the contact's compliance"})
     ds.attrs["title"] = f"camdyn jump chart: the jump speed against {parameter}, rig {rig.name}"

@@ -28,11 +28,6 @@ def _static_scene(contact: str, rig: Rig | None = None) -> Scene:
     return Scene(contact=contact, damping="none", friction="none", profile=profile, follower=follower)
 
 
-def inertia(rig: Rig) -> float:
-    """The follower's inertia along its coordinate: I_Pb (kg m^2), or the translating follower's m_f (kg)."""
-    return rig.m_f if rig.follower == "translating" else rig.I_Pb
-
-
 def rigid_kinematics(rig: Rig, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(alpha_i, alpha_i'', F_s d_x) at the cam angles ``theta``: the follower angle in rigid
     contact, its second derivative in Theta (1/rad) and the spring's moment there (N m).  The
@@ -141,7 +136,7 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     """
     thetas = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
     alpha_i, curvature, spring_moment = rigid_kinematics(rig, thetas)
-    I = inertia(rig)
+    I = rig.inertia
     if rig.follower != "translating" and np.any(np.abs(alpha_i) > ANGLE_LIMIT):
         raise GeometryError("in rigid contact the follower would pass 90 degrees over a revolution")
     if np.any(spring_moment <= 0):
@@ -176,22 +171,23 @@ def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 200
     at Theta* that is -I_Pb Omega^2 M_c'' / K < 0.  With dM_c/d(Omega^2) = I_Pb alpha_i''(Theta*) < 0,
     the loss speed moves by ``-M_c''(Theta*) / (2 K |alpha_i''(Theta*)|)``, that is
     ``-(1/2) (Omega/vartheta)^2 m`` with ``m = M_c'' / (I_Pb |alpha_i''| Omega^2)``, a number of the
-    cam's profile.  ``scene`` gives vartheta (default: line contact, damping D, Coulomb).
+    cam's profile.  ``scene`` gives vartheta (default: line contact; vartheta is the static
+    equilibrium's, which no damping or friction law changes).
     ``loss_rpm``: Omega_ik (rev/min) where the caller has it already, else :func:`contact_loss_speed`.
     Returns 0 when the follower never leaves the cam (no decelerating cam angle).
     """
     loss = contact_loss_speed(rig) if loss_rpm is None else float(loss_rpm)
     if not math.isfinite(loss) or loss == 0:
         return 0.0
-    scene = scene or Scene(contact="line", damping="D", friction="coulomb", profile=_static_scene("line", rig).profile)
+    scene = scene or _static_scene("line", rig)
     omega = loss * RPM
     theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
     _, curvature, spring = rigid_kinematics(rig, theta)
-    M = rig.I_Pb * curvature * omega ** 2 + spring
+    M = rig.inertia * curvature * omega ** 2 + spring
     k, h = int(np.argmin(M)), theta[1] - theta[0]
     M2 = (M[k - 1] - 2 * M[k] + M[(k + 1) % samples]) / h ** 2
     vartheta = Model(rig, scene, ConstantSpeed(0.0)).equilibrium.vartheta
-    return float(-0.5 * M2 / (rig.I_Pb * vartheta ** 2 * abs(curvature[k])))
+    return float(-0.5 * M2 / (rig.inertia * vartheta ** 2 * abs(curvature[k])))
 
 
 def energy_balance_peak(rig: Rig, speed_rpm: float, xi: float, *, potential: str = "printed",

@@ -97,9 +97,8 @@ def _rigid_equilibrium(rig: Rig, at_rest: tuple) -> Equilibrium:
     _, dM, psi_i, psi_j, _ = at_rest
     q0 = zero_state(rig)
     chi = rig.chi0 if rig.follower == _OSCILLATING else math.nan
-    inertia = rig.I_Pb if rig.follower == _OSCILLATING else rig.m_f
     return Equilibrium(float(q0), float(psi_i), float(psi_j), float(chi), float(-dM), math.inf,
-                       math.sqrt(abs(dM) / inertia))
+                       math.sqrt(abs(dM) / rig.inertia))
 
 
 def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
@@ -142,9 +141,8 @@ def solve_equilibrium(rig: Rig, kernels: ModuleType) -> Equilibrium:
     if not dM < 0:
         raise EquilibriumError(f"the static equilibrium {name}* = {a_star:g} {unit} is unstable (d load/d{name} = {dM:g})")
     chi = rig.chi0 - psi_j if rig.follower == _OSCILLATING else math.nan
-    inertia = rig.I_Pb if rig.follower == _OSCILLATING else rig.m_f
     return Equilibrium(float(a_star), float(psi_i), float(psi_j), float(chi), float(-dM),
-                       float(k_lambda), math.sqrt(-dM / inertia))
+                       float(k_lambda), math.sqrt(-dM / rig.inertia))
 
 
 def _check_profile(rig: Rig, scene: Scene) -> None:

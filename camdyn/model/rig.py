@@ -231,6 +231,12 @@ class Rig:
         ``1 / ((1 - nu_c**2) / Y_c + (1 - nu_b**2) / Y_b)``."""
         return 1.0 / ((1.0 - self.nu_c**2) / self.Y_c + (1.0 - self.nu_b**2) / self.Y_b)
 
+    @property
+    def inertia(self) -> float:
+        """The follower's inertia along its coordinate: I_Pb (kg m^2, Eq. 10) for the oscillating
+        follower, m_f (kg) for the translating one."""
+        return self.m_f if self.follower == "translating" else self.I_Pb
+
     def require(self, *names: str, why: str = "") -> None:
         """Raise :class:`ParameterError` if any of the named parameters is not given.
 

@@ -167,7 +167,7 @@ def test_tanh_friction_approaches_coulomb_as_s_grows_on_a_cam(cam_rig):
 
 def test_the_rockers_quasi_static_orbit_on_a_cam_is_the_converged_run(cam_rig, loss):
     """response='quasistatic' for the rocker on a profile, whose rigid angle is the root of the gap
-    (Model.rigid_kinematics, with its implicit derivatives): against the full model's run after 39
+    (Model.rigid_coordinate, with its implicit derivatives): against the full model's run after 39
     revolutions at 0.8 x the jump speed (rtol 1e-10), the same alpha to 1e-2 of the residual's amplitude
     (measured: 1.0e-8 rad against 2.3e-6 rad, the ringing that the cycloidal cam's jerk steps start, which the
     quasi-static orbit leaves out); the shooting started from it finds the orbit that a warm-up run finds, to

@@ -310,7 +310,12 @@ class Model:
         cam.  The rocker on any other cam has none: its q_i is the root of the gap."""
         return self.rig.profile is None or self.scene.follower != _OSCILLATING
 
-    def rigid_kinematics(self, theta: float) -> tuple[float, float, float]:
+    @cached_property
+    def _follower(self):
+        """The rig's follower geometry (camdyn.model.followers), for the root of the gap on a profile."""
+        return follower_of_rig(self.rig)
+
+    def rigid_coordinate(self, theta: float) -> tuple[float, float, float]:
         """The follower in rigid contact at the cam angle ``theta`` (rad): its coordinate q_i
         (Eq. 29's alpha_i, or y_i) and its first and second derivatives in Theta (per rad and
         rad^2): the generated ``rigid_contact`` where it is in closed form, else the root of the
@@ -318,7 +323,7 @@ class Model:
         if self._rigid_contact_in_closed_form:
             q, dq, ddq, _ = self.kernels.rigid_contact(theta, self.p)
             return float(q), float(dq), float(ddq)
-        found = rigid_contact(self.rig.profile, follower_of_rig(self.rig), np.array([theta], dtype=float))
+        found = rigid_contact(self.rig.profile, self._follower, np.array([theta], dtype=float))
         return float(found.q[0]), float(found.q_dot[0]), float(found.q_ddot[0])
 
     def _with_rigid_contact(self, t, values: np.ndarray) -> np.ndarray:
@@ -328,7 +333,7 @@ class Model:
         if self._rigid_contact_in_closed_form:
             return values
         theta = self.cam_state(np.asarray(t, dtype=float))[0]
-        values[self.kernels.OUT_ALPHA_I] = rigid_contact(self.rig.profile, follower_of_rig(self.rig),
+        values[self.kernels.OUT_ALPHA_I] = rigid_contact(self.rig.profile, self._follower,
                                                          np.asarray(theta, dtype=float)).q
         return values
 

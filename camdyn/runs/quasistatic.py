@@ -2,7 +2,7 @@
 
 In permanent contact the follower moves with the cam up to a contact deformation of a few
 1e-8 m.  The quasi-static orbit takes alpha_dot and alpha_ddot from the rigid kinematics,
-alpha_i(Theta) of Eq. 29 and its Theta derivatives (``Model.rigid_kinematics``; on a cam
+alpha_i(Theta) of Eq. 29 and its Theta derivatives (``Model.rigid_coordinate``; on a cam
 profile, the rocker's root of the gap):
 
     alpha_dot = alpha_i' Theta_dot,   alpha_ddot = alpha_i'' Theta_dot^2 + alpha_i' Theta_ddot,
@@ -105,7 +105,7 @@ def rigid_kinematics(model: Model, t: float) -> tuple[float, float, float]:
     """(alpha_i, alpha_i_dot, alpha_i_ddot) at t: Eq. 29 and its Theta derivatives, chained."""
     cam = model.cam_state(t)
     theta, theta_dot, theta_ddot = (float(np.asarray(cam[i])) for i in (CAM_THETA, CAM_THETA_DOT, CAM_THETA_DDOT))
-    a, da, dda = model.rigid_kinematics(theta)
+    a, da, dda = model.rigid_coordinate(theta)
     return a, da * theta_dot, dda * theta_dot ** 2 + da * theta_ddot
 
 

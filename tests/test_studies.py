@@ -235,6 +235,13 @@ def test_chaos_scan_writes_its_section_to_both_documents(tmp_path):
     studies.run("reference-rig", **quiet)
     again = (tmp_path / "reference-rig.md").read_text()
     assert again.count("## Chaos onsets: geometry scan") == 1 and "Not run yet" not in again
+    # --reuse takes stage 1 from the report only when its settings are the same
+    from camdyn.studies import chaos_scan
+    ctx = common.Context(fast=True, out=tmp_path, reuse=True)
+    s = chaos_scan.settings(True)
+    assert chaos_scan._recorded_stage1(ctx, s) == out.numbers["stage1"]
+    assert chaos_scan._recorded_stage1(ctx, {**s, "revolutions": s["revolutions"] + 1}) is None
+    assert chaos_scan._recorded_stage1(common.Context(fast=True, out=tmp_path / "empty"), s) is None
 
 
 # ---------------------------------------------------------------- where the studies write (issue 14, I)

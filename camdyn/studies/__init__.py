@@ -51,14 +51,17 @@ def report_path(out: str | Path | None = None) -> Path:
 
 
 def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, write_docs: bool = True,
-        data_dir: str | Path | None = None, log=print) -> StudyOutput:
+        data_dir: str | Path | None = None, log=print, reuse: bool = False) -> StudyOutput:
     """Run one study; write its figure(s) and its section of ``<out>/reproduction.md``.
 
     ``fast`` (default: the environment variable CAMDYN_FAST) reduces speeds and revolutions.
     ``out`` is the folder of the report (default: the checkout's ``docs/`` when camdyn runs
     from a source checkout, else ``./camdyn-reproduction``); figures go to ``<out>/img``.
     ``data_dir`` is where ``reference-rig`` writes the presets (default: the checkout's
-    ``camdyn/model/data``, else ``<out>/rigs``).  Nothing is written inside an installed package.
+    ``camdyn/model/data``, else ``<out>/rigs``).  ``reuse`` lets a study take the results of an
+    expensive stage from the numbers it recorded in ``<out>/reproduction.md`` when they were made
+    with the same settings (chaos-scan's stage 1); the section then says so.  Nothing is written
+    inside an installed package.
     """
     if name not in STUDIES:
         import difflib
@@ -71,11 +74,11 @@ def run(name: str, *, fast: bool | None = None, out: str | Path | None = None, w
         log(f"camdyn is not running from a source checkout: writing to {out_dir} (choose with --out DIR)")
     out_dir.mkdir(parents=True, exist_ok=True)
     ctx = Context(fast=fast, out=out_dir, write_docs=write_docs,
-                  data_dir=Path(data_dir) if data_dir is not None else None, log=log)
+                  data_dir=Path(data_dir) if data_dir is not None else None, log=log, reuse=reuse)
     module = importlib.import_module(f"{__name__}.{STUDIES[name][0]}")
     output = module.run(ctx)
     if write_docs:
-        command = f"python -m camdyn.studies {name}" + (" --fast" if fast else "")
+        command = f"python -m camdyn.studies {name}" + (" --fast" if fast else "") + (" --reuse" if reuse else "")
         update_report(out_dir / "reproduction.md", output, command)
         log(f"updated {out_dir / 'reproduction.md'} (section {name})")
     return output

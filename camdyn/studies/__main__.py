@@ -18,6 +18,9 @@ def main(argv=None) -> int:
                                                     "docs/ in a source checkout, else ./camdyn-reproduction)")
     parser.add_argument("--data-dir", default=None, help="where reference-rig writes the presets (default: the "
                                                          "checkout's camdyn/model/data, else <out>/rigs)")
+    parser.add_argument("--reuse", action="store_true",
+                        help="reuse the results of expensive stages recorded in the report with the same "
+                             "settings (chaos-scan: stage 1)")
     parser.add_argument("--no-docs", action="store_true", help="do not update the report")
     parser.add_argument("--json", action="store_true", help="print the study's numbers as JSON on stdout "
                                                             "(always on for 'numbers')")
@@ -33,7 +36,7 @@ def main(argv=None) -> int:
     log = (lambda *a, **k: print(*a, file=sys.stderr, **k)) if quiet else print
     for name in names:
         output = run(name, fast=args.fast, out=args.out, write_docs=not args.no_docs,
-                     data_dir=args.data_dir, log=log)
+                     data_dir=args.data_dir, log=log, reuse=args.reuse)
         if quiet:
             print(to_json(output.numbers))
         else:

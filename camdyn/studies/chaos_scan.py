@@ -17,13 +17,15 @@ study records in the report).
 """
 from __future__ import annotations
 
+import json
 import math
 import time
 
 from camdyn.analysis.statics import contact_loss_speed
 from camdyn.model.presets import load_rig
 
-from .common import Context, StudyOutput, chaos_by_lyapunov, fmt, impact_run, md_table, parallel_map
+from .common import (Context, StudyOutput, chaos_by_lyapunov, fmt, impact_run, md_table, parallel_map,
+                     recorded_numbers, to_json)
 from .rig_fit import INITIAL, experiment_variant, identify, preset_start, unknowns
 
 NAME, TITLE = "chaos-scan", "Chaos onsets: geometry scan"
@@ -196,12 +198,12 @@ def section(numbers: dict) -> str:
     s = numbers["settings"]
     st1, st2 = numbers["stage1"], numbers["stage2"]
     runs = [f"{d}{sp:g}" for d, sp in s["stage1"]]
-    lines = _intro(s, st1) + _stage1_lines(st1, runs) + _stage2_lines(st2, s["dense"])
+    lines = _intro(s, st1, numbers.get("stage1_reused", False)) + _stage1_lines(st1, runs) + _stage2_lines(st2, s["dense"])
     lines += _conclusion(st2, s["dense"])
     return "\n".join(lines)
 
 
-def _intro(s: dict, st1: list[dict]) -> list[str]:
+def _intro(s: dict, st1: list[dict], reused: bool) -> list[str]:
     """The grid, the refit and the classifier."""
     g = s["grid"]
     return [
@@ -224,8 +226,9 @@ def _intro(s: dict, st1: list[dict]) -> list[str]:
         f"settles. *ap* = still aperiodic after {s['max_revolutions']} revolutions "
         f"(chaotic or a very long transient; no Lyapunov exponent is computed).",
         "",
-        "**Stage 1**: every geometry at the speeds that decide the paper's statements. Checks: "
-        + "; ".join(f"({i + 1}) {CHECKS[k][0]}" for i, k in enumerate(CHECKS)) + ".",
+        "**Stage 1**: every geometry at the speeds that decide the paper's statements"
+        + (" (recorded by an earlier run with the same settings, reused: `--reuse`)" if reused else "")
+        + ". Checks: " + "; ".join(f"({i + 1}) {CHECKS[k][0]}" for i, k in enumerate(CHECKS)) + ".",
         "",
     ]
 
@@ -278,8 +281,8 @@ def _stage2_lines(st2: list[dict], speeds) -> list[str]:
                        + [fmt(r["onsets_lyapunov"][d]) if r["onsets_lyapunov"][d] else "none"] for d in MODELS]
             lines.append(md_table(["Ω_c (rev/min)"] + [f"{v:g}" for v in speeds] + ["first chaotic (λ1)"], ly_rows))
         lines.append("")
-        lines.append("Paper's statements on this grid (chaos judged by λ1 where there is one, by periodicity for "
-                     "C and E): " + "; ".join(
+        lines.append("Paper's statements on this grid (chaos judged by λ1 where there is one, by periodicity "
+                     "where it is n/a): " + "; ".join(
                          f"{k}: {'yes' if v else '**no**'}" for k, v in verdict(judged(r), speeds).items()) + ".")
         lines.append("")
     return lines
@@ -296,7 +299,7 @@ def _conclusion(st2: list[dict], speeds) -> list[str]:
     again = [(i, d) for i, d in rows_ap
              if any(str(classes[i][f"{d}{sp:g}"]).startswith("P") for sp in speeds if sp > first[i][d])]
     if rows_ap:
-        lines.append(f"In stage 2 (chaos by λ1 where there is one, by periodicity for C and E), {len(rows_ap)} of "
+        lines.append(f"In stage 2 (chaos by λ1 where there is one, by periodicity where it is n/a), {len(rows_ap)} of "
                      f"{len(st2) * len(MODELS)} model rows have a chaotic speed; in {len(again)} of them a higher "
                      "speed is periodic again.")
         lines.append("")
@@ -334,8 +337,13 @@ def _conclusion(st2: list[dict], speeds) -> list[str]:
 def run(ctx: Context) -> StudyOutput:
     s = settings(ctx.fast)
     geos = geometries(s["grid"])
-    ctx.log(f"{NAME}: stage 1, {len(geos)} geometries x {len(s['stage1'])} runs")
-    st1 = parallel_map(_stage1, [(g, s["stage1"], s) for g in geos], ctx.fast)
+    st1 = _recorded_stage1(ctx, s) if ctx.reuse else None
+    reused = st1 is not None
+    if not reused:
+        ctx.log(f"{NAME}: stage 1, {len(geos)} geometries x {len(s['stage1'])} runs")
+        st1 = parallel_map(_stage1, [(g, s["stage1"], s) for g in geos], ctx.fast)
+    else:
+        ctx.log(f"{NAME}: stage 1 reused from {ctx.out / 'reproduction.md'} ({len(st1)} geometries)")
     # stage 2: the geometries meeting most checks among those reproducing every printed number
     best = sorted(range(len(st1)), key=lambda i: (not st1[i]["within_rounding"], -st1[i]["met"], i))[: s["stage2"]]
     shipped = dict(r_c=0.025, chi0=0.10, dx_ratio=1.0, theta0_offset=0.0)
@@ -343,13 +351,28 @@ def run(ctx: Context) -> StudyOutput:
     ctx.log(f"{NAME}: stage 2, {len(cand) + 1} geometries x {len(MODELS) * len(s['dense'])} runs")
     st2 = parallel_map(_stage2, [(g, s["dense"], s) for g in cand + [shipped]], ctx.fast)
     st2[-1]["shipped"] = True
-    numbers = {"settings": {**s, "stage1": [list(x) for x in s["stage1"]]},
+    numbers = {"settings": {**s, "stage1": [list(x) for x in s["stage1"]]}, "stage1_reused": reused,
                "stage1": [{k: v for k, v in r.items() if k != "seconds"} for r in st1], "stage2": st2,
                "reproduced": [r["geometry"] for r in st2 if all(r["verdict"].values())]}
     md = section(numbers)
     if ctx.write_docs:
         _update_reference_rig_doc(ctx, md)
     return StudyOutput(NAME, TITLE, md, numbers, [])
+
+
+#: the settings stage 1's results depend on: a recorded stage 1 is reused only when they agree
+STAGE1_SETTINGS = ("grid", "stage1", "revolutions", "transient", "max_revolutions")
+
+
+def _recorded_stage1(ctx: Context, s: dict) -> list[dict] | None:
+    """Stage 1 as recorded in the report by an earlier run with the same stage-1 settings, or None
+    (then it is run again)."""
+    rec = recorded_numbers(ctx.out / "reproduction.md").get(NAME)
+    if not rec:
+        return None
+    now = json.loads(to_json({**s, "stage1": [list(x) for x in s["stage1"]]}))
+    same = all(rec["settings"].get(k) == now[k] for k in STAGE1_SETTINGS)
+    return rec["stage1"] if same and len(rec["stage1"]) == len(geometries(s["grid"])) else None
 
 
 MARK_BEGIN, MARK_END = "<!-- chaos-scan begin -->", "<!-- chaos-scan end -->"

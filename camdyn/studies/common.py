@@ -92,6 +92,7 @@ class Context:
     write_docs: bool = True   # update reproduction.md / reference-rig.md
     data_dir: Path | None = None  # where reference-rig writes the presets (None: default_data_dir(out))
     log: Any = print
+    reuse: bool = False       # reuse the stages a study recorded in the report (chaos-scan's stage 1)
 
     @property
     def img(self) -> Path:

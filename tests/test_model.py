@@ -64,6 +64,36 @@ def test_rigid_contact_angle_is_alpha0_at_theta0_and_continuous():
     assert a.min() < 0 < a.max()  # both signs: the printed arccos would lose one (misprint 10)
 
 
+@pytest.mark.parametrize("preset", ["reference", "example", "translating-example"])
+def test_closed_forms_on_arrays_are_the_scalar_kernels(preset):
+    """rigid_kinematics evaluates the generated closed forms (reach, rigid_contact) on the whole
+    array of cam angles at once (camdyn.engine.kernels.on_arrays): the same values as the scalar
+    kernels angle by angle, to a few ulps (NumPy's sin and cos against libm's, 1 ulp each, through
+    the derivative's ~40 operations: 1e-12 relative)."""
+    from camdyn.model.model import static_parameters
+    rig = camdyn.load_rig(preset)
+    K = analysis._static_scene("line", rig).kernels()
+    p = static_parameters(rig, K)
+    th = rig.theta0 + np.linspace(0, 2 * math.pi, 257)
+    scalar = np.array([K.rigid_contact(t, p) for t in th]).T
+    q, curvature, load = analysis.rigid_kinematics(rig, th)
+    for got, want in ((q, scalar[0]), (curvature, scalar[2]), (load, scalar[3])):
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.max(np.abs(want)))
+    if hasattr(K, "reach"):
+        margins = np.array([K.reach(t, p) for t in th])
+        np.testing.assert_allclose(camdyn.engine.kernels.on_arrays(K.reach)(th, p), margins, rtol=1e-12)
+
+
+def test_closed_forms_on_arrays_refuse_branching_code():
+    """A kernel with a branch on its argument cannot run on an array: NumPy says so, no silent result."""
+    from camdyn.engine.kernels import on_arrays
+
+    def branching(x, p):
+        return 2.0 * x if x > 0 else 0.0
+    with pytest.raises(ValueError, match="ambiguous"):
+        on_arrays(branching)(np.linspace(-1, 1, 5), None)
+
+
 def test_energy_balance_grows_with_speed_towards_90_degrees():
     """Eqs. 31-33: alpha_p rises with speed and xi, and stays below 90 degrees (L ~ sec alpha)."""
     eq = analysis.static_equilibrium(RIG)

@@ -9,6 +9,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import signal
+from ..engine.kernels import on_arrays
 from ..model.cam import RPM, CamMotion, ConstantSpeed
 from ..model.followers import follower_of_rig, rigid_contact
 from ..errors import GeometryError, ParameterError
@@ -39,16 +40,25 @@ def rigid_kinematics(rig: Rig, theta) -> tuple[np.ndarray, np.ndarray, np.ndarra
     K = _static_scene("line", rig).kernels()
     p = static_parameters(rig, K)
     if rig.follower == "translating":
-        y_i, _, curvature, spring_force = np.array([K.rigid_contact(th, p) for th in theta]).T
+        y_i, _, curvature, spring_force = _closed_form(K.rigid_contact, theta, p, rig.profile is None)
         return y_i, curvature, spring_force
     if rig.profile is None:
-        if np.any(np.array([K.reach(th, p) for th in theta]) <= 0):
+        if np.any(_closed_form(K.reach, theta, p, True)[0] <= 0):
             raise GeometryError("the follower cannot reach the cam at some cam angle (|PG_c| < r_c + w_b/2)")
-        alpha_i, _, curvature, spring_moment = np.array([K.rigid_contact(th, p) for th in theta]).T
+        alpha_i, _, curvature, spring_moment = _closed_form(K.rigid_contact, theta, p, True)
         return alpha_i, curvature, spring_moment
     contact = rigid_contact(rig.profile, follower_of_rig(rig), theta)
     spring_moment = np.array([K.spring_moment(a, p) for a in contact.q])
     return contact.q, contact.q_ddot, spring_moment
+
+
+def _closed_form(kernel, theta: np.ndarray, p: np.ndarray, closed: bool) -> np.ndarray:
+    """The generated ``kernel(Theta, p)``'s results (rows) at the cam angles ``theta``: on the
+    whole array at once where the kernel is a closed form (``closed``: a circular cam,
+    :func:`camdyn.engine.kernels.on_arrays`), else angle by angle (a profile cam's spline)."""
+    if closed:
+        return np.array(np.broadcast_arrays(*np.atleast_1d(on_arrays(kernel)(theta, p))), dtype=float)
+    return np.array([np.atleast_1d(kernel(th, p)) for th in theta], dtype=float).T
 
 
 def static_equilibrium(rig: Rig, contact: str = "line") -> Equilibrium:

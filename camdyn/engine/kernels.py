@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from types import ModuleType
+from types import FunctionType, ModuleType
 
 import numba
 import numpy as np
@@ -170,6 +170,27 @@ def python_kernels(K: ModuleType, cam=None) -> Kernels:
     reset = getattr(K, "reset", _no_fill)
     return Kernels(_guarded(rhs), _guarded(surface), _guarded_fill(outputs), _guarded_fill(reset),
                    _guarded_fill(with_rate))
+
+
+#: NumPy's ufuncs under the names of the math functions generated code calls (it imports
+#: ``from math import *`` and calls them on floats): what :func:`on_arrays` rebinds
+_ARRAY_MATH = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos,
+               "atan": np.arctan, "atan2": np.arctan2, "sqrt": np.sqrt, "exp": np.exp, "log": np.log,
+               "fabs": np.fabs, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh}
+
+
+@lru_cache(maxsize=None)
+def on_arrays(kernel):
+    """A generated kernel of scalar arguments evaluated element-wise on arrays: the same code (the
+    function's code object, so the same expressions in the same order) with NumPy's ufuncs bound to
+    the math names it calls.  Only for a closed form: straight-line code of arithmetic and those
+    functions (``reach``, ``rigid_contact`` and ``spring_moment`` of a circular cam); code with a
+    branch on its arguments raises NumPy's "truth value of an array is ambiguous", a profile
+    cam's spline evaluator among them.  Where math would raise (asin or sqrt out of its domain)
+    the result is NaN, and NumPy warns.  Results may differ from the scalar kernel's by an ulp
+    (NumPy's sin, not libm's)."""
+    scope = {**kernel.__globals__, **_ARRAY_MATH}
+    return FunctionType(kernel.__code__, scope, kernel.__name__, kernel.__defaults__, kernel.__closure__)
 
 
 @njit(cache=True, error_model="numpy")

@@ -112,6 +112,18 @@ def test_two_rig_parameters_need_a_speed_and_the_chart_a_rig_parameter():
         jump_chart(RIG, SCENE, "speed_rpm", 900.0, 1000.0)
     with pytest.raises(ParameterError, match="gap_tol"):
         GrazingSettings(gap_tol=0.5)
+    for threads in (0, 1.5, True):
+        with pytest.raises(ParameterError, match="threads"):
+            GrazingSettings(threads=threads)
+
+
+def test_threads_run_the_same_curve_bit_for_bit():
+    """A point's independent runs (the tangent dynamics and the two parameter differences) on two
+    threads (GrazingSettings.threads) are the runs made in turn: the same curve, to the bit."""
+    curves = [jump_chart(RIG, SCENE, "k_s", 2000.0, 2060.0, settings=GrazingSettings(threads=n)) for n in (1, 2)]
+    assert curves[0].sizes["point"] >= 3
+    for name in ("speed_rpm", "k_s", "alpha", "alpha_dot", "grazing_gap", "multiplier_real", "multiplier_imag"):
+        np.testing.assert_array_equal(curves[0][name].values, curves[1][name].values)
 
 
 def test_no_grazing_in_the_search_range_ends_the_curve_at_its_start():

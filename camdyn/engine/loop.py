@@ -322,7 +322,7 @@ RAW_FIELDS = ("outcome", "n_samples", "switch_buffer", "n_switches", "nfev", "st
 #: differ from the helpers' (it has a Python wrapper): so run calls no helper that another
 #: helper also calls (allocations in _buffers, the ledger through _account, the interpolant's
 #: restart state in _restart_state), else that helper is compiled twice
-_run_compiled = njit(cache=True, error_model="numpy")(run)
+_run_compiled = njit(cache=True, nogil=True, error_model="numpy")(run)
 
 
 #: the compiled loop's machine-code entry per layout of its arguments (:func:`_layout`), found by

@@ -117,7 +117,7 @@ def _stages(rhs, jacobian, p, m, t, t0, y, h, method, look_ahead, K, z, jac):
         augmented_field(rhs, jacobian, p, m, t + coef[method.c_row, s] * h, z, t0, look_ahead, jac, K[s])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")   # nogil: the grazing curve runs it beside other runs
 def integrate_segment(rhs, jacobian, p, m, t0, t_end, y, rtol, atol, method, look_ahead, control):
     """y (N_AUGMENTED) at t_end from y at t0 in mode m, the step size set by ``control`` (a
     :class:`~camdyn.engine.config.StepControl`); returns (y, ok)."""

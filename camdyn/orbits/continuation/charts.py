@@ -102,7 +102,7 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     _settings(settings, GrazingSettings)
     system = GrazingSystem(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
                            options, backend, free_start=float(search[0]), deflection=math.nan,
-                           tol=settings.continuation.tol, gap_tol=settings.gap_tol)
+                           tol=settings.continuation.tol, gap_tol=settings.gap_tol, threads=settings.threads)
     system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
     system.model(float(search[1]), system.end)
     curve, layout, system = _curve(system, search, settings, warmup_revolutions)

@@ -43,7 +43,9 @@ derivation), at the steps of :func:`camdyn.orbits.derivatives.finite_difference_
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -84,13 +86,14 @@ RATE_TOL = 0.1
 class GrazingSystem(TwoParameters):
     """What is continued (:class:`.problem.TwoParameters`), with lambda1 at the start
     (``free_start``), the gap's scale d (``deflection``, m, :func:`gap_maximum`), the
-    corrector's tolerance ``tol`` on the scaled residual and the gap's ``gap_tol`` (a fraction
-    of d)."""
+    corrector's tolerance ``tol`` on the scaled residual, the gap's ``gap_tol`` (a fraction
+    of d) and the ``threads`` :func:`derivatives` runs its independent runs on."""
 
     free_start: float
     deflection: float
     tol: float = 1e-8
     gap_tol: float = 1e-6
+    threads: int = 1
 
     def section_map(self, free: float, lam: float, mode: int | None) -> StroboscopicMap:
         model = self.model(free, lam)
@@ -197,16 +200,31 @@ def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Eval
     (not at the rule's first step, which a grazing orbit lifts off at on both sides: 2-4 runs
     per column instead of ~6; starting at the step itself, the steps only shrink along the
     curve, and on reference-experiment against k_s the curve took 48 orbits instead of 38);
-    ``strict``: False at a corrector's iterate (:func:`contact_side_difference`)."""
+    ``strict``: False at a corrector's iterate (:func:`contact_side_difference`).  The tangent
+    dynamics and the two differences are independent runs: they run on ``system.threads``
+    threads at once (the same numbers as in turn: each run is the same computation).  A failure
+    raises from the first of them that failed, in that order: the tangent dynamics, then each
+    column."""
     A = np.zeros((N_STATE + 2, G_SIZE))
-    *window, M = _fundamental(base, layout.split(z)[0])
+    columns = ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range))
+
+    def parameter_column(column: int, index: int):
+        first = None if previous is None else SHRINK * float(previous[column])
+        return _parameter_column(system, layout, z, base, index, first, strict)
+    tasks = [partial(_fundamental, base, layout.split(z)[0])] + [
+        partial(parameter_column, column, index) for column, index, _ in columns]
+    if system.threads > 1:
+        with ThreadPoolExecutor(system.threads) as pool:      # the compiled loop releases the GIL
+            futures = [pool.submit(task) for task in tasks]
+            (*window, M), *found = [f.result() for f in futures]
+    else:
+        (*window, M), *found = [task() for task in tasks]
     A[:, G_STATE] = _state_columns(system, layout, base, M, window)
     A[:, G_PHASE] = _phase_column(system, base)
     steps, notes = np.empty(2), []
-    for column, index, sigma in ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range)):
-        first = None if previous is None else SHRINK * float(previous[column])
-        d, steps[column], note = _parameter_column(system, layout, z, base, index, first, strict)
+    for (column, index, sigma), (d, step, note) in zip(columns, found):
         A[:, index] = d * sigma
+        steps[column] = step
         if note:
             notes.append(f"d/d{(system.free, system.parameter)[column]}: {note}")
     if not np.all(np.isfinite(A)):

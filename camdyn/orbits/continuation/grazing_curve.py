@@ -67,11 +67,14 @@ class GrazingSettings:
     ``search``: the one-parameter continuation that finds the first grazing (its orbit only
     starts the extended system's Newton, which locates the grazing itself: a coarse one);
     ``gap_tol``: the gap's tolerance, a fraction of the largest deflection over the first orbit
-    (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it)."""
+    (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it); ``threads``:
+    how many of a point's independent runs (the tangent dynamics and the two parameter
+    differences, :func:`.grazing.derivatives`) run at once; the curve is the same for any value."""
 
     continuation: ContinuationSettings = ContinuationSettings(switch_depth=0)
     gap_tol: float = 1e-6
     search: ContinuationSettings = ContinuationSettings(step=0.05, max_step=0.25, locate_tol=1e-5, switch_depth=0)
+    threads: int = 2
 
     def __post_init__(self):
         for name in ("continuation", "search"):
@@ -79,6 +82,8 @@ class GrazingSettings:
                 raise ParameterError(name, getattr(self, name), "a camdyn.orbits.continuation.ContinuationSettings")
         real("gap_tol", self.gap_tol, "1e-12 <= gap_tol <= 1e-2 (of the largest deflection over the orbit)",
              lambda v: 1e-12 <= v <= 1e-2)
+        if not (isinstance(self.threads, int) and not isinstance(self.threads, bool) and 1 <= self.threads <= 64):
+            raise ParameterError("threads", self.threads, "an integer from 1 to 64")
 
 
 class GrazingPoint(NamedTuple):

@@ -144,3 +144,30 @@ def test_damping_laws_without_tangent_dynamics_get_an_exponent_and_a_verdict(by_
     assert math.isfinite(d.largest) and abs(d.delta_difference) < d.standard_error
     verdict = chaos_by_lyapunov(CHAOS_RIG, damping, CHAOS_SPEED, CHAOS.transient, CHAOS.revolutions, CHAOS.batches)
     assert verdict["lyapunov_method"] == "differences" and verdict["chaos"] == "chaotic"
+
+
+def test_a_stable_orbit_of_damping_C_is_regular_at_both_distances():
+    """Below the contact-loss speed (130 rev/min on reference-experiment) damping C's follower
+    rides the cam on a stable period-1 orbit: both neighbours of the two-run estimate sink
+    towards it, the estimate is negative at delta and at 10 delta by many standard errors,
+    whatever its size there (which the distance sets: the runs' error floor over delta), and
+    the verdict is regular (the chaos tables' C and E rows at 140-145 rev/min)."""
+    from camdyn.model.model import Model
+    from camdyn.orbits.lyapunov import largest_by_differences
+
+    scene = camdyn.Scene(contact="line", damping="C", friction="coulomb")
+    d = largest_by_differences(Model(CHAOS_RIG, scene, camdyn.ConstantSpeed(110.0)),
+                               LyapunovSettings(revolutions=20, transient=20, batches=5))
+    assert d.largest < -3 * d.standard_error and d.at_ten_delta < -3 * d.standard_error
+    assert d.verdict(3.0) == "regular"
+
+
+def test_the_two_run_verdict_holds_only_where_both_distances_agree():
+    """The rule of DifferenceEstimate.verdict on made-up estimates: a sign that flips between the
+    two distances, or an estimate within the bound of zero, is undecided."""
+    from camdyn.orbits.lyapunov import DifferenceEstimate
+
+    def verdict(at_delta, at_ten_delta, se=0.1):
+        return DifferenceEstimate(at_delta, se, at_ten_delta, 100, 100, 0.4, 1e-7).verdict(3.0)
+    assert verdict(2.0, 2.5) == "chaotic" and verdict(-13.6, -20.0) == "regular"
+    assert verdict(2.0, -2.0) == "undecided" and verdict(2.0, 0.2) == "undecided" and verdict(-0.2, -5.0) == "undecided"

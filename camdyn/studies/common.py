@@ -362,7 +362,7 @@ def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revol
     cannot (damping C and E: their impact law's Jacobian is unbounded at first contact,
     camdyn.orbits.tangent), from two neighbouring runs (``method`` "differences",
     camdyn.orbits.lyapunov.largest_by_differences), whose distance's effect on the exponent must
-    then be below one standard error, else the verdict is *undecided*."""
+    then not change the verdict (:meth:`camdyn.orbits.lyapunov.DifferenceEstimate.verdict`)."""
     from camdyn.model.model import Model
     from camdyn.orbits.lyapunov import LyapunovSettings, largest_by_differences, lyapunov_exponents
     from camdyn.orbits.tangent import TangentFailure
@@ -371,13 +371,13 @@ def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revol
     settings = LyapunovSettings(revolutions=revolutions, transient=transient, batches=batches)
     try:
         ly = lyapunov_exponents(rig, scene, speed_rpm=speed_rpm, settings=settings)
-        lam, se, period, method, settled = ly.largest, float(ly.standard_error[0]), ly.period, "variational", True
+        lam, se, period, method = ly.largest, float(ly.standard_error[0]), ly.period, "variational"
+        verdict = ("chaotic" if lam > CONFIDENCE_SE * se else "regular" if lam < -CONFIDENCE_SE * se
+                   else "undecided")
     except TangentFailure:
         d = largest_by_differences(Model(rig, scene, camdyn.ConstantSpeed(speed_rpm)), settings)
         lam, se, period, method = d.largest, d.standard_error, d.period, "differences"
-        settled = abs(d.delta_difference) <= se
-    verdict = ("undecided" if not settled else "chaotic" if lam > CONFIDENCE_SE * se
-               else "regular" if lam < -CONFIDENCE_SE * se else "undecided")
+        verdict = d.verdict(CONFIDENCE_SE)
     return {"lyapunov": lam, "lyapunov_se": se, "lyapunov_per_rev": lam * period, "chaos": verdict,
             "lyapunov_method": method}
 

@@ -124,9 +124,10 @@ class Result:
 
     def impacts(self) -> np.ndarray:
         """Times at which contact starts (a switch from a free mode to a contact mode), and the rigid
-        contact's impacts (a switch through the gap from free flight back into it: the bounce)."""
+        contact's impacts (a switch whose reset is Newton's impact law, back into free flight: the
+        bounce; ``meta["impact_transitions"]``, camdyn.engine.impact_transitions)."""
         before, after = self._contact_across_switches()
-        bounce = ~before & ~after & (self.switches.surface == "gap")
+        bounce = np.isin(self.switches.records["transition"], self.meta.get("impact_transitions", ()))
         return self.switches.t[(~before & after) | bounce]
 
     def separations(self) -> np.ndarray:

@@ -7,7 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..engine import SolverOptions, Switches, Trajectory, integrate, transition_surfaces
+from ..engine import SolverOptions, Switches, Trajectory, impact_transitions, integrate, transition_surfaces
 from ..errors import CamdynError, ParameterError
 from ..model.cam import CamMotion, cam_motion
 from ..model.model import Model
@@ -201,7 +201,7 @@ def _result(model: Model, traj, backend: str) -> Result:
     return Result(t, alpha, alpha_dot, theta, traj.regime.astype(str), outputs, traj.switches,
                   traj.outcome, traj.stats, model.period, model.scene.slug, model.equilibrium.q,
                   {"rig": model.rig.name, "cam": model.cam, "contact": contact, "follower": follower,
-                   "coordinate": COORDINATES[follower][0]})
+                   "coordinate": COORDINATES[follower][0], "impact_transitions": impact_transitions(K)})
 
 
 #: Result.outputs' names of the energy ledger's works of FLOWS (P_in, D_c, D_f), in that order

@@ -10,6 +10,7 @@ import numpy as np
 
 import camdyn
 from camdyn.analysis.statics import contact_loss_speed
+from camdyn.engine import impact_transitions
 from camdyn.model.presets import second_rig
 
 from .common import Context, StudyOutput, figure, fmt, md_table, parallel_map, save, simulate
@@ -35,19 +36,16 @@ def _run(args) -> dict:
     section = r.q[::per_turn][revolutions - kept:revolutions].tolist()
     model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(speed))
     K = SCENE.kernels()
-    impacts, leaves = [], []
-    for s in r.switches:
-        if s.t < keep_from:
-            continue
-        if s.surface == "gap" and s.before == "free" and s.after == "free":
-            approach = -model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s.t, s.alpha, s.alpha_dot) / rig.xi
-            if approach < -0.5:
-                impacts.append(s.t)
-        elif s.before == "contact" and s.after == "free":
-            leaves.append(s.t)
+    kept_switches = r.switches.records[r.switches.t >= keep_from]
+    bounces = kept_switches[np.isin(kept_switches["transition"], impact_transitions(K))]
+    # the state recorded is the one after the reset: the approach is the rate before it, -1/xi times
+    approach = np.array([-model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s["t"], s["alpha"], s["alpha_dot"]) / rig.xi
+                         for s in bounces])
+    impacts = bounces["t"][approach < -0.5] if bounces.size else np.empty(0)
+    leaves = kept_switches["t"][(kept_switches["before"] == K.MODE_CONTACT) & (kept_switches["after"] == K.MODE_FREE)]
     return {"speed_rpm": speed, "outcome": r.outcome.name, "section": section,
-            "impact_deg": _cam_angle_deg(rig, np.array(impacts), speed).tolist(),
-            "leave_deg": _cam_angle_deg(rig, np.array(leaves), speed).tolist()}
+            "impact_deg": _cam_angle_deg(rig, impacts, speed).tolist(),
+            "leave_deg": _cam_angle_deg(rig, leaves, speed).tolist()}
 
 
 def _junctions_deg(rig) -> list[float]:

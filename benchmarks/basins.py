@@ -2,6 +2,7 @@
 
     python benchmarks/basins.py                 # 100 x 100, writes docs/img/basins_125rpm.png
     python benchmarks/basins.py --n 20          # a smaller map (a smoke run)
+    python benchmarks/basins.py --speed-rpm 159 --damping D --n 40    # a coexistence of Figs. 4-5
 
 The map: ``camdyn.basins`` on the ``reference-experiment`` preset (line contact 16 mm, damping D,
 Coulomb friction, the experiment's k_s) at 125 rev/min, between the flight orbit's fold (116.2
@@ -29,32 +30,37 @@ from camdyn.model.presets import load_rig
 from camdyn.sweep import process_pool
 from camdyn.sweep.attractors import attractor_table
 
-SPEED_RPM = 125.0
-SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
-IMG = Path(__file__).resolve().parent.parent / "docs" / "img" / "basins_125rpm.png"
+IMG = Path(__file__).resolve().parent.parent / "docs" / "img"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=100, help="starts per axis (default 100)")
+    parser.add_argument("--speed-rpm", type=float, default=125.0, help="cam speed (default 125 rev/min)")
+    parser.add_argument("--damping", default="D", help="damping model A-E (default D)")
+    parser.add_argument("--lyapunov-revolutions", type=int, default=0,
+                        help="revolutions of the largest Lyapunov exponent of a start that does not settle "
+                             "(default 0: none; not for damping C and E)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--no-figure", action="store_true")
     parser.add_argument("--keep", metavar="FILE.nc", help="write the map to FILE.nc (default: a temporary file)")
     args = parser.parse_args()
     warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
     rig = load_rig("reference-experiment")
+    speed, scene = args.speed_rpm, camdyn.Scene(contact="line", damping=args.damping, friction="coulomb")
     a_star = camdyn.static_equilibrium(rig).alpha
-    camdyn.simulate(rig, SCENE, speed_rpm=SPEED_RPM, revolutions=1)   # the compiled loop loaded before timing
+    camdyn.simulate(rig, scene, speed_rpm=speed, revolutions=1)   # the compiled loop loaded before timing
     alpha = a_star + np.linspace(0.0, 0.5, args.n)
     alpha_dot = np.linspace(-3.0, 3.0, args.n)
     load0 = os.getloadavg()
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp, process_pool(args.workers) as pool:
-        ds = camdyn.basins(rig, SCENE, alpha=alpha, alpha_dot=alpha_dot, speed_rpm=SPEED_RPM, executor=pool,
-                           out=args.keep or Path(tmp) / "basins.nc", overwrite=True, progress=False)
+        ds = camdyn.basins(rig, scene, alpha=alpha, alpha_dot=alpha_dot, speed_rpm=speed, executor=pool,
+                           out=args.keep or Path(tmp) / "basins.nc", overwrite=True, progress=False,
+                           lyapunov_revolutions=args.lyapunov_revolutions)
     wall = time.perf_counter() - t0
     load1 = os.getloadavg()
-    print(f"{args.n} x {args.n} basin map at {SPEED_RPM:g} rev/min: {wall:.1f} s wall on {args.workers} workers "
+    print(f"{args.n} x {args.n} basin map at {speed:g} rev/min, damping {args.damping}: {wall:.1f} s wall on {args.workers} workers "
           f"({os.cpu_count()} cores; load average {load0[0]:.2f} before, {load1[0]:.2f} after)")
     print(f"revolutions integrated: {ds.attrs['revolutions_run_total']:.0f} of {ds.attrs['revolutions_requested_total']:.0f};"
           f" {wall / ds.attrs['points'] * 1e3:.1f} ms per point")
@@ -62,9 +68,11 @@ def main() -> None:
         print(row)
     if not args.no_figure:
         from camdyn.io import plots
-        fig = plots.basin_map(ds, title=f"basins at {SPEED_RPM:g} rev/min, reference-experiment, damping D")
-        fig.savefig(IMG)
-        print(f"wrote {IMG}")
+        fig = plots.basin_map(ds, title=f"basins at {speed:g} rev/min, reference-experiment, damping {args.damping}")
+        suffix = "" if args.damping == "D" else f"_{args.damping}"
+        path = IMG / f"basins_{speed:g}rpm{suffix}.png"
+        fig.savefig(path)
+        print(f"wrote {path}")
 
 
 if __name__ == "__main__":

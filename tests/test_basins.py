@@ -245,3 +245,29 @@ def test_the_basins_command_prints_the_attractor_table(tmp_path, capsys):
     assert nc.is_file() and png.is_file()
     assert main(["--no-progress", "sweep", "--resume", str(nc)]) == 0      # a finished map reads back
     assert "2 attractors" in capsys.readouterr().out
+
+
+def test_two_run_estimates_must_agree_for_a_chaotic_verdict():
+    """Damping C and E: lambda_1 by two neighbouring runs at two distances (lyapunov and
+    lyapunov_check); a start is chaotic only where both are above chaos_se standard errors
+    (camdyn.orbits.lyapunov.verdict), else not settled."""
+    ds, spec = _synthetic(ROWS)
+    check = ds["lyapunov"].values.copy()
+    check[1, 1] = 0.1                        # the chaotic row's second estimate: 1 se, no verdict
+    ds["lyapunov_check"] = (("alpha_start", "alpha_dot_start"), check)
+    codes, _ = LabelAttractors().label(ds, spec)
+    assert codes[5] == NOT_SETTLED
+    ds["lyapunov_check"] = ds["lyapunov"]
+    assert LabelAttractors().label(ds, spec)[0][5] == CHAOTIC
+
+
+def test_a_chaotic_start_under_damping_C_gets_its_exponent_from_two_runs():
+    """Damping C cannot run the tangent dynamics past first contact: the exponent of a start that
+    does not settle comes from two neighbouring runs (tests/test_lyapunov.py measured 1.59 +- 0.28
+    1/s at 196 rev/min over 100 revolutions), and the start is chaotic where both distances agree."""
+    scene = camdyn.Scene(contact="line", damping="C", friction="coulomb")
+    ds = basins(RIG, scene, alpha=[A_STAR], alpha_dot=[0.0], speed_rpm=196.0, revolutions=60,
+                lyapunov_revolutions=60, progress=False)
+    assert (ds["stop_period"].values == 0).all()
+    assert np.isfinite(ds["lyapunov"].values).all() and np.isfinite(ds["lyapunov_check"].values).all()
+    assert (ds["attractor"].values == CHAOTIC).all()

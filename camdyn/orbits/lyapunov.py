@@ -168,20 +168,28 @@ class DifferenceEstimate:
         return self.largest - self.at_ten_delta
 
     def verdict(self, confidence: float) -> str:
-        """'chaotic' where both estimates (at ``delta`` and 10 ``delta``) are positive by
-        ``confidence`` standard errors, 'regular' where both are negative by as many, else
-        'undecided'.  The neighbour's distance may change the estimate's size (on a strongly
+        """:func:`verdict` of both estimates (at ``delta`` and 10 ``delta``): 'chaotic' where both
+        are positive by ``confidence`` standard errors, 'regular' where both are negative by as
+        many, else 'undecided'.  The neighbour's distance may change the estimate's size (on a strongly
         contracting orbit the neighbour sinks to the runs' error floor within a revolution, and
         the estimate measures that floor's ratio to delta: in the chaos scan of docs/reproduction.md
         a period-1 orbit of damping C at 140 rev/min gave -13.6 +- 0.24 1/s at delta and a
         different value at 10 delta), but a verdict that holds at both distances does not depend
         on it."""
-        bound = confidence * self.standard_error
-        if min(self.largest, self.at_ten_delta) > bound:
-            return "chaotic"
-        if max(self.largest, self.at_ten_delta) < -bound:
-            return "regular"
-        return "undecided"
+        return verdict((self.largest, self.at_ten_delta), self.standard_error, confidence)
+
+
+def verdict(estimates, standard_error: float, confidence: float) -> str:
+    """The chaos verdict of one or more estimates of lambda_1 with the standard error of their
+    batch means: 'chaotic' where every estimate is positive by ``confidence`` standard errors,
+    'regular' where every one is negative by as many, else 'undecided' (NaN estimates: undecided)."""
+    values = np.asarray(estimates, dtype=float)
+    bound = confidence * standard_error
+    if values.size and np.all(values > bound) and np.all(values > 0):
+        return "chaotic"
+    if values.size and np.all(values < -bound) and np.all(values < 0):
+        return "regular"
+    return "undecided"
 
 
 def largest_by_differences(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=None,

@@ -365,6 +365,7 @@ def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revol
     then not change the verdict (:meth:`camdyn.orbits.lyapunov.DifferenceEstimate.verdict`)."""
     from camdyn.model.model import Model
     from camdyn.orbits.lyapunov import LyapunovSettings, largest_by_differences, lyapunov_exponents
+    from camdyn.orbits.lyapunov import verdict as chaos_verdict
     from camdyn.orbits.tangent import TangentFailure
 
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
@@ -372,8 +373,7 @@ def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revol
     try:
         ly = lyapunov_exponents(rig, scene, speed_rpm=speed_rpm, settings=settings)
         lam, se, period, method = ly.largest, float(ly.standard_error[0]), ly.period, "variational"
-        verdict = ("chaotic" if lam > CONFIDENCE_SE * se else "regular" if lam < -CONFIDENCE_SE * se
-                   else "undecided")
+        verdict = chaos_verdict((lam,), se, CONFIDENCE_SE)
     except TangentFailure:
         d = largest_by_differences(Model(rig, scene, camdyn.ConstantSpeed(speed_rpm)), settings)
         lam, se, period, method = d.largest, d.standard_error, d.period, "differences"

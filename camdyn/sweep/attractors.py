@@ -19,8 +19,9 @@ What a point reached (:class:`AttractorSection`, in the worker):
 * **chaotic**: it did not settle within ``revolutions``, and its largest Lyapunov exponent
   (:func:`camdyn.orbits.lyapunov.spectrum`, from its last section point at an even revolution,
   over ``lyapunov_revolutions``) is positive by more than ``chaos_se`` standard errors; only
-  with ``lyapunov_revolutions`` > 0, and only where the tangent dynamics run (not damping C
-  and E: :mod:`camdyn.orbits.tangent`);
+  with ``lyapunov_revolutions`` > 0; where the tangent dynamics cannot pass first contact
+  (damping C and E: :mod:`camdyn.orbits.tangent`) the exponent is estimated by two neighbouring
+  runs at two distances, and both estimates must say so (:func:`camdyn.orbits.lyapunov.verdict`);
 * **not settled**: neither (a long transient, a period above ``stop.max_period``, or chaos
   with no exponent);
 * **no run**: the run did not succeed (its ``outcome`` says why).
@@ -91,7 +92,9 @@ class AttractorSection:
         "cycle_alpha_dot": ("alpha_dot at the section t = k T over the converged cycle (as cycle_alpha)", "rad/s"),
         "lyapunov": ("largest Lyapunov exponent of a run that did not settle (NaN: not computed, or no tangent "
                      "dynamics)", "1/s"),
-        "lyapunov_se": ("standard error of lyapunov (batch means)", "1/s")}
+        "lyapunov_se": ("standard error of lyapunov (batch means)", "1/s"),
+        "lyapunov_check": ("a second estimate of lyapunov: by two neighbouring runs (damping C, E), the one at "
+                           "10 times the neighbour's distance; else lyapunov itself", "1/s")}
 
     def __post_init__(self):
         integer("max_period", self.max_period, "an integer >= 1", lambda n: n >= 1)
@@ -103,7 +106,7 @@ class AttractorSection:
                                  f"a multiple of lyapunov_batches = {self.lyapunov_batches}")
 
     def __call__(self, result, inputs) -> dict:
-        out = {"lyapunov": math.nan, "lyapunov_se": math.nan}
+        out = {"lyapunov": math.nan, "lyapunov_se": math.nan, "lyapunov_check": math.nan}
         if not result.ok or result.t.size == 0:
             return {**out, "cycle_alpha": ("cycle", []), "cycle_alpha_dot": ("cycle", [])}
         p = int(result.stats.get("stop_period", 0))
@@ -117,20 +120,28 @@ class AttractorSection:
 
     def _lyapunov(self, result, inputs) -> dict:
         """lambda_1 from the last section point at an even revolution (the kernels' period is 2 T,
-        so that state is a start at t = 0), NaN where the tangent dynamics cannot run."""
-        from ..orbits.lyapunov import LyapunovSettings, spectrum
+        so that state is a start at t = 0): by the tangent dynamics, or where they cannot pass
+        first contact (damping C, E) by two neighbouring runs at two distances
+        (:func:`camdyn.orbits.lyapunov.largest_by_differences`); NaN where neither runs."""
+        from ..orbits.lyapunov import LyapunovSettings, largest_by_differences, spectrum
+        from ..orbits.tangent import TangentFailure
 
         k = (result.t.size - 1) // 2 * 2
         settings = LyapunovSettings(self.lyapunov_revolutions, 0, self.lyapunov_batches)
+        start, options, backend = (result.q[k], result.q_dot[k]), inputs.request.options, inputs.request.backend
         try:
             model = Model(inputs.rig, inputs.scene, inputs.cam)
-            found = spectrum(model, settings, (result.q[k], result.q_dot[k]), inputs.request.options,
-                             inputs.request.backend)
-        except Exception as exc:  # no tangent dynamics here (damping C, E...): no verdict
+            try:
+                found = spectrum(model, settings, start, options, backend)
+                lam = found.largest
+                return {"lyapunov": lam, "lyapunov_se": float(found.standard_error[0]), "lyapunov_check": lam}
+            except TangentFailure:
+                d = largest_by_differences(model, settings, start, options, backend)
+                return {"lyapunov": d.largest, "lyapunov_se": d.standard_error, "lyapunov_check": d.at_ten_delta}
+        except Exception as exc:  # a run that fails from here: no verdict
             if _interrupted(exc):
                 raise KeyboardInterrupt from exc
             return {}
-        return {"lyapunov": found.largest, "lyapunov_se": float(found.standard_error[0])}
 
 
 @dataclass(frozen=True)
@@ -167,12 +178,15 @@ class LabelAttractors:
 
     def label(self, ds, spec: SweepSpec) -> tuple[np.ndarray, list[dict]]:
         """(the code of every point in flat order, the attractors found: dicts in id order)."""
+        from ..orbits.lyapunov import verdict as chaos_verdict
         n = spec.size
         outcome = ds["outcome"].values.reshape(n)
         period = np.nan_to_num(ds["stop_period"].values.reshape(n)).astype(int)
         alpha = ds["cycle_alpha"].values.reshape(n, -1)
         alpha_dot = ds["cycle_alpha_dot"].values.reshape(n, -1)
         lam, se = ds["lyapunov"].values.reshape(n), ds["lyapunov_se"].values.reshape(n)
+        # (a map streamed before lyapunov_check was recorded: its one estimate)
+        check = ds["lyapunov_check"].values.reshape(n) if "lyapunov_check" in ds else lam
         others = [k for k, name in enumerate(spec.names) if name not in STATE_NAMES]
         codes = np.full(n, NO_RUN, dtype=np.int32)
         table: list[dict] = []
@@ -182,7 +196,7 @@ class LabelAttractors:
                 continue
             p = period[index]
             if p <= 0:
-                chaotic = np.isfinite(lam[index]) and lam[index] > self.chaos_se * se[index] and lam[index] > 0
+                chaotic = chaos_verdict((lam[index], check[index]), se[index], self.chaos_se) == "chaotic"
                 codes[index] = CHAOTIC if chaotic else NOT_SETTLED
                 continue
             group = tuple(where[k] for k in others)

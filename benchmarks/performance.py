@@ -20,6 +20,8 @@ C B A, ...) so that a busy spell of the machine falls on all of them alike.
 * Start-up: cold (empty numba cache) and warm, each in fresh processes.
 * Sweeps (optional): the bifurcation diagram and contact-loss map timed with camdyn.sweep.api; the
   diagram stopping once periodic and shooting from the quasi-static warm start (sweep_stop.py).
+* Kept as they are: the sections other scripts write with ``--report`` (jump_chart.py,
+  second_rig_peers.py, basins.py; perf/sections.py), after the rest.
 
 The script is this entry point; its parts are in benchmarks/perf/: what is measured (cases.py,
 peers.py, precision.py, engine_costs.py, timing.py), the report's text (report.py) and its
@@ -40,6 +42,7 @@ from perf.figures import plot_case, plot_floor, plot_sweeps
 from perf.peers import peers_available
 from perf.precision import measure_case
 from perf.report import write_report
+from perf.sections import kept_sections
 from perf.timing import start_times, sweep_timing
 
 
@@ -78,7 +81,9 @@ def main(argv=None) -> int:
              "floor": fs, "starts": starts, "results": results, "sweeps": sw, "profiles": profiles,
              "cam_floor": cam_floor}
     text = write_report(parts, cfg)
-    (DOCS / "performance.md").write_text(text + "\n")
+    report = DOCS / "performance.md"
+    kept = kept_sections(report.read_text(encoding="utf-8")) if report.exists() else ""
+    report.write_text(text + ("\n\n" + kept if kept else "") + "\n")
     print(text)
     return 0
 

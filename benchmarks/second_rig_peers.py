@@ -32,6 +32,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from second_rig_exact import Rig as ExactRig, sample, solve  # noqa: E402
 
 import camdyn  # noqa: E402
+from camdyn.engine import impact_transitions  # noqa: E402
 from camdyn.model.presets import second_rig  # noqa: E402
 
 SCENE = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
@@ -56,16 +57,15 @@ def camdyn_run(rig, speed_rpm: float, revolutions: int, rtol: float, repeats: in
 
 def approach_speeds(rig, result) -> tuple[np.ndarray, np.ndarray]:
     """The impacts' times and their relative approach speeds (Newton's law: psi_i_dot- = -psi_i_dot+ / xi,
-    the rate after read from the switch's state under the free mode's laws)."""
+    the rate after read from the switch's state under the free mode's laws); the impacts are the
+    switches whose reset is the impact law (camdyn.engine.impact_transitions)."""
     model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(result.meta["cam"].speed_rpm))
     K = SCENE.kernels()
-    times, speeds = [], []
-    for s in result.switches:
-        if s.surface == "gap" and s.before == "free":
-            after = model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s.t, s.alpha, s.alpha_dot)
-            times.append(s.t)
-            speeds.append(-after / rig.xi if s.after == "free" else 0.0)
-    return np.array(times), np.array(speeds)
+    records = result.switches.records
+    bounces = records[np.isin(records["transition"], impact_transitions(K))]
+    after = np.array([model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, r["t"], r["alpha"], r["alpha_dot"])
+                      for r in bounces])
+    return bounces["t"].copy(), -after / rig.xi if bounces.size else np.empty(0)
 
 
 def errors(reference: np.ndarray, times: np.ndarray) -> tuple[float, float]:
@@ -76,41 +76,9 @@ def errors(reference: np.ndarray, times: np.ndarray) -> tuple[float, float]:
     return float(np.median(d)), float(np.max(d))
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--speed-rpm", type=float, default=256.0)
-    ap.add_argument("--revolutions", type=int, default=30)
-    ap.add_argument("--siconos", help="a JSON of benchmarks/siconos_cam_follower.py (law flat, same speed)")
-    ap.add_argument("--run-siconos", metavar="JSON", help="run the Siconos peer now (/usr/bin/python3, its steps "
-                    "1e-3 .. 3e-6 s), in this run, into JSON, and compare with it")
-    args = ap.parse_args()
-    if args.run_siconos:
-        import subprocess
-        here = os.path.dirname(os.path.abspath(__file__))
-        subprocess.run(["/usr/bin/python3", os.path.join(here, "siconos_cam_follower.py"), "--law", "flat",
-                        "--speed-rpm", f"{args.speed_rpm:g}", "--revolutions", str(args.revolutions), "--steps",
-                        "1e-3", "3e-4", "1e-4", "3e-5", "1e-5", "3e-6", "--out", args.run_siconos], check=True,
-                       stdout=subprocess.DEVNULL)
-        args.siconos = args.run_siconos
-    warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
-    exact = ExactRig("flat", args.speed_rpm)
-    period = 60.0 / args.speed_rpm
-    impacts, pieces = solve(exact, args.revolutions * period)
-    rig = second_rig()
-    v_min = 0.5
-    siconos = None
-    if args.siconos:
-        siconos = json.load(open(args.siconos))
-        meta = siconos["meta"]
-        if (meta["law"], meta["speed_rpm"], meta["revolutions"]) != ("flat", args.speed_rpm, args.revolutions):
-            raise SystemExit(f"{args.siconos} is not the flat law at {args.speed_rpm} rev/min over {args.revolutions}")
-        v_min = meta["v_min"]
-    reference = np.array([t for t, v, _ in impacts if v < -v_min])
-    section_deg = siconos["meta"]["section_deg"] if siconos else 130.0
-    print(f"second rig, flat face, {args.speed_rpm:g} rev/min, {args.revolutions} revolutions: {reference.size} exact "
-          f"impacts faster than {v_min} m/s; section at {section_deg:g} deg; load {os.getloadavg()[0]:.2f}")
-    print("| peer | setting | wall (s) | impacts | impact-time error median (s) | max (s) | section y error max (m) |")
-    print("|---|---|---|---|---|---|---|")
+def camdyn_rows(rig, exact, pieces, reference, args, v_min: float, section_deg: float) -> list[str]:
+    """camdyn's rows of the table: each tolerance's least wall time and errors."""
+    period, rows = 60.0 / args.speed_rpm, []
     for rtol in RTOLS:
         wall, result = camdyn_run(rig, args.speed_rpm, args.revolutions, rtol)
         times, speeds = approach_speeds(rig, result)
@@ -119,18 +87,81 @@ def main() -> None:
         sec_t = (np.arange(args.revolutions) + section_deg / 360) * period
         exact_u, _ = sample(exact, pieces, sec_t)
         index = np.rint((sec_t + period / 4) / period * SAMPLES_PER_TURN).astype(int)
-        run_u = result.y[index]
-        print(f"| camdyn (rigid, DOP853) | rtol {rtol:g} | {wall:.3g} | {fast.size} | {median:.2g} | {largest:.2g} | "
-              f"{np.max(np.abs(run_u - exact_u)):.2g} |")
-    if siconos:
-        for run in siconos["runs"]:
-            times = np.array([i["t"] for i in run["impacts"]])
-            median, largest = errors(reference, times)
-            sec_t = [x["t"] for x in run["section"]]
-            exact_u, _ = sample(exact, pieces, sec_t)
-            du = max(abs(x["u"] - a) for x, a in zip(run["section"], exact_u))
-            print(f"| Siconos (Moreau-Jean) | h {run['h']:g} s | {run['wall_s']:.3g} | {times.size} | {median:.2g} | "
-                  f"{largest:.2g} | {du:.2g} |")
+        rows.append(f"| camdyn (rigid, DOP853) | rtol {rtol:g} | {wall:.3g} | {fast.size} | {median:.2g} | "
+                    f"{largest:.2g} | {np.max(np.abs(result.y[index] - exact_u)):.2g} |")
+    return rows
+
+
+def siconos_rows(siconos: dict, exact, pieces, reference) -> list[str]:
+    """The peer's rows, from its JSON."""
+    rows = []
+    for run in siconos["runs"]:
+        times = np.array([i["t"] for i in run["impacts"]])
+        median, largest = errors(reference, times)
+        exact_u, _ = sample(exact, pieces, [x["t"] for x in run["section"]])
+        du = max(abs(x["u"] - a) for x, a in zip(run["section"], exact_u))
+        rows.append(f"| Siconos (Moreau-Jean) | h {run['h']:g} s | {run['wall_s']:.3g} | {times.size} | {median:.2g} | "
+                    f"{largest:.2g} | {du:.2g} |")
+    return rows
+
+
+def run_siconos(args) -> None:
+    import subprocess
+    here = os.path.dirname(os.path.abspath(__file__))
+    subprocess.run(["/usr/bin/python3", os.path.join(here, "siconos_cam_follower.py"), "--law", "flat",
+                    "--speed-rpm", f"{args.speed_rpm:g}", "--revolutions", str(args.revolutions), "--steps",
+                    "1e-3", "3e-4", "1e-4", "3e-5", "1e-5", "3e-6", "--out", args.run_siconos], check=True,
+                   stdout=subprocess.DEVNULL)
+
+
+def report(lines: list[str], args) -> None:
+    from perf.sections import write_section
+    command = (f"python benchmarks/second_rig_peers.py --speed-rpm {args.speed_rpm:g} --revolutions {args.revolutions}"
+               + (" --run-siconos FILE" if args.run_siconos else "") + " --report")
+    head = ["## The rigid scene: work-precision beside Siconos", "",
+            f"`{command}`: the second rig (docs/second-rig.md) with `contact=\"rigid\"`, camdyn at four tolerances "
+            "against Siconos's Moreau-Jean time stepping at six steps, both against an event-driven solution with "
+            "closed-form flights (benchmarks/second_rig_exact.py): wall time against the error of the impact times "
+            "(impacts faster than the peer's threshold) and of the follower's position at a section once a "
+            "revolution. Compare ratios within this one run.", ""]
+    print(f"wrote {write_section('rigid-scene', chr(10).join(head + lines))}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--speed-rpm", type=float, default=256.0)
+    ap.add_argument("--revolutions", type=int, default=30)
+    ap.add_argument("--siconos", help="a JSON of benchmarks/siconos_cam_follower.py (law flat, same speed)")
+    ap.add_argument("--run-siconos", metavar="JSON", help="run the Siconos peer now (/usr/bin/python3, its steps "
+                    "1e-3 .. 3e-6 s), in this run, into JSON, and compare with it")
+    ap.add_argument("--report", action="store_true", help="write the section of docs/performance.md")
+    args = ap.parse_args()
+    load0 = os.getloadavg()[0]
+    if args.run_siconos:
+        run_siconos(args)
+        args.siconos = args.run_siconos
+    warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
+    exact = ExactRig("flat", args.speed_rpm)
+    impacts, pieces = solve(exact, args.revolutions * 60.0 / args.speed_rpm)
+    siconos, v_min = None, 0.5
+    if args.siconos:
+        siconos = json.load(open(args.siconos))
+        meta = siconos["meta"]
+        if (meta["law"], meta["speed_rpm"], meta["revolutions"]) != ("flat", args.speed_rpm, args.revolutions):
+            raise SystemExit(f"{args.siconos} is not the flat law at {args.speed_rpm} rev/min over {args.revolutions}")
+        v_min = meta["v_min"]
+    reference = np.array([t for t, v, _ in impacts if v < -v_min])
+    section_deg = siconos["meta"]["section_deg"] if siconos else 130.0
+    lines = [f"Second rig, flat face, {args.speed_rpm:g} rev/min, {args.revolutions} revolutions: {reference.size} "
+             f"exact impacts faster than {v_min} m/s; section at {section_deg:g} deg.", "",
+             "| peer | setting | wall (s) | impacts | impact-time error median (s) | max (s) | section y error max (m) |",
+             "|---|---|---|---|---|---|---|"]
+    lines += camdyn_rows(second_rig(), exact, pieces, reference, args, v_min, section_deg)
+    lines += siconos_rows(siconos, exact, pieces, reference) if siconos else []
+    lines += ["", f"Load average {load0:.2f} before, {os.getloadavg()[0]:.2f} after ({os.cpu_count()} cores)."]
+    print("\n".join(lines))
+    if args.report:
+        report(lines, args)
 
 
 if __name__ == "__main__":

@@ -154,10 +154,11 @@ def _protocol(rig, s: dict) -> str:
         "standard errors, else *undecided*. Where the tangent integration cannot pass an impact law's unbounded "
         "Jacobian at first contact (damping C and E, c ∝ |ψ_i|^(1/4), at every impact; D's β k_λ|ψ_i| on some "
         "runs), λ1 is measured by two neighbouring runs instead (`largest_by_differences`: Benettin's "
-        "two-trajectory method on the same window, the neighbour 1e-7 rad away and again 1e-6 rad away; where "
-        "the two distances' estimates differ by more than a standard error the verdict is *undecided*: so on a "
-        "strongly contracting orbit, whose neighbour falls below the runs' own error within a revolution and whose "
-        "λ1 then reads as that floor's, e.g. −28 1/s where the tangent dynamics give −800). "
+        "two-trajectory method on the same window, the neighbour 1e-7 rad away and again 1e-6 rad away; the "
+        "verdict must hold at both distances, else it is *undecided* (`DifferenceEstimate.verdict`): on a "
+        "strongly contracting orbit the neighbour falls below the runs' own error within a revolution and λ1 "
+        "reads as that floor's, e.g. −28 1/s where the tangent dynamics give −800, its sign kept, its size not "
+        "the orbit's). "
         f"A run whose last {s['revolutions'] - s['transient']} revolutions are aperiodic "
         f"is continued, {s['revolutions'] - s['transient']} revolutions at a time, up to {s['max_revolutions']} "
         "in all, and classed by its last window, so that a motion wandering between coexisting attractors "
@@ -225,8 +226,10 @@ def _lyapunov_checks(first_chaotic: dict, chaos155: dict, judged: dict) -> list[
 
     bd = all(judged[d] and first_chaotic[d] is not None and first_chaotic[d] >= 155.0 for d in "BD")
     ac = [d for d in "AC" if judged[d]]
+    e_ok = judged["E"] and first_chaotic["E"] is not None and first_chaotic["E"] < 155.0
     return [
         ["B and D chaotic above about 155 rev/min (by λ1)", ", ".join(first(d) for d in "BD"), yes(bd)],
+        ["E chaotic before 155 rev/min (by λ1)", first("E"), yes(e_ok)],
         ["A and C still periodic at 155 rev/min (by λ1)",
          ", ".join(f"{d}: {chaos155.get(d)}" for d in ac) + ("; C: n/a" if "C" not in ac else ""),
          yes(bool(ac) and all(chaos155.get(d) == "regular" for d in ac))],

@@ -9,7 +9,6 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import signal
-from ..engine.kernels import on_arrays
 from ..model.cam import RPM, CamMotion, ConstantSpeed
 from ..model.followers import follower_of_rig, rigid_contact
 from ..errors import GeometryError, ParameterError
@@ -57,6 +56,7 @@ def _closed_form(kernel, theta: np.ndarray, p: np.ndarray, closed: bool) -> np.n
     whole array at once where the kernel is a closed form (``closed``: a circular cam,
     :func:`camdyn.engine.kernels.on_arrays`), else angle by angle (a profile cam's spline)."""
     if closed:
+        from ..engine import on_arrays      # (numba: loaded on first use, not with camdyn)
         return np.array(np.broadcast_arrays(*np.atleast_1d(on_arrays(kernel)(theta, p))), dtype=float)
     return np.array([np.atleast_1d(kernel(th, p)) for th in theta], dtype=float).T
 

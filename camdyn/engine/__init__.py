@@ -31,7 +31,7 @@ _LAZY = {"integrate": ".driver", "Trajectory": ".driver", "Switch": ".switches",
          "Domain": ".domain", "Augmented": ".variational", "augmented_flow": ".variational",
          "frozen_step": ".variational", "record_saltation": ".saltation", "switch_saltation": ".saltation",
          "saltation_matrix": ".saltation", "compiled_kernels": ".kernels", "python_kernels": ".kernels",
-         "outputs_on_samples": ".kernels", "transition_surfaces": ".tables",
+         "outputs_on_samples": ".kernels", "on_arrays": ".kernels", "transition_surfaces": ".tables",
          "impact_transitions": ".tables", "user_cache_root": ".cache",
          "cache_dir": ".cache", "source_hash": ".cache", "remove_folders": ".cache", "cache_entries": ".cache",
          "clear_cache": ".cache", "CACHE_ENV": ".cache", "STEP_CONTROL": ".config"}

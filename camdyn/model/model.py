@@ -20,7 +20,6 @@ from ..vocabulary.parameters import CAM_NAMES, EQUILIBRIUM_NAMES
 from ..vocabulary import (COORDINATES, ECCENTRIC, FOLLOWERS, JAC_D_ALPHA, JAC_D_ALPHA_DOT, RESET_JACOBIAN, STATIC_LOAD,
                           SURFACE_GRADIENT)
 from ..engine import ANGLE_LIMIT  # |alpha| beyond it: the singular 90 degrees of Eq. 11
-from ..engine.kernels import on_arrays
 from ..errors import EquilibriumError, GeometryError, SceneError
 from .rig import Rig
 from .followers import cam_of, follower_of_rig, rigid_contact
@@ -179,6 +178,7 @@ def _worst_reach(rig: Rig, kernels: ModuleType) -> tuple[float, float]:
     seen, so that a sweep in the speed does not redo it for every point (docs/design-notes.md)."""
     thetas = rig.theta0 + np.linspace(0, 2 * math.pi, 721)
     p = static_parameters(rig, kernels)
+    from ..engine import on_arrays      # (numba: loaded with the first model, not with camdyn)
     margins = np.broadcast_to(on_arrays(kernels.reach)(thetas, p), thetas.shape)
     worst = int(np.argmin(margins))
     return float(thetas[worst]), float(margins[worst])

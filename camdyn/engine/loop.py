@@ -286,7 +286,7 @@ def run(prob, method, cfg, start, samples):
                     history[CHATTER_COUNT] = 0.0
                 m_new, c0, c1 = switch(prob, row, t_cross, c0, c1, cfg, buf)
                 capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
-                sw = _record(sw, n_sw, t_cross, w, m, m_new, c0, c1)
+                sw = _record(sw, n_sw, t_cross, row, m, m_new, c0, c1)
                 n_sw += 1
                 t, y0, y1, m = t_cross, c0, c1, m_new
                 if tab.data[tab.mode_terminal + m] == 1:

@@ -491,12 +491,19 @@ def chatter_ends(history, t, v, atol, resolution):
 
 
 @jitable
+def row_reset(tab, w):
+    """The reset (an index into RESETS) of target row w: a transition's own, or past the
+    transitions the chatter end's (row n_transitions + 1).  A switch record's ``transition`` is
+    such a row, so the saltation of a recorded switch reads its reset here too."""
+    return tab.data[tab.reset + w] if w < tab.n_transitions else tab.chatter_reset
+
+
+@jitable
 def switch(prob, w, t, a, ad, cfg, buf):
     """The mode after transition w fires at (t, a, ad), and the state after its reset; ``w`` past the
     transitions, the chatter end's row (n_transitions + 1, with its reset)."""
-    tab = prob.tables
     m_new = target(prob, w, t, a, ad, cfg.look_ahead)
-    j = tab.data[tab.reset + w] if w < tab.n_transitions else tab.chatter_reset
+    j = row_reset(prob.tables, w)
     if j >= 0:
         prob.kernels.reset(j, t, a, ad, prob.p, buf)
         return m_new, buf[STATE_ALPHA], buf[STATE_ALPHA_DOT]

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..vocabulary import (GRAD_D_ALPHA, GRAD_D_ALPHA_DOT, GRAD_D_T, RJ_Q_Q, RJ_Q_QD, RJ_Q_T, RJ_QD_Q, RJ_QD_QD, RJ_QD_T,
                           STATE_ALPHA, STATE_ALPHA_DOT)
+from .rules import row_reset
 from .tables import IDENTITY, tables, transition_surface_indices
 
 
@@ -69,15 +70,10 @@ def switch_saltation(model, before: int, after: int, surface: int, t: float, x, 
 
 
 def record_reset(K, record) -> int:
-    """The reset a switch record went through (an index into RESETS, IDENTITY for none): its
-    transition's, or the chatter end's where an impact ended a chatter (camdyn.engine.rules.chatter_ends:
-    the record's mode after is not the impact's target)."""
-    tab = tables(K)
-    w = int(record["transition"])
-    impact_target = tab.data[tab.target_mode + tab.data[tab.target_start + w]]
-    if w == tab.chatter and int(record["after"]) != impact_target:
-        return int(tab.chatter_reset)
-    return int(tab.data[tab.reset + w])
+    """The reset a switch record went through (an index into RESETS, IDENTITY for none): its row's
+    (camdyn.engine.rules.row_reset: a transition's, or the chatter end's, which the loop records as
+    its own row)."""
+    return int(row_reset(tables(K), int(record["transition"])))
 
 
 def record_saltation(model, record, x_before=None) -> tuple[np.ndarray, int]:

@@ -129,9 +129,13 @@ def transition_rows(K: ModuleType) -> list[tuple]:
 
 @lru_cache(maxsize=None)
 def transition_surface_indices(K: ModuleType) -> tuple[int, ...]:
-    """The surface (an index into SURFACES) of each transition, in the loop's transition order
-    (a switch record's ``transition``)."""
-    return tuple(int(row[SURFACE]) for row in transition_rows(K))
+    """The surface (an index into SURFACES) of each row a switch record's ``transition`` names:
+    the transitions in the loop's order, then, in a scene with a chatter end, -1 for the initial
+    mode's row (n_transitions, never recorded) and the impact's surface for the chatter end's row
+    (n_transitions + 1: the impact that ended a chatter, recorded as its own row)."""
+    surfaces = [int(row[SURFACE]) for row in transition_rows(K)]
+    chatter = getattr(K, "CHATTER", None)
+    return tuple(surfaces + ([-1, int(chatter[SURFACE])] if chatter is not None else []))
 
 
 @lru_cache(maxsize=None)
@@ -145,4 +149,4 @@ def impact_transitions(K: ModuleType) -> tuple[int, ...]:
 def transition_surfaces(K: ModuleType) -> tuple[str, ...]:
     """The name of the surface each transition crosses, by the transition's index (a switch
     record's ``transition``), once per scene module."""
-    return tuple(K.SURFACES[s] for s in transition_surface_indices(K))
+    return tuple(K.SURFACES[s] if s >= 0 else "" for s in transition_surface_indices(K))

@@ -24,6 +24,7 @@ import pytest
 import camdyn
 from camdyn.analysis.statics import compliance_shift
 from camdyn.orbits.continuation import EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
+from camdyn.orbits.continuation.corners import NO_LANDINGS
 from camdyn.engine.config import SolverOptions
 from camdyn.errors import ParameterError
 from camdyn.model.model import Model
@@ -477,6 +478,7 @@ def _continued(f, start, end, monkeypatch):
         return corrector.Run(None, leg.section_map(lam, mode).evaluate(x), None, np.zeros(0))
     monkeypatch.setattr(corrector, "orbit_run", run)
     monkeypatch.setattr(corrector, "gap", lambda run: (-1.0, np.zeros(1), 0))
+    monkeypatch.setattr(corrector, "landings", lambda run: NO_LANDINGS)
     leg = Leg(_AnalyticProblem(f, start, end), 1, np.ones(2), ContinuationSettings())
     first = corrector.first_point(leg, start, np.zeros(2), 0, 1.0)
     branch, events = Branch(1), []

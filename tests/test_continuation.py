@@ -286,6 +286,13 @@ def test_the_dataset_round_trips_through_netcdf(pd_branch, tmp_path):
         np.testing.assert_array_equal(back["lambda"].values, pd_branch["lambda"].values)
 
 
+def test_a_compliant_branch_lands_no_impacts_and_has_no_corner_impact(pd_branch):
+    """A compliant contact has no Newton impacts: its orbits' impact angles are NaN (one column, the
+    Dataset's least) and no corner_impact is told (camdyn.orbits.continuation.corners)."""
+    assert pd_branch.sizes["impact"] == 1 and np.isnan(pd_branch["impact_angle"].values).all()
+    assert "corner_impact" not in [e[0] for e in events_table(pd_branch)]
+
+
 def test_the_branches_plot_over_a_diagram(pd_branch):
     pytest.importorskip("matplotlib")
     from camdyn.io import plots

@@ -24,6 +24,7 @@ import pytest
 import camdyn
 from camdyn.analysis.statics import compliance_shift
 from camdyn.orbits.continuation import EVENTS, ContinuationOutcome, ContinuationSettings, continue_orbit, events_table
+from camdyn.orbits.continuation.corners import NO_LANDINGS
 from camdyn.engine.config import SolverOptions
 from camdyn.errors import ParameterError
 from camdyn.model.model import Model
@@ -285,6 +286,13 @@ def test_the_dataset_round_trips_through_netcdf(pd_branch, tmp_path):
         np.testing.assert_array_equal(back["lambda"].values, pd_branch["lambda"].values)
 
 
+def test_a_compliant_branch_lands_no_impacts_and_has_no_corner_impact(pd_branch):
+    """A compliant contact has no Newton impacts: its orbits' impact angles are NaN (one column, the
+    Dataset's least) and no corner_impact is told (camdyn.orbits.continuation.corners)."""
+    assert pd_branch.sizes["impact"] == 1 and np.isnan(pd_branch["impact_angle"].values).all()
+    assert "corner_impact" not in [e[0] for e in events_table(pd_branch)]
+
+
 def test_the_branches_plot_over_a_diagram(pd_branch):
     pytest.importorskip("matplotlib")
     from camdyn.io import plots
@@ -477,6 +485,7 @@ def _continued(f, start, end, monkeypatch):
         return corrector.Run(None, leg.section_map(lam, mode).evaluate(x), None, np.zeros(0))
     monkeypatch.setattr(corrector, "orbit_run", run)
     monkeypatch.setattr(corrector, "gap", lambda run: (-1.0, np.zeros(1), 0))
+    monkeypatch.setattr(corrector, "landings", lambda run: NO_LANDINGS)
     leg = Leg(_AnalyticProblem(f, start, end), 1, np.ones(2), ContinuationSettings())
     first = corrector.first_point(leg, start, np.zeros(2), 0, 1.0)
     branch, events = Branch(1), []

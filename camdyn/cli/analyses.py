@@ -159,10 +159,11 @@ def add_continue(sub) -> None:
                     "Pseudo-arclength continuation of the fixed points of the stroboscopic map\n"
                     "(camdyn.orbits.continuation), from the orbit found by shooting at --start after --warmup\n"
                     "revolutions. Prints how each branch ended and the events (fold, branch_point,\n"
-                    "period_doubling, neimark_sacker, grazing) with their parameter values, as CSV. At a period\n"
-                    "doubling the doubled branch is continued too. The section is at --phase-fraction of the\n"
-                    "cam period (0: the sections of 'camdyn sweep'; where the orbit sits on a switching surface\n"
-                    "there, e.g. in permanent contact at the 0-state, choose another).", cmd_continue)
+                    "period_doubling, neimark_sacker, grazing, corner_impact) with their parameter values, as\n"
+                    "CSV. At a period doubling the doubled branch is continued too. The section is at\n"
+                    "--phase-fraction of the cam period (0: the sections of 'camdyn sweep'; where the orbit sits\n"
+                    "on a switching surface there, e.g. in permanent contact at the 0-state, choose another).",
+                    cmd_continue)
     _add_physics(p)
     g = p.add_argument_group("continuation")
     g.add_argument("--param", default="speed_rpm", metavar="NAME",

@@ -59,7 +59,14 @@ with its test function and locator in one table, :data:`.events.KINDS`):
   that the bracket closes from both sides (:func:`.events.grazing_location`; its trials against
   bisection's are measured in docs/continuation.md).
   A trial needs the gap alone: its orbit is corrected without derivatives (6 runs less each),
-  which only the two bracketing points get.
+  which only the two bracketing points get;
+* ``corner_impact`` (a rigid scene on a cam profile with junctions, :mod:`.corners`): a Newton
+  impact's landing angle on the cam (the contact's body angle phi at the impact) crosses a
+  junction of the profile, where its curvature jumps (Osorio, di Bernardo & Santini 2008): the
+  signed angular distance of one impact to one junction changes sign between two points while
+  both are within half the junctions' least spacing, the impacts matched by their order in the
+  period (as many at both points); located by secant trials on that distance, corrected orbits
+  without derivatives as grazing's, the located orbit the last trial before the event.
 
 At a period doubling the branch of period 2 n T is switched to: Newton's method on P_2n from
 x* +/- eps v (v the eigenvector of the multiplier near -1) on the side where P_n is unstable,
@@ -72,7 +79,8 @@ The modules, one job each: ``problem`` (the problem, settings, outcomes, the rec
 :class:`~.problem.Leg` every step of a branch shares, with the layout of z), ``corrector`` (the
 orbit's run and gap, the derivatives, tangent, predictor and corrector), ``events`` (the event
 table, detection and location), ``switching`` (branch switching at a period doubling),
-``follow`` (the first orbit, the steps along each branch) and ``dataset`` (the result).
+``follow`` (the first orbit, the steps along each branch), ``corners`` (where impacts land
+against the profile's junctions: the corner impact's test) and ``dataset`` (the result).
 
 **Two parameters** (design charts, issue 29): :func:`continue_grazing` follows the grazing
 orbit in two parameters and :func:`jump_chart` gives the jump speed against a rig parameter

@@ -13,6 +13,7 @@ from ...errors import CamdynError
 from ..derivatives import Column, Unresolved, resolved_difference
 from ..section_map import MapFailure, MapValue, StroboscopicMap, derivative_at
 from ..shooting import newton_matrix
+from .corners import landings
 from .problem import N_STATE, Z_LAMBDA, Z_SIZE, Z_STATE, Derivation, Leg, Point
 
 #: samples of psi_i per cam period for the orbit's largest gap (:data:`camdyn.orbits.continuation.GAP_SAMPLES`),
@@ -207,11 +208,11 @@ def refined_max(v: np.ndarray) -> float:
 
 
 def _point(lam: float, x, run: Run, ev: Scaled, direction, iterations: int) -> Point:
-    """The orbit (lam, x) as a Point: its gap from its run, its derivatives ``ev``, its tangent
-    oriented along ``direction``."""
+    """The orbit (lam, x) as a Point: its gap and its impacts' landings from its run, its
+    derivatives ``ev``, its tangent oriented along ``direction``."""
     max_gap, alphas, end_mode = gap(run)
     return Point(lam, np.array(x, dtype=float), ev.J, tangent(ev.A, direction), max_gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation)
+                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation, landings(run))
 
 
 def step(leg: Leg, p: Point, ds: float) -> Point | None:

@@ -31,7 +31,11 @@ def branch_dataset(problem: Problem, branches: list, events: list, scale=None):
     where not by differences), ``max_gap`` (the largest psi_i over the orbit, m: < 0 in
     permanent contact), ``point_branch`` (the branch it is on), ``periods``, ``mode`` (code into
     attrs ``modes``), ``residual``, ``alpha_revolution`` (alpha at the starts of the orbit's
-    revolutions: the points of the brute-force diagram).  Per event: ``event_kind`` (code into
+    revolutions: the points of the brute-force diagram), ``impact_angle`` (dim ``impact``, the most
+    impacts of any orbit, at least 1: the cam's body angle phi, rad in [0, 2 pi), at which each
+    Newton impact of the orbit lands, in time order from the section, NaN beyond its own and on a
+    compliant scene: :class:`.corners.Landings`; the profile's junctions, where a ``corner_impact``
+    lands, are ``rig.profile.junctions()``).  Per event: ``event_kind`` (code into
     ``event_kinds``), ``event_lambda``, ``event_alpha``, ``event_alpha_dot``, ``event_branch``,
     ``event_point`` (the point just before it), ``event_max_gap``, ``event_multiplier_real``/
     ``_imag``, ``event_alpha_revolution``.  Per branch: ``branch_periods``, ``branch_parent``
@@ -120,6 +124,10 @@ def _point_variables(problem: Problem, branches: list, unit: str, n_rev: int, pr
         "alpha_revolution": (("point", "revolution"), _padded([p.alpha_revolutions for p in points], n_rev),
                              {"units": q_unit, "long_name": f"{q} at the starts of the orbit's revolutions "
                                                             "(the brute-force diagram's sections)"}),
+        "impact_angle": (("point", "impact"), _padded([p.landings.angles for p in points],
+                                                      max([p.landings.angles.size for p in points] + [1])),
+                         {"units": "rad", "long_name": "cam body angle phi at which each impact lands, in time "
+                                                       "order from the section (NaN: none)"}),
     }
 
 

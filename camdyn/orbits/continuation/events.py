@@ -1,7 +1,9 @@
 """The events along a branch, in one table (:data:`KINDS`): each kind's test function, whose
-sign change between two points marks it, the distance of the multipliers from its critical
-value, and how it is located in arclength (the secant trials with the Illinois rule, or the
-grazing trials from the contact side); their detection between two points and location."""
+sign change between two points marks it (a corner impact's: the continuous sign change of one
+impact's distance to one junction, :func:`.corners.crossings`), the distance of the multipliers
+from its critical value, and how it is located in arclength (the secant trials with the Illinois
+rule, or the grazing trials from the contact side); their detection between two points and
+location."""
 from __future__ import annotations
 
 import math
@@ -11,6 +13,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from ..shooting import sorted_multipliers
+from .corners import crossings, distance_of, landings
 from .corrector import completed, corrected, gap, step
 from .problem import N_STATE, Z_LAMBDA, Event, Leg, Point
 
@@ -29,19 +32,24 @@ GRAZING_PAST = 0.25
 
 
 class Kind(NamedTuple):
-    """An event kind: its name; its test function at a point (None: a kind only named after a
-    location, ``multiplier_jump``); the distance of each multiplier from the kind's critical
-    value (None: not an event of the multipliers, always smooth); its locator, ``(leg, kind, p,
-    q, ds) -> (before, after)``; and the kind whose sign change at the same step masks it
+    """An event kind: its name; its test function at a point (a float, or what ``changed``
+    reads; None: a kind only named after a location, ``multiplier_jump``); the distance of each
+    multiplier from the kind's critical value (None: not an event of the multipliers, always
+    smooth); its locator, ``(leg, kind, p, q, ds) -> (before, after)``; and the kind whose sign change at the same step masks it
     (``unless``: the +1 multiplier of a fold is no branch point); ``switch_branch``: whether the
-    branch of period 2 n T is switched to there (:mod:`.switching`)."""
+    branch of period 2 n T is switched to there (:mod:`.switching`); ``changed(f_p, f_q)``:
+    whether the test's values at two points mark the event (None: a strict sign change of two
+    finite values); ``located_before``: the located orbit is the bracket's end on p's side (else
+    the far end's, where it ran)."""
 
     name: str
-    test: Callable[[Point], float] | None
+    test: Callable[[Point], object] | None
     distance: Callable[[np.ndarray], np.ndarray] | None
     locate: Callable | None
     unless: str | None = None
     switch_branch: bool = False
+    changed: Callable | None = None
+    located_before: bool = False
 
 
 class Found(NamedTuple):
@@ -84,8 +92,19 @@ def _grazing(p: Point) -> float:
     return p.max_gap
 
 
-def tests(p: Point) -> dict[str, float]:
-    """The test functions at a point, by kind.  Where the point's derivatives are unresolved they
+def _corner_impact(p: Point):
+    """Where the orbit's impacts land against the profile's junctions (:class:`.corners.Landings`),
+    whose signed distances are the test function (:func:`.corners.signed_distances`)."""
+    return p.landings
+
+
+def _corner_crossed(a, b) -> bool:
+    return bool(crossings(a, b))
+
+
+def tests(p: Point) -> dict:
+    """The test functions at a point, by kind (a float each; a corner impact's: the point's
+    landings, :func:`_corner_impact`).  Where the point's derivatives are unresolved they
     come from the differences across the first step (:mod:`camdyn.orbits.derivatives`): a sign
     change next to such a point is located but named a ``multiplier_jump``, never a bifurcation
     (:func:`smooth`)."""
@@ -94,6 +113,11 @@ def tests(p: Point) -> dict[str, float]:
 
 def _changed(a: float, b: float) -> bool:
     return math.isfinite(a) and math.isfinite(b) and a * b < 0
+
+
+def marked(kind: Kind, a, b) -> bool:
+    """Whether ``kind``'s test values a and b at two consecutive points mark an event between them."""
+    return (kind.changed or _changed)(a, b)
 
 
 # --- location ----------------------------------------------------------------------------------------
@@ -135,15 +159,51 @@ def secant_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
     bracket, with the Illinois rule (the value kept at an end twice in a row is halved, so that
     both ends close in: superlinear for a smooth f) and kept ``locate_tol`` / 2 inside it; the
     midpoint where an end has no value."""
-    tol = leg.settings.locate_tol
-    bracket = Bracket(0.0, ds, kind.test(p), kind.test(q), p)
+    def at(s: float):
+        r = step(leg, p, s)
+        return (math.nan if r is None else kind.test(r)), r
+    bracket = secant_bracket(Bracket(0.0, ds, kind.test(p), kind.test(q), p), at, leg.settings.locate_tol)
+    return bracket.before, bracket.after
+
+
+def secant_bracket(bracket: Bracket, at: Callable, tol: float) -> Bracket:
+    """``bracket`` shrunk to ``tol`` (or MAX_BISECTIONS trials) by secant trials with the Illinois
+    rule (:func:`trial`, :meth:`Bracket.narrow`); ``at(s)``: the test function's value at a
+    trial s and the orbit there (NaN: a failed step)."""
     for _ in range(MAX_BISECTIONS):
         if bracket.hi - bracket.lo <= tol:
             break
         s = trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, tol)
-        r = step(leg, p, s)
-        bracket.narrow(s, math.nan if r is None else kind.test(r), r)
-    return bracket.before, bracket.after
+        bracket.narrow(s, *at(s))
+    return bracket
+
+
+def corner_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
+    """The corner impact between p and q: the first crossing of :func:`.corners.crossings` (by
+    impact, then junction; one per step), bracketed by :func:`secant_bracket` on that impact's
+    signed distance to that junction.  It is continuous through the event (the gap is C1 across
+    a junction: the impact's time is) and smooth on either side, its slope jumping there as the
+    branch's tangent does (the reset's derivative sees the curvature's jump: the multipliers
+    jump); the Illinois rule closes the bracket from both sides all the same.  A trial's
+    impacts are matched to p's by order (NaN where their count differs: taken as the far side).
+    A trial needs the landings alone: it is a corrected orbit without derivatives, which only
+    the two points returned get (:func:`completed_ends`)."""
+    pair, impacts = crossings(p.landings, q.landings)[0], p.landings.angles.size
+
+    def at(s: float):
+        r = corrected(leg, p, s)
+        return (math.nan if r is None else distance_of(landings(r.run), impacts, pair)), r
+    f_p, f_q = (distance_of(o.landings, impacts, pair) for o in (p, q))
+    return completed_ends(leg, p, secant_bracket(Bracket(0.0, ds, f_p, f_q, p), at, leg.settings.locate_tol))
+
+
+def completed_ends(leg: Leg, p: Point, bracket: Bracket):
+    """The ends of a bracket whose trials are corrected orbits without derivatives, as Points
+    (:func:`completed`): (before, after); before is p where no trial landed on its side or its
+    completion fails (the location lost for that rare case), after None where a run fails."""
+    before = bracket.before if bracket.before is p else completed(leg, p, bracket.before)
+    after = None if bracket.after is None else completed(leg, p, bracket.after)
+    return before or p, after
 
 
 def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
@@ -168,9 +228,7 @@ def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
         if f < 0:
             contact.append((s, f))
         bracket.narrow(s, f, r)
-    before = bracket.before if bracket.before is p else completed(leg, p, bracket.before)
-    after = None if bracket.after is None else completed(leg, p, bracket.after)
-    return before or p, after
+    return completed_ends(leg, p, bracket)
 
 
 def grazing_trial(lo: float, hi: float, contact: list, far: float, tol: float) -> float:
@@ -220,12 +278,12 @@ def detect(leg: Leg, p: Point, q: Point, ds: float, where: tuple[int, int]) -> l
     f0, f1 = tests(p), tests(q)
     found = []
     for kind in DETECTED:
-        if not _changed(f0[kind.name], f1[kind.name]):
+        if not marked(kind, f0[kind.name], f1[kind.name]):
             continue
-        if kind.unless is not None and _changed(f0[kind.unless], f1[kind.unless]):
+        if kind.unless is not None and marked(KIND[kind.unless], f0[kind.unless], f1[kind.unless]):
             continue
         before, after = locate(leg, kind, p, q, ds)
-        e = after or before
+        e = before if kind.located_before else (after or before)
         mu = sorted_multipliers(e.jacobian) if e.resolved else np.full(N_STATE, np.nan, dtype=complex)
         named = kind.name if smooth(kind, before, after) else MULTIPLIER_JUMP.name
         event = Event(named, e.lam, e.x, where[0], where[1], mu, e.alpha_revolutions, e.max_gap)
@@ -264,15 +322,18 @@ def _from_unit_circle(mu: np.ndarray) -> np.ndarray:
 #: through +1, the branch turning back), ``branch_point`` (through +1 while the branch does not
 #: turn: a crossing of branches), ``period_doubling`` (a real multiplier through -1),
 #: ``neimark_sacker`` (a complex pair through the unit circle), ``grazing`` (the orbit's largest
-#: gap through 0); ``multiplier_jump``: a test function of the multipliers changed sign but the
-#: located orbit's multipliers are not critical or jump across the bracket (the map is not smooth
-#: there, e.g. where the orbit meets a new switching surface)
+#: gap through 0), ``corner_impact`` (an impact landing on a junction of the cam's profile:
+#: :func:`.corners.crossings`; the located orbit is the last trial on p's side);
+#: ``multiplier_jump``: a test function of the multipliers changed sign but the located orbit's
+#: multipliers are not critical or jump across the bracket (the map is not smooth there, e.g.
+#: where the orbit meets a new switching surface)
 KINDS = (
     Kind("fold", _fold, _from_one, secant_location),
     Kind("branch_point", _branch_point, _from_one, secant_location, unless="fold"),
     Kind("period_doubling", _period_doubling, _from_minus_one, secant_location, switch_branch=True),
     Kind("neimark_sacker", _neimark_sacker, _from_unit_circle, secant_location),
     Kind("grazing", _grazing, None, grazing_location),
+    Kind("corner_impact", _corner_impact, None, corner_location, changed=_corner_crossed, located_before=True),
     Kind("multiplier_jump", None, None, None),
 )
 #: the event kinds' names, in the table's order (:data:`camdyn.orbits.continuation.EVENTS`)

@@ -22,6 +22,7 @@ from ...vocabulary import STATE
 from ..derivatives import finite_differences
 from ..section_map import DEFAULT_OPTIONS, StroboscopicMap
 from ..shooting import ShootingSettings
+from .corners import Landings
 
 #: the parameter name of the cam speed (:data:`camdyn.orbits.continuation.SPEED`)
 SPEED = "speed_rpm"
@@ -197,7 +198,9 @@ class Point(NamedTuple):
     """One orbit on a branch: lambda, x at the section, dP_n/dx, the unit tangent (scaled), the
     largest gap (m), alpha at the revolutions' starts (the brute-force diagram's section), the
     mode at the section, the scaled residual, the corrector's steps, the scaled derivatives
-    of G there, and how they were obtained (:class:`Derivation`)."""
+    of G there, how they were obtained (:class:`Derivation`), and where its Newton impacts land
+    on the cam against the profile's junctions (:class:`~.corners.Landings`: from the run that
+    converged; no impacts on a compliant scene)."""
 
     lam: float
     x: np.ndarray
@@ -210,6 +213,7 @@ class Point(NamedTuple):
     iterations: int
     derivatives: np.ndarray     # the scaled [dG/dx, dG/dlambda] (n x n + 1) at the point: the next corrector's
     derivation: Derivation
+    landings: Landings
 
     @property
     def resolved(self) -> bool:

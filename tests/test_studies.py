@@ -98,6 +98,8 @@ def test_study_runs_fast_and_writes_its_figure_and_section(name, report_dir):
     section = text[text.index(begin):text.index(end)]
     assert f"python -m camdyn.studies {name} --fast" in section
     assert "The paper" in section or "the paper" in section
+    if name == "second-rig":   # its corner impact, located on the continued branch (tests/test_corner_impact.py)
+        assert [round(c["speed_rpm"], 1) for c in out.numbers["corner_impacts"]] == [331.2]
     json.dumps(out.numbers, default=common._json_default)      # the numbers are JSON-able
     assert common.recorded_numbers(report_dir / "reproduction.md")[name] is not None
 

@@ -79,6 +79,7 @@ def run(ctx: Context) -> StudyOutput:
     at_corner = [row for row in rows if row["leave_deg"] and all(
         min(abs(a - j) for j in junctions) < 1e-3 for a in row["leave_deg"])]
     periods = [_period(row["section"]) for row in rows]
+    corner_text, corners = _corner_impacts(rig)
     table = [[fmt(row["speed_rpm"], 4), row["outcome"], p or "none within the kept revolutions",
               len(row["impact_deg"]) // kept if kept else 0,
               "corner" if row in at_corner else ("smooth" if row["leave_deg"] else "never leaves")]
@@ -97,13 +98,36 @@ def run(ctx: Context) -> StudyOutput:
         "changes is the corner-impact scenario.",
         md_table(["speed (rev/min)", "outcome", "period of the section", "impacts > 0.5 m/s per revolution",
                   "leaves the cam at"], table),
+        corner_text,
     ])
-    numbers = {"detachment_rpm": loss, "junctions_deg": junctions,
+    numbers = {"detachment_rpm": loss, "junctions_deg": junctions, "corner_impacts": corners,
                "speeds": [{"speed_rpm": row["speed_rpm"], "outcome": row["outcome"], "period": p,
                            "impacts_per_revolution": len(row["impact_deg"]) / kept,
                            "leaves": "corner" if row in at_corner else ("smooth" if row["leave_deg"] else "never")}
                           for row, p in zip(rows, periods)]}
     return StudyOutput(NAME, TITLE, md, numbers, [png])
+
+
+#: the speeds (rev/min) over which the corner impact is continued: the unstable period-1 orbit of three
+#: impacts per revolution lands its third impact at 271.4 degrees at 320 rev/min and 266.9 at 350
+#: (tests/test_corner_impact.py), across the junction at 270
+CORNER_RANGE = (310.0, 360.0)
+
+
+def _corner_impacts(rig) -> tuple[str, list[dict]]:
+    """The corner impacts located by continuing the period-1 branch in the speed over CORNER_RANGE
+    (camdyn.continue_orbit; event kind ``corner_impact``): a paragraph and their numbers."""
+    from camdyn.orbits.continuation import ContinuationSettings, continue_orbit, events_table
+
+    ds = continue_orbit(rig, SCENE, "speed_rpm", *CORNER_RANGE, settings=ContinuationSettings(switch_depth=0))
+    found = [{"speed_rpm": float(speed)} for kind, speed, *_ in events_table(ds) if kind == "corner_impact"]
+    text = (f"Corner impacts, located by continuing the period-1 orbit in the speed from {CORNER_RANGE[0]:g} to "
+            f"{CORNER_RANGE[1]:g} rev/min (`camdyn.continue_orbit`, event kind `corner_impact`: an impact's landing "
+            "angle crossing a junction, docs/continuation.md): "
+            + (", ".join(f"{c['speed_rpm']:.6f} rev/min" for c in found) if found else "none")
+            + ". The orbit there is unstable (three impacts per revolution); whether it is the orbit of the 2008 "
+            "paper's scenario could not be checked (the paper's text was not available).")
+    return text, found
 
 
 def _period(section: list[float], tol: float = 1e-7) -> int | None:

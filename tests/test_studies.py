@@ -98,8 +98,10 @@ def test_study_runs_fast_and_writes_its_figure_and_section(name, report_dir):
     section = text[text.index(begin):text.index(end)]
     assert f"python -m camdyn.studies {name} --fast" in section
     assert "The paper" in section or "the paper" in section
-    if name == "second-rig":   # its corner impact, located on the continued branch (tests/test_corner_impact.py)
-        assert [round(c["speed_rpm"], 1) for c in out.numbers["corner_impacts"]] == [331.2]
+    if name == "second-rig":   # its corner impact, located on the continued branch (checked against a run in
+        from camdyn.studies.second_rig import CORNER_RANGE      # tests/test_corner_impact.py)
+        found = [c["speed_rpm"] for c in out.numbers["corner_impacts"]]
+        assert len(found) == 1 and CORNER_RANGE[0] < found[0] < CORNER_RANGE[1] and f"{found[0]:.6f}" in section
     json.dumps(out.numbers, default=common._json_default)      # the numbers are JSON-able
     assert common.recorded_numbers(report_dir / "reproduction.md")[name] is not None
 

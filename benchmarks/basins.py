@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 import time
 import warnings
@@ -25,10 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-import camdyn
-from camdyn.model.presets import load_rig
-from camdyn.sweep import process_pool
-from camdyn.sweep.attractors import attractor_table
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import camdyn  # noqa: E402
+from camdyn.model.presets import load_rig  # noqa: E402
+from camdyn.sweep import process_pool  # noqa: E402
+from camdyn.sweep.attractors import attractor_table  # noqa: E402
 
 IMG = Path(__file__).resolve().parent.parent / "docs" / "img"
 
@@ -44,6 +47,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--no-figure", action="store_true")
     parser.add_argument("--keep", metavar="FILE.nc", help="write the map to FILE.nc (default: a temporary file)")
+    parser.add_argument("--report", action="store_true", help="write the basins section of docs/performance.md")
     args = parser.parse_args()
     warnings.filterwarnings("ignore", category=camdyn.CompileNotice)
     rig = load_rig("reference-experiment")
@@ -60,12 +64,19 @@ def main() -> None:
                            lyapunov_revolutions=args.lyapunov_revolutions)
     wall = time.perf_counter() - t0
     load1 = os.getloadavg()
-    print(f"{args.n} x {args.n} basin map at {speed:g} rev/min, damping {args.damping}: {wall:.1f} s wall on {args.workers} workers "
-          f"({os.cpu_count()} cores; load average {load0[0]:.2f} before, {load1[0]:.2f} after)")
-    print(f"revolutions integrated: {ds.attrs['revolutions_run_total']:.0f} of {ds.attrs['revolutions_requested_total']:.0f};"
-          f" {wall / ds.attrs['points'] * 1e3:.1f} ms per point")
-    for row in attractor_table(ds):
-        print(row)
+    lines = [f"{args.n} x {args.n} basin map at {speed:g} rev/min, damping {args.damping}: **{wall:.1f} s** wall on "
+             f"{args.workers} workers ({os.cpu_count()} cores; load average {load0[0]:.2f} before, {load1[0]:.2f} after).",
+             f"Revolutions integrated: {ds.attrs['revolutions_run_total']:.0f} of "
+             f"{ds.attrs['revolutions_requested_total']:.0f}; {wall / ds.attrs['points'] * 1e3:.1f} ms per start.",
+             *(f"Attractor: {row}" for row in attractor_table(ds))]
+    print("\n".join(lines))
+    if args.report:
+        from perf.sections import write_section
+        command = " ".join(["python benchmarks/basins.py"] + sys.argv[1:])
+        head = ["## Basins: a basin map timed", "", f"`{command}` (the reference experiment rig, starts at t = 0 "
+                "over alpha* + [0, 0.5] rad x [-3, 3] rad/s, each run stopped once periodic, at most 200 "
+                "revolutions; the attractors confirmed by shooting, included in the time; docs/basins.md).", ""]
+        print(f"wrote {write_section('basins', chr(10).join(head + [f'- {line}' for line in lines]))}")
     if not args.no_figure:
         from camdyn.io import plots
         fig = plots.basin_map(ds, title=f"basins at {speed:g} rev/min, reference-experiment, damping {args.damping}")

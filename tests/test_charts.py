@@ -233,3 +233,42 @@ def test_the_fold_and_period_doubling_curves_meet_the_one_parameter_ones(kind, r
                if EVENTS[k] == kind]
     assert located, branch.attrs["branch_0_message"]
     assert abs(ds["speed_rpm"].values[-1] - located[0]) <= 2 * settings.locate_tol * abs(window[1] - window[0])
+
+
+def test_a_largest_gap_within_the_correctors_tolerance_is_the_grazing_one():
+    """The grazing orbit is converged with psi_i(t_g) in [-2, 0] margin (margin = gap_tol d):
+    another sample's gap up to +margin is the same maximum or noise (a stiff contact's psi_i
+    noise, ~1e-17 m on reference-experiment, once ended the jump chart as a double grazing);
+    beyond +margin another maximum has overtaken it."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.grazing import is_largest
+
+    system = SimpleNamespace(gap_tol=1e-6, deflection=4.7e-10)
+    margin = system.gap_tol * system.deflection
+    assert is_largest(system, SimpleNamespace(max_gap=-margin)) and is_largest(system, SimpleNamespace(max_gap=1.9e-17))
+    assert not is_largest(system, SimpleNamespace(max_gap=1.5 * margin))
+
+
+def test_a_step_whose_orbit_has_no_contact_side_difference_is_retried_shorter(monkeypatch):
+    """A corrected orbit whose parameter differences lift off on both sides at every step
+    (Unresolved: an orbit at the grazing's noise) is a failed step (None: follow() halves it),
+    not the curve's end; a derivative that cannot be evaluated at all still ends it."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation import grazing_curve
+    from camdyn.orbits.derivatives import Unresolved
+    from camdyn.orbits.section_map import MapFailure
+
+    leg = SimpleNamespace(system=SimpleNamespace(free="speed_rpm", parameter="k_s"),
+                          layout=SimpleNamespace(split=lambda z: (None, 0.5, 1000.0, 2000.0)))
+    p = SimpleNamespace(tangent=np.zeros(5), derivatives=SimpleNamespace(steps=np.ones(2)))
+    monkeypatch.setattr(grazing_curve, "corrected", lambda *a: (np.zeros(5), SimpleNamespace(max_gap=-1.0), 2))
+    monkeypatch.setattr(grazing_curve, "is_largest", lambda system, e: True)
+    for failure, ends in ((Unresolved("no step keeps the path"), False), (MapFailure("no tangent dynamics"), True)):
+        def point(*a, failure=failure):
+            raise failure
+        monkeypatch.setattr(grazing_curve, "_point", point)
+        got = grazing_curve.step(leg, p, 0.01)
+        assert (isinstance(got, grazing_curve.Ended) and got.outcome == GrazingOutcome.NO_DERIVATIVES) if ends \
+            else got is None

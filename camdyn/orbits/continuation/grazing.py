@@ -365,9 +365,12 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
     return layout.split(z + dz)[2]
 
 
-def is_largest(evaluation: Evaluation) -> bool:
+def is_largest(system: GrazingSystem, evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
-    parabola) stays below zero, the orbit in contact throughout (else another maximum of the gap
-    has overtaken the one at t_g, which is at -margin: the follower first leaves the cam
-    elsewhere)."""
-    return evaluation.max_gap < 0.0
+    parabola) stays below +margin (gap_tol d), else another maximum of the gap has overtaken the
+    one at t_g and the follower first leaves the cam elsewhere.  Not below zero: the orbit is
+    converged with psi_i(t_g) within [-2, 0] margin, so a largest sample up to +margin is that
+    maximum (or another within the corrector's tolerance of it) and the psi_i noise of a stiff
+    contact (measured: 1.9e-17 m against -4.3e-18 m at t_g, margin 4.7e-16 m, on
+    reference-experiment at k_s = 30 N/m, which ended the jump chart there as a double grazing)."""
+    return evaluation.max_gap < system.gap_tol * system.deflection

@@ -27,6 +27,7 @@ import numpy as np
 from ..._checks import real
 from ...errors import CamdynError, ParameterError
 from ...outcome import ActionableOutcome
+from ..derivatives import Unresolved
 from ..shooting import sorted_multipliers
 from .corrector import chord, tangent
 from .events import MAX_BISECTIONS, Bracket, trial
@@ -202,18 +203,22 @@ def _residual(leg: Leg, z, mode):
 
 def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
     """The point at arclength ds from p (``final``: at the range's end, :func:`corrected`): a
-    GrazingPoint, None when the corrector fails, or :class:`Ended` (MAXIMUM_MOVED,
-    NO_DERIVATIVES) with where and why."""
+    GrazingPoint, None when the corrector fails or when no parameter step keeps the converged
+    orbit's path (an orbit lifted off at the psi_i noise of a stiff contact: the step is retried
+    shorter, as a failed one; seen on reference-experiment at k_s = 30 N/m, where it ended the
+    chart), or :class:`Ended` (MAXIMUM_MOVED, NO_DERIVATIVES) with where and why."""
     found = corrected(leg, p, ds, final)
     if found is None:
         return None
     z, e, iterations = found
-    if not is_largest(e):
+    if not is_largest(leg.system, e):
         return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} m over the orbit "
                                                    f"against {e.psi_g:.3g} m at the grazing's t_g")
     try:
         q = _point(leg, z, e, p.tangent, iterations, p.derivatives.steps)
         return q._replace(curvature=(q.tangent - p.tangent) / ds)
+    except Unresolved:
+        return None
     except CamdynError as failure:
         return Ended(GrazingOutcome.NO_DERIVATIVES, f"at {_where(leg, z)}: {failure}")
 
@@ -242,7 +247,7 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
         return (f"the extended system's corrector did not converge from the near-grazing orbit at "
                 f"{system.free} = {free:.8g}")
     z, e, iterations = found
-    if not is_largest(e):
+    if not is_largest(system, e):
         return f"the located orbit's largest gap is not at its t_g ({e.max_gap:.3g} m against {e.psi_g:.3g} m)"
     try:
         return _point(leg, z, e, along, iterations)

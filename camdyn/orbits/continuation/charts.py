@@ -84,7 +84,8 @@ def _settings(settings, kind) -> None:
 def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple,
                      free: str = SPEED, speed_rpm: float | None = None, phase_fraction: float = 0.5,
                      warmup_revolutions: int = 20, settings: GrazingSettings = GrazingSettings(),
-                     options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled"):
+                     options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled",
+                     guess: float | None = None):
     """The curve of grazing period-1 orbits (the follower first leaving the cam) in two
     parameters: ``free`` (lambda1, default the cam speed ``speed_rpm``, rev/min) and
     ``parameter`` (lambda2, a rig parameter, SI; or the speed) from ``start`` to ``end``, by
@@ -94,7 +95,10 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     ``search``: (low, high) of ``free``, over which :func:`camdyn.continue_orbit` (at lambda2 =
     start, from the orbit at low) finds the first grazing; ``speed_rpm``: the cam speed when
     neither parameter is the speed; ``phase_fraction``: the section's time in the period (choose it
-    away from the gap's maximum).  The scene needs the tangent dynamics (not damping C or E:
+    away from the gap's maximum); ``guess``: a value of ``free`` just on the contact side of the
+    first grazing (the jump chart's: the contact-loss speed less its compliance shift), from whose
+    periodic orbit the extended system is solved without the search, which runs only where that
+    fails.  The scene needs the tangent dynamics (not damping C or E:
     :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
     result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
     """
@@ -105,32 +109,62 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
                            tol=settings.continuation.tol, gap_tol=settings.gap_tol, threads=settings.threads)
     system.model(system.free_start, system.start)              # a rig value the rig refuses raises here
     system.model(float(search[1]), system.end)
-    curve, layout, system = _curve(system, search, settings, warmup_revolutions)
+    if guess is not None:
+        finite("guess", guess)
+    curve, layout, system = _curve(system, search, settings, warmup_revolutions, guess)
     return grazing_dataset(system, curve, layout, settings)
 
 
-def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
-    """(curve, layout, the system with lambda1 at the first grazing) from the start's search:
-    the extended system solved from each candidate orbit in turn until one converges."""
-    found = _search(system, search, settings, warmup_revolutions)
-    if isinstance(found, str):
-        return Curve([], [], GrazingOutcome.START_FAILED, found), None, system
-    candidates, scale = found
+def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int, guess=None):
+    """(curve, layout, the system with lambda1 at the first grazing) from the candidate first
+    orbits of the guess (:func:`_guessed`), else of the search (:func:`_search`): the extended
+    system solved from each candidate in turn until one converges."""
     why = []
-    for x, free, mode in candidates:
-        layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
-        try:
-            phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
-        except CamdynError as failure:
-            why.append(f"the orbit at {system.free} = {free:.8g} cannot be run: {failure}")
+    sources = ([lambda: _guessed(system, guess)] if guess is not None else []) + [
+        lambda: _search(system, search, settings, warmup_revolutions)]
+    for source in sources:
+        found = source()
+        if isinstance(found, str):
+            why.append(found)
             continue
-        at = dataclasses.replace(system, free_start=free, deflection=deflection)
-        leg = Leg(at, layout, settings.continuation)
-        p = first(leg, x, phase, free, mode)
-        if not isinstance(p, str):
-            return follow(leg, p), layout, at
-        why.append(p)
+        for x, free, mode in found[0]:
+            layout = Layout(np.asarray(found[1], dtype=float), abs(free), system.span)
+            p = _first_from(system, layout, settings, x, free, mode)
+            if isinstance(p, str):
+                why.append(p)
+                continue
+            at = p[1]
+            return follow(Leg(at, layout, settings.continuation), p[0]), layout, at
     return Curve([], [], GrazingOutcome.START_FAILED, "; ".join(why)), None, system
+
+
+def _first_from(system: GrazingSystem, layout: Layout, settings: GrazingSettings, x, free: float, mode):
+    """(the first grazing point, the system with its gap's scale) from a candidate orbit, or why not."""
+    try:
+        phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
+    except CamdynError as failure:
+        return f"the orbit at {system.free} = {free:.8g} cannot be run: {failure}"
+    at = dataclasses.replace(system, free_start=free, deflection=deflection)
+    p = first(Leg(at, layout, settings.continuation), x, phase, free, mode)
+    return p if isinstance(p, str) else (p, at)
+
+
+def _guessed(system: GrazingSystem, guess: float):
+    """The candidate first orbit at lambda1 = ``guess`` and lambda2 = start, ([(x, guess, None)],
+    the motion's scale): the period-1 orbit there by shooting from the quasi-static start
+    (camdyn.periodic_orbit), the section at the system's phase; or why there is none."""
+    from ..shooting import OrbitOutcome, periodic_orbit
+
+    try:
+        model = system.model(float(guess), system.start)
+        orbit = periodic_orbit(model.rig, system.scene, model.cam, phase=system.phase_fraction * model.period,
+                               options=system.options, jacobian=variational, backend=system.backend,
+                               start="quasistatic")
+    except CamdynError as failure:
+        return f"no periodic orbit at the guess {system.free} = {guess:.8g}: {failure}"
+    if orbit.outcome is not OrbitOutcome.CONVERGED:
+        return f"no periodic orbit at the guess {system.free} = {guess:.8g}: {orbit.message or orbit.outcome.name}"
+    return [(orbit.state, float(guess), None)], orbit.scale
 
 
 def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_revolutions: int):
@@ -166,6 +200,12 @@ def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_rev
 #: contact's compliance (:func:`camdyn.analysis.compliance_shift`: 2e-6 to 5e-8 of it on the
 #: shipped rigs), and the contact orbit exists from the low end
 JUMP_SEARCH = (0.9, 1.05)
+#: the jump chart's first orbit is guessed this fraction below the contact-loss speed less its
+#: compliance shift (the grazing's first-order estimate, within 3 % of the shift on a stiff contact,
+#: tests/test_charts.py): on the contact side unless the estimate is off by more than this, and then
+#: the search over ``search`` runs instead (on reference-experiment the guess's orbit and its Newton
+#: solve took ~1 s against the search's ~7 s)
+GUESS_BELOW = 1e-4
 #: cam angles of compliance_shift's search for the spring moment's minimum and its second
 #: difference there (its default, 20000, costs 0.18 s a point; with 3600, 0.1 degree apart, the
 #: second difference's truncation error is ~(0.1 degree)^2 of the curvature's scale, 3e-6)
@@ -183,8 +223,10 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
     at each point's parameter value, and the first-order shift between them by the contact's
     compliance (:func:`camdyn.analysis.compliance_shift`).
 
-    ``search``: the speeds (rev/min) the first grazing is searched between; default
-    :data:`JUMP_SEARCH` times the contact-loss speed at ``start``.  Returns the Dataset of
+    The first grazing is solved for from the orbit at the guess :data:`GUESS_BELOW` below the
+    contact-loss speed less its compliance shift at ``start``; where that fails it is searched
+    for between the speeds ``search`` (rev/min; default :data:`JUMP_SEARCH` times the contact-loss
+    speed at ``start``).  Returns the Dataset of
     :func:`continue_grazing` with ``contact_loss_rpm`` and ``compliance_shift`` per point.
     """
     from ...analysis.statics import compliance_shift, contact_loss_speed
@@ -192,16 +234,18 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
     if parameter == SPEED or parameter not in _names():
         raise ParameterError("parameter", parameter, f"a rig parameter ({', '.join(_names()[1:])}): the jump "
                                                      "speed is charted against it")
+    finite("start", start)
+    at_start = rig.replace(**{parameter: float(start)})
+    loss = contact_loss_speed(at_start)
+    if not (math.isfinite(loss) and loss > 0):
+        raise ParameterError("start", start, f"a value of {parameter} at which the follower leaves the cam "
+                                             f"at some speed (contact-loss speed {loss} rev/min there)")
     if search is None:
-        finite("start", start)
-        loss = contact_loss_speed(rig.replace(**{parameter: float(start)}))
-        if not (math.isfinite(loss) and loss > 0):
-            raise ParameterError("start", start, f"a value of {parameter} at which the follower leaves the cam "
-                                                 f"at some speed (contact-loss speed {loss} rev/min there)")
         search = (JUMP_SEARCH[0] * loss, JUMP_SEARCH[1] * loss)
+    guess = loss * (1.0 + compliance_shift(at_start, scene, samples=SHIFT_SAMPLES, loss_rpm=loss)) * (1.0 - GUESS_BELOW)
     ds = continue_grazing(rig, scene, parameter, start, end, search=search, phase_fraction=phase_fraction,
                           warmup_revolutions=warmup_revolutions, settings=settings, options=options,
-                          backend=backend)
+                          backend=backend, guess=guess)
     rigs = [rig.replace(**{parameter: float(v)}) for v in ds[parameter].values]
     losses = [contact_loss_speed(r) for r in rigs]
     ds["contact_loss_rpm"] = ("point", np.array(losses),

@@ -208,11 +208,12 @@ def refined_max(v: np.ndarray) -> float:
 
 
 def _point(lam: float, x, run: Run, ev: Scaled, direction, iterations: int) -> Point:
-    """The orbit (lam, x) as a Point: its gap and its impacts' landings from its run, its
-    derivatives ``ev``, its tangent oriented along ``direction``."""
+    """The orbit (lam, x) as a Point: its gap, its impacts' landings and its lift-off test
+    function from its run, its derivatives ``ev``, its tangent oriented along ``direction``."""
+    from .lift_off import lift_off          # (here: lift_off reads this module's refined_max)
     max_gap, alphas, end_mode = gap(run)
     return Point(lam, np.array(x, dtype=float), ev.J, tangent(ev.A, direction), max_gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation, landings(run))
+                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation, landings(run), lift_off(run))
 
 
 def step(leg: Leg, p: Point, ds: float) -> Point | None:

@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numpy.polynomial import polynomial as P
 
-from .corrector import Run, refined_max
+from .sampled import refined_max
 
 #: F_n just after a restart of the contact at t is read at t + RESTART_NUDGE T: past the switch's
 #: located time (~1e-15 T) onto the arc the follower rides on, near enough that the force
@@ -45,8 +45,8 @@ def constrained(kernels) -> bool:
     return hasattr(kernels, "SURFACE_CONTACT_FORCE")
 
 
-def lift_off(run: Run) -> float:
-    """The lift-off test function of the orbit of ``run`` (module docstring): -min F_n (N) on a
+def lift_off(run) -> float:
+    """The lift-off test function of the orbit of ``run`` (:class:`.corrector.Run`; module docstring): -min F_n (N) on a
     contact orbit, the flight's largest gap psi_i (m, > 0) on one that leaves; NaN on a compliant
     scene.  From the run's samples and switch records, with the generated outputs kernel."""
     model, tr = run.section_map.model, run.trajectory
@@ -80,7 +80,7 @@ def least_force(force: np.ndarray, t: np.ndarray, restarts: np.ndarray) -> float
 def quartic_least(v: np.ndarray) -> float:
     """The least value of the quartic through five equally spaced samples v (the middle one
     the least) within one spacing of the middle.  Its error is O(h^6) of the curve's sixth
-    derivative: the parabola through three (:func:`.corrector.refined_max`, O(h^4)) leaves
+    derivative: the parabola through three (:func:`.sampled.refined_max`, O(h^4)) leaves
     8e-8 N on reference-experiment's least force at 256 samples a period (measured against
     20000 samples of the constrained force), 1.1e-7 of the contact-loss speed."""
     u = np.arange(-FIT_HALF, FIT_HALF + 1, dtype=float)
@@ -90,7 +90,7 @@ def quartic_least(v: np.ndarray) -> float:
     return float(min(v[FIT_HALF], *P.polyval(inside, c))) if inside.size else float(v[FIT_HALF])
 
 
-def restart_force(run: Run, records: np.ndarray) -> float:
+def restart_force(run, records: np.ndarray) -> float:
     """The least F_n (N) just after the switches of a contact orbit (RESTART_NUDGE T past each:
     a junction of a cam of arcs restarts the contact on the next arc, where the needed force
     has jumped); inf without switches."""

@@ -27,6 +27,7 @@ def _lift_offs(rig, scene, **kw):
     ds = continue_orbit(rig, scene, "speed_rpm", (1 - WIDTH) * loss, (1 + WIDTH) * loss, **kw)
     outcome = ds.attrs["outcomes"].split()[int(ds["branch_outcome"].values[0])]
     assert outcome == ContinuationOutcome.END_REACHED.name, ds.attrs["branch_0_message"]
+    assert "grazing" not in [kind for kind, *_ in events_table(ds)]
     speeds = [speed for kind, speed, branch, _ in events_table(ds) if kind == "lift_off"]
     return speeds, loss, ContinuationSettings().locate_tol * 2 * WIDTH * loss
 

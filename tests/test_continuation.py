@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 
 import numpy as np
 import pytest
@@ -486,6 +487,7 @@ def _continued(f, start, end, monkeypatch):
     monkeypatch.setattr(corrector, "orbit_run", run)
     monkeypatch.setattr(corrector, "gap", lambda run: (-1.0, np.zeros(1), 0))
     monkeypatch.setattr(corrector, "landings", lambda run: NO_LANDINGS)
+    monkeypatch.setattr(corrector, "lift_off", lambda run: math.nan)     # no constrained contact
     leg = Leg(_AnalyticProblem(f, start, end), 1, np.ones(2), ContinuationSettings())
     first = corrector.first_point(leg, start, np.zeros(2), 0, 1.0)
     branch, events = Branch(1), []

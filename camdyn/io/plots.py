@@ -433,7 +433,7 @@ def bifurcation(speed_rpm, points, *, quantity: str = "alpha", relative_to: floa
 #: the marker of each event kind of :func:`camdyn.orbits.continuation.continue_orbit`
 #: (every kind of camdyn.orbits.continuation.EVENTS: tests/test_plots.py)
 EVENT_MARKERS = {"fold": "s", "branch_point": "D", "period_doubling": "^", "neimark_sacker": "o", "grazing": "v",
-                 "corner_impact": "*", "multiplier_jump": "x"}
+                 "lift_off": "<", "corner_impact": "*", "multiplier_jump": "x"}
 
 
 def stability_runs(flags: np.ndarray) -> list[tuple[int, int, bool]]:

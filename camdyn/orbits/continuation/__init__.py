@@ -60,6 +60,11 @@ with its test function and locator in one table, :data:`.events.KINDS`):
   bisection's are measured in docs/continuation.md).
   A trial needs the gap alone: its orbit is corrected without derivatives (6 runs less each),
   which only the two bracketing points get;
+* ``lift_off`` (a rigid scene, :mod:`.lift_off`): the rigid follower's contact orbit starts to
+  leave the cam.  Its gap is 0 to rounding there (``grazing`` is not told on a rigid scene); the
+  test function is -min F_n over the orbit (N, the constraint's force, ``OUT_F_N``, refined by a
+  quartic, and just past each restart of the contact: a corner of a cam of arcs) on a contact
+  orbit, the flight's largest gap (m, > 0) on one that leaves; located as grazing is;
 * ``corner_impact`` (a rigid scene on a cam profile with junctions, :mod:`.corners`): a Newton
   impact's landing angle on the cam (the contact's body angle phi at the impact) crosses a
   junction of the profile, where its curvature jumps (Osorio, di Bernardo & Santini 2008): the

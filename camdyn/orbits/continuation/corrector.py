@@ -14,6 +14,8 @@ from ..derivatives import Column, Unresolved, resolved_difference
 from ..section_map import MapFailure, MapValue, StroboscopicMap, derivative_at
 from ..shooting import newton_matrix
 from .corners import landings
+from .lift_off import lift_off
+from .sampled import refined_max
 from .problem import N_STATE, Z_LAMBDA, Z_SIZE, Z_STATE, Derivation, Leg, Point
 
 #: samples of psi_i per cam period for the orbit's largest gap (:data:`camdyn.orbits.continuation.GAP_SAMPLES`),
@@ -198,21 +200,12 @@ def gap(run: Run):
     return refined_max(psi), tr.alpha[np.searchsorted(tr.t, run.starts)], int(tr.end_mode)
 
 
-def refined_max(v: np.ndarray) -> float:
-    """The largest value of a periodic sampled curve, refined by a parabola through its neighbours."""
-    v = v[:-1]                              # the last sample repeats the first (one period)
-    k = int(np.argmax(v))
-    a, b, c = v[k - 1], v[k], v[(k + 1) % v.size]
-    curvature = a - 2 * b + c
-    return float(b - (a - c) ** 2 / (8 * curvature)) if curvature < 0 else float(b)
-
-
 def _point(lam: float, x, run: Run, ev: Scaled, direction, iterations: int) -> Point:
-    """The orbit (lam, x) as a Point: its gap and its impacts' landings from its run, its
-    derivatives ``ev``, its tangent oriented along ``direction``."""
+    """The orbit (lam, x) as a Point: its gap, its impacts' landings and its lift-off test
+    function from its run, its derivatives ``ev``, its tangent oriented along ``direction``."""
     max_gap, alphas, end_mode = gap(run)
     return Point(lam, np.array(x, dtype=float), ev.J, tangent(ev.A, direction), max_gap, alphas, end_mode,
-                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation, landings(run))
+                 float(np.max(np.abs(ev.G))), iterations, ev.A, ev.derivation, landings(run), lift_off(run))
 
 
 def step(leg: Leg, p: Point, ds: float) -> Point | None:

@@ -15,6 +15,7 @@ import numpy as np
 from ..shooting import sorted_multipliers
 from .corners import crossings, distance_of, landings
 from .corrector import completed, corrected, gap, step
+from .lift_off import lift_off
 from .problem import N_STATE, Z_LAMBDA, Event, Leg, Point
 
 #: a located bifurcation's critical multiplier (+1, -1, ``|mu| = 1``) is within this of its value,
@@ -40,7 +41,9 @@ class Kind(NamedTuple):
     branch of period 2 n T is switched to there (:mod:`.switching`); ``changed(f_p, f_q)``:
     whether the test's values at two points mark the event (None: a strict sign change of two
     finite values); ``located_before``: the located orbit is the bracket's end on p's side (else
-    the far end's, where it ran)."""
+    the far end's, where it ran); ``of_run``: the test function from a corrected orbit's run
+    (:class:`.corrector.Run`), for a locator whose trials are orbits without derivatives
+    (:func:`grazing_location`)."""
 
     name: str
     test: Callable[[Point], object] | None
@@ -50,6 +53,7 @@ class Kind(NamedTuple):
     switch_branch: bool = False
     changed: Callable | None = None
     located_before: bool = False
+    of_run: Callable | None = None
 
 
 class Found(NamedTuple):
@@ -89,7 +93,19 @@ def _neimark_sacker(p: Point) -> float:
 
 
 def _grazing(p: Point) -> float:
-    return p.max_gap
+    """The largest gap (m); NaN on a rigid scene (where the lift-off test is defined), whose
+    contact orbits have a gap of 0 to rounding: its sign there is noise (:mod:`.lift_off`)."""
+    return p.max_gap if math.isnan(p.lift_off) else math.nan
+
+
+def _largest_gap(run) -> float:
+    return gap(run)[0]
+
+
+def _lift_off(p: Point) -> float:
+    """-min F_n (N) on a rigid contact orbit, the flight's largest gap (m) past it; NaN on a
+    compliant scene (:func:`.lift_off.lift_off`)."""
+    return p.lift_off
 
 
 def _corner_impact(p: Point):
@@ -207,24 +223,26 @@ def completed_ends(leg: Leg, p: Point, bracket: Bracket):
 
 
 def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
-    """The grazing between p and q bracketed as :func:`secant_location` does, the trials aimed
-    from the contact side (:func:`grazing_trial`): its test function, the largest gap, has a
-    corner at the event (the contact's deflection before it, the flight's height after), so
-    secant trials across the bracket crawl in from the flat side, while on the contact side
-    (gap < 0) it is smooth, the contact orbit continuing through the event.  A trial needs the
-    gap alone: it is a corrected orbit without derivatives (6 runs less by finite
+    """The grazing (or rigid lift-off) between p and q bracketed as :func:`secant_location` does,
+    the trials aimed from the contact side (:func:`grazing_trial`): its test function (the
+    largest gap; a rigid orbit's lift-off test, :mod:`.lift_off`) has a corner at the event (the
+    contact's deflection or least force before it, the flight's height after), so secant trials
+    across the bracket crawl in from the flat side, while on the contact side (test < 0) it is
+    smooth, the contact orbit continuing through the event.  A trial needs the test alone
+    (``kind.of_run``): it is a corrected orbit without derivatives (6 runs less by finite
     differences); the two points returned get theirs (after: None when a run fails there, as
     for a failed step; before: p then, the bracket's start, the location lost for that rare case)."""
     tol = leg.settings.locate_tol
-    bracket = Bracket(0.0, ds, kind.test(p), kind.test(q), p)
-    contact = [(0.0, p.max_gap) if p.max_gap < 0 else (ds, q.max_gap)]
-    far = 1.0 if p.max_gap < 0 else -1.0
+    f_p, f_q = kind.test(p), kind.test(q)
+    bracket = Bracket(0.0, ds, f_p, f_q, p)
+    contact = [(0.0, f_p) if f_p < 0 else (ds, f_q)]
+    far = 1.0 if f_p < 0 else -1.0
     for _ in range(MAX_BISECTIONS):
         if bracket.hi - bracket.lo <= tol:
             break
         s = grazing_trial(bracket.lo, bracket.hi, contact[-3:], far, tol)
         r = corrected(leg, p, s)
-        f = math.nan if r is None else gap(r.run)[0]
+        f = math.nan if r is None else kind.of_run(r.run)
         if f < 0:
             contact.append((s, f))
         bracket.narrow(s, f, r)
@@ -322,7 +340,8 @@ def _from_unit_circle(mu: np.ndarray) -> np.ndarray:
 #: through +1, the branch turning back), ``branch_point`` (through +1 while the branch does not
 #: turn: a crossing of branches), ``period_doubling`` (a real multiplier through -1),
 #: ``neimark_sacker`` (a complex pair through the unit circle), ``grazing`` (the orbit's largest
-#: gap through 0), ``corner_impact`` (an impact landing on a junction of the cam's profile:
+#: gap through 0; compliant scenes), ``lift_off`` (a rigid orbit's least contact force through 0,
+#: to a flight: :mod:`.lift_off`), ``corner_impact`` (an impact landing on a junction of the cam's profile:
 #: :func:`.corners.crossings`; the located orbit is the last trial on p's side);
 #: ``multiplier_jump``: a test function of the multipliers changed sign but the located orbit's
 #: multipliers are not critical or jump across the bracket (the map is not smooth there, e.g.
@@ -332,7 +351,8 @@ KINDS = (
     Kind("branch_point", _branch_point, _from_one, secant_location, unless="fold"),
     Kind("period_doubling", _period_doubling, _from_minus_one, secant_location, switch_branch=True),
     Kind("neimark_sacker", _neimark_sacker, _from_unit_circle, secant_location),
-    Kind("grazing", _grazing, None, grazing_location),
+    Kind("grazing", _grazing, None, grazing_location, of_run=_largest_gap),
+    Kind("lift_off", _lift_off, None, grazing_location, of_run=lift_off),
     Kind("corner_impact", _corner_impact, None, corner_location, changed=_corner_crossed, located_before=True),
     Kind("multiplier_jump", None, None, None),
 )

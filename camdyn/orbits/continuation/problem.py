@@ -198,9 +198,10 @@ class Point(NamedTuple):
     """One orbit on a branch: lambda, x at the section, dP_n/dx, the unit tangent (scaled), the
     largest gap (m), alpha at the revolutions' starts (the brute-force diagram's section), the
     mode at the section, the scaled residual, the corrector's steps, the scaled derivatives
-    of G there, how they were obtained (:class:`Derivation`), and where its Newton impacts land
+    of G there, how they were obtained (:class:`Derivation`), where its Newton impacts land
     on the cam against the profile's junctions (:class:`~.corners.Landings`: from the run that
-    converged; no impacts on a compliant scene)."""
+    converged; no impacts on a compliant scene), and the lift-off test function (N where it is
+    < 0, m where > 0; NaN on a compliant scene: :func:`.lift_off.lift_off`, from the same run)."""
 
     lam: float
     x: np.ndarray
@@ -214,6 +215,7 @@ class Point(NamedTuple):
     derivatives: np.ndarray     # the scaled [dG/dx, dG/dlambda] (n x n + 1) at the point: the next corrector's
     derivation: Derivation
     landings: Landings
+    lift_off: float
 
     @property
     def resolved(self) -> bool:

@@ -28,9 +28,15 @@ class Domain:
 
     def surface_crossed(self, mode: int, t: float, alpha: float, alpha_dot: float) -> int:
         """The first surface that ``mode`` watches whose far side (in its transition's direction)
-        the state is on, or on it: outside the mode's domain; -1 inside it."""
+        the state is on, or on it: outside the mode's domain; -1 inside it.  A surface the mode
+        watches in both directions (a cam of arcs' junction indicator, whose sign alternates from
+        arc to arc: a restart of the mode, not a side of its domain) bounds nothing: every state
+        is on the far side of one of its two transitions."""
         tab = self._problem.tables
-        for w in range(tab.data[tab.watch_start + mode], tab.data[tab.watch_start + mode + 1]):
-            if across(self._problem, mode, w, float(t), float(alpha), float(alpha_dot)):
-                return int(tab.data[tab.surface + w])
+        watched = range(tab.data[tab.watch_start + mode], tab.data[tab.watch_start + mode + 1])
+        surfaces = [int(tab.data[tab.surface + w]) for w in watched]
+        for w, surface in zip(watched, surfaces):
+            if surfaces.count(surface) == 1 and across(self._problem, mode, w, float(t), float(alpha),
+                                                       float(alpha_dot)):
+                return surface
         return -1

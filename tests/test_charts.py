@@ -274,6 +274,7 @@ def test_a_step_whose_orbit_has_no_contact_side_difference_is_retried_shorter(mo
             else got is None
 
 
+@pytest.mark.slow   # three continuations, ~9 s; the guessed start alone runs in every chart above
 def test_the_guessed_start_and_the_searched_one_find_the_same_grazing():
     """jump_chart starts from the orbit at its guess (the contact-loss speed less the compliance
     shift, 1e-4 below); continue_grazing without a guess searches the branch over ``search``; a

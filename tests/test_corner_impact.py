@@ -69,8 +69,8 @@ def test_a_junction_at_the_turns_start_is_crossed_through_the_angles_wrap():
     assert crossings(_landing([0.49], ()), _landing([0.52], ())) == []
 
 
-@pytest.mark.parametrize("follower", ["translating", "oscillating"])
-def test_an_impact_lands_where_the_faces_normal_points_on_the_cam(follower):
+@pytest.mark.parametrize("follower", ["translating", pytest.param("oscillating", marks=pytest.mark.slow)])
+def test_an_impact_lands_where_the_faces_normal_points_on_the_cam(follower):   # (the rocker's: its scene derived, ~7 s)
     """On a rigid scene over a cam of arcs at 1.5 x its jump speed (3 revolutions from rest), each
     impact's landing angle (camdyn.orbits.continuation.corners.landings) is the body angle of the
     face's normal toward the follower: the guide g = (cos gamma, sin gamma) for the translating face,

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,7 +40,7 @@ from ..model.model import Model
 from ..model.rig import Rig
 from ..model.scene import Scene
 from .section_map import DEFAULT_OPTIONS, MapFailure, warm_up
-from .tangent import TangentSettings, tangent
+from .tangent import TangentFailure, TangentSettings, tangent
 
 __all__ = ["lyapunov_exponents", "spectrum", "largest_by_differences", "LyapunovExponents", "LyapunovSettings",
            "DifferenceEstimate"]
@@ -190,6 +191,36 @@ def verdict(estimates, standard_error: float, confidence: float) -> str:
     if values.size and np.all(values < -bound) and np.all(values < 0):
         return "regular"
     return "undecided"
+
+
+class LargestExponent(NamedTuple):
+    """lambda_1 (1/s) by :func:`largest_exponent`: ``largest`` and its batch means'
+    ``standard_error``; ``check``, a second estimate (two runs: the one at 10 delta; the tangent
+    dynamics: ``largest`` itself); the cam ``period`` (s); ``method``, "variational" or "differences"."""
+
+    largest: float
+    standard_error: float
+    check: float
+    period: float
+    method: str
+
+    def verdict(self, confidence: float) -> str:
+        """:func:`verdict` of both estimates."""
+        return verdict((self.largest, self.check), self.standard_error, confidence)
+
+
+def largest_exponent(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=None,
+                     options: SolverOptions = DEFAULT_OPTIONS, backend: str = "compiled") -> LargestExponent:
+    """lambda_1 of ``model``'s run by the tangent dynamics (:func:`spectrum`), or, where they
+    cannot pass first contact (damping C and E: :class:`camdyn.orbits.tangent.TangentFailure`), by
+    two neighbouring runs at two distances (:func:`largest_by_differences`)."""
+    try:
+        found = spectrum(model, settings, y0, options, backend)
+        lam = found.largest
+        return LargestExponent(lam, float(found.standard_error[0]), lam, found.period, "variational")
+    except TangentFailure:
+        d = largest_by_differences(model, settings, y0, options, backend)
+        return LargestExponent(d.largest, d.standard_error, d.at_ten_delta, d.period, "differences")
 
 
 def largest_by_differences(model: Model, settings: LyapunovSettings = LyapunovSettings(), y0=None,

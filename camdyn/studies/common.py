@@ -362,24 +362,15 @@ def chaos_by_lyapunov(rig, damping: str, speed_rpm: float, transient: int, revol
     cannot (damping C and E: their impact law's Jacobian is unbounded at first contact,
     camdyn.orbits.tangent), from two neighbouring runs (``method`` "differences",
     camdyn.orbits.lyapunov.largest_by_differences), whose distance's effect on the exponent must
-    then not change the verdict (:meth:`camdyn.orbits.lyapunov.DifferenceEstimate.verdict`)."""
+    then not change the verdict (:func:`camdyn.orbits.lyapunov.largest_exponent`)."""
     from camdyn.model.model import Model
-    from camdyn.orbits.lyapunov import LyapunovSettings, largest_by_differences, lyapunov_exponents
-    from camdyn.orbits.lyapunov import verdict as chaos_verdict
-    from camdyn.orbits.tangent import TangentFailure
+    from camdyn.orbits.lyapunov import LyapunovSettings, largest_exponent
 
     scene = camdyn.Scene(contact="line", damping=damping, friction="coulomb")
     settings = LyapunovSettings(revolutions=revolutions, transient=transient, batches=batches)
-    try:
-        ly = lyapunov_exponents(rig, scene, speed_rpm=speed_rpm, settings=settings)
-        lam, se, period, method = ly.largest, float(ly.standard_error[0]), ly.period, "variational"
-        verdict = chaos_verdict((lam,), se, CONFIDENCE_SE)
-    except TangentFailure:
-        d = largest_by_differences(Model(rig, scene, camdyn.ConstantSpeed(speed_rpm)), settings)
-        lam, se, period, method = d.largest, d.standard_error, d.period, "differences"
-        verdict = d.verdict(CONFIDENCE_SE)
-    return {"lyapunov": lam, "lyapunov_se": se, "lyapunov_per_rev": lam * period, "chaos": verdict,
-            "lyapunov_method": method}
+    e = largest_exponent(Model(rig, scene, camdyn.ConstantSpeed(speed_rpm)), settings)
+    return {"lyapunov": e.largest, "lyapunov_se": e.standard_error, "lyapunov_per_rev": e.largest * e.period,
+            "chaos": e.verdict(CONFIDENCE_SE), "lyapunov_method": e.method}
 
 
 def continuation_start(end_state, from_rpm: float, to_rpm: float) -> tuple[list[float], float]:

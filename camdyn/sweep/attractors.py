@@ -122,22 +122,15 @@ class AttractorSection:
         """lambda_1 from the last section point at an even revolution (the kernels' period is 2 T,
         so that state is a start at t = 0): by the tangent dynamics, or where they cannot pass
         first contact (damping C, E) by two neighbouring runs at two distances
-        (:func:`camdyn.orbits.lyapunov.largest_by_differences`); NaN where neither runs."""
-        from ..orbits.lyapunov import LyapunovSettings, largest_by_differences, spectrum
-        from ..orbits.tangent import TangentFailure
+        (:func:`camdyn.orbits.lyapunov.largest_exponent`); NaN where neither runs."""
+        from ..orbits.lyapunov import LyapunovSettings, largest_exponent
 
         k = (result.t.size - 1) // 2 * 2
         settings = LyapunovSettings(self.lyapunov_revolutions, 0, self.lyapunov_batches)
-        start, options, backend = (result.q[k], result.q_dot[k]), inputs.request.options, inputs.request.backend
         try:
-            model = Model(inputs.rig, inputs.scene, inputs.cam)
-            try:
-                found = spectrum(model, settings, start, options, backend)
-                lam = found.largest
-                return {"lyapunov": lam, "lyapunov_se": float(found.standard_error[0]), "lyapunov_check": lam}
-            except TangentFailure:
-                d = largest_by_differences(model, settings, start, options, backend)
-                return {"lyapunov": d.largest, "lyapunov_se": d.standard_error, "lyapunov_check": d.at_ten_delta}
+            e = largest_exponent(Model(inputs.rig, inputs.scene, inputs.cam), settings, (result.q[k], result.q_dot[k]),
+                                 inputs.request.options, inputs.request.backend)
+            return {"lyapunov": e.largest, "lyapunov_se": e.standard_error, "lyapunov_check": e.check}
         except Exception as exc:  # a run that fails from here: no verdict
             if _interrupted(exc):
                 raise KeyboardInterrupt from exc

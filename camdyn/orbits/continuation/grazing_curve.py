@@ -30,7 +30,7 @@ from ...outcome import ActionableOutcome
 from ..derivatives import Unresolved
 from ..shooting import sorted_multipliers
 from .corrector import chord, tangent
-from .events import MAX_BISECTIONS, Bracket, trial
+from .events import Bracket, secant_bracket
 from .follow import AT_END, GROWTH, clipped, left_range
 from .grazing import (G_RANGE, G_SIZE, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
                       free_at_zero_gap, is_largest)
@@ -301,7 +301,7 @@ def _reaches_end(leg, p, ds: float) -> bool:
 
 def located(leg: Leg, p: GrazingPoint, q: GrazingPoint, ds: float, index: int) -> list[Codim2]:
     """The codimension-2 points between p and q (ds apart), each located in arclength to
-    ``locate_tol`` by secant trials with the Illinois rule (:class:`.events.Bracket`); the
+    ``locate_tol`` by secant trials with the Illinois rule (:func:`.events.secant_bracket`); the
     located orbit is the last trial on p's side of the sign change."""
     out = []
     f0, f1 = p.tests, q.tests
@@ -309,14 +309,10 @@ def located(leg: Leg, p: GrazingPoint, q: GrazingPoint, ds: float, index: int) -
         a, b = f0[kind], f1[kind]
         if not (math.isfinite(a) and math.isfinite(b) and a * b < 0):
             continue
-        bracket = Bracket(0.0, ds, a, b, p)
-        for _ in range(MAX_BISECTIONS):
-            if bracket.hi - bracket.lo <= leg.settings.locate_tol:
-                break
-            s = trial(bracket.lo, bracket.hi, bracket.f_lo, bracket.f_hi, leg.settings.locate_tol)
+        def at(s: float, test=CODIM2[kind]):
             r = step(leg, p, s)
-            r = r if isinstance(r, GrazingPoint) else None
-            bracket.narrow(s, math.nan if r is None else CODIM2[kind](r.M), r)
+            return (test(r.M), r) if isinstance(r, GrazingPoint) else (math.nan, None)
+        bracket = secant_bracket(Bracket(0.0, ds, a, b, p), at, leg.settings.locate_tol)
         out.append(Codim2(kind, bracket.before, index))
     return out
 

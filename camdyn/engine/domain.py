@@ -20,6 +20,7 @@ class Domain:
         K = model.kernels
         self.modes, self.surfaces = tuple(K.MODES), tuple(K.SURFACES)
         self._problem = Problem(python_kernels(K), tables(K), np.ascontiguousarray(model.p, dtype=float))
+        self._bounds = [_bounding(self._problem.tables, m) for m in range(len(self.modes))]
 
     def initial_mode(self, t: float, alpha: float, alpha_dot: float) -> int:
         """The mode a run from (t, alpha, alpha_dot) starts in: the automaton's initial rule
@@ -27,16 +28,20 @@ class Domain:
         return int(initial_mode(self._problem, float(t), float(alpha), float(alpha_dot), LOOK_AHEAD))
 
     def surface_crossed(self, mode: int, t: float, alpha: float, alpha_dot: float) -> int:
-        """The first surface that ``mode`` watches whose far side (in its transition's direction)
-        the state is on, or on it: outside the mode's domain; -1 inside it.  A surface the mode
-        watches in both directions (a cam of arcs' junction indicator, whose sign alternates from
-        arc to arc: a restart of the mode, not a side of its domain) bounds nothing: every state
-        is on the far side of one of its two transitions."""
+        """The first surface that bounds ``mode`` (:func:`_bounding`) whose far side (in its
+        transition's direction) the state is on, or on it: outside the mode's domain; -1 inside it."""
         tab = self._problem.tables
-        watched = range(tab.data[tab.watch_start + mode], tab.data[tab.watch_start + mode + 1])
-        surfaces = [int(tab.data[tab.surface + w]) for w in watched]
-        for w, surface in zip(watched, surfaces):
-            if surfaces.count(surface) == 1 and across(self._problem, mode, w, float(t), float(alpha),
-                                                       float(alpha_dot)):
-                return surface
+        for w in self._bounds[mode]:
+            if across(self._problem, mode, w, float(t), float(alpha), float(alpha_dot)):
+                return int(tab.data[tab.surface + w])
         return -1
+
+
+def _bounding(tab, mode: int) -> tuple[int, ...]:
+    """The transitions of ``mode`` whose surfaces bound its domain: those it watches, less a
+    surface it watches in both directions (a cam of arcs' junction indicator, whose sign
+    alternates from arc to arc: a restart of the mode, not a side of its domain; every state is
+    on the far side of one of its two transitions)."""
+    watched = range(tab.data[tab.watch_start + mode], tab.data[tab.watch_start + mode + 1])
+    surfaces = [int(tab.data[tab.surface + w]) for w in watched]
+    return tuple(w for w, surface in zip(watched, surfaces) if surfaces.count(surface) == 1)

@@ -23,7 +23,6 @@ import numpy as np
 
 from ..vocabulary import FLOWS, TRANSITION_DIRECTION as DIRECTION, TRANSITION_RESET as RESET
 from ..vocabulary import TRANSITION_SOURCE as SOURCE, TRANSITION_SURFACE as SURFACE, TRANSITION_TARGETS as TARGETS
-from ..vocabulary import TRANSITION_RESET
 
 #: reset index of the identity (no call to a reset kernel)
 IDENTITY = -1
@@ -143,7 +142,7 @@ def impact_transitions(K: ModuleType) -> tuple[int, ...]:
     """The transitions (switch records' ``transition``) whose reset is Newton's impact law (the
     module's RESET_IMPACT: the rigid contact's bounce); none in a scene without it."""
     impact = getattr(K, "RESET_IMPACT", None)
-    return tuple(i for i, row in enumerate(transition_rows(K)) if impact is not None and row[TRANSITION_RESET] == impact)
+    return tuple(i for i, row in enumerate(transition_rows(K)) if impact is not None and row[RESET] == impact)
 
 
 def transition_surfaces(K: ModuleType) -> tuple[str, ...]:

@@ -127,14 +127,15 @@ def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revo
         if isinstance(found, str):
             why.append(found)
             continue
-        for x, free, mode in found[0]:
-            layout = Layout(np.asarray(found[1], dtype=float), abs(free), system.span)
-            p = _first_from(system, layout, settings, x, free, mode)
-            if isinstance(p, str):
-                why.append(p)
+        candidates, scale = found
+        for x, free, mode in candidates:
+            layout = Layout(np.asarray(scale, dtype=float), abs(free), system.span)
+            started = _first_from(system, layout, settings, x, free, mode)
+            if isinstance(started, str):
+                why.append(started)
                 continue
-            at = p[1]
-            return follow(Leg(at, layout, settings.continuation), p[0]), layout, at
+            point, at = started
+            return follow(Leg(at, layout, settings.continuation), point), layout, at
     return Curve([], [], GrazingOutcome.START_FAILED, "; ".join(why)), None, system
 
 

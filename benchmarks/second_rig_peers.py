@@ -32,10 +32,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from second_rig_exact import Rig as ExactRig, sample, solve  # noqa: E402
 
 import camdyn  # noqa: E402
-from camdyn.engine import impact_transitions  # noqa: E402
 from camdyn.model.presets import second_rig  # noqa: E402
+from camdyn.studies.second_rig import SCENE, approach_speeds  # noqa: E402
 
-SCENE = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
 RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
 #: camdyn's samples per cam revolution: every 10 degrees, so that its start (a quarter turn before the
 #: peer's) and the section fall on samples (no interpolation between them)
@@ -53,19 +52,6 @@ def camdyn_run(rig, speed_rpm: float, revolutions: int, rtol: float, repeats: in
         result = camdyn.simulate(rig, SCENE, **kw)
         best = min(best, time.perf_counter() - start)
     return best, result
-
-
-def approach_speeds(rig, result) -> tuple[np.ndarray, np.ndarray]:
-    """The impacts' times and their relative approach speeds (Newton's law: psi_i_dot- = -psi_i_dot+ / xi,
-    the rate after read from the switch's state under the free mode's laws); the impacts are the
-    switches whose reset is the impact law (camdyn.engine.impact_transitions)."""
-    model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(result.meta["cam"].speed_rpm))
-    K = SCENE.kernels()
-    records = result.switches.records
-    bounces = records[np.isin(records["transition"], impact_transitions(K))]
-    after = np.array([model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, r["t"], r["alpha"], r["alpha_dot"])
-                      for r in bounces])
-    return bounces["t"].copy(), -after / rig.xi if bounces.size else np.empty(0)
 
 
 def errors(reference: np.ndarray, times: np.ndarray) -> tuple[float, float]:

@@ -351,7 +351,7 @@ def run(ctx: Context) -> StudyOutput:
     ctx.log(f"{NAME}: stage 2, {len(cand) + 1} geometries x {len(MODELS) * len(s['dense'])} runs")
     st2 = parallel_map(_stage2, [(g, s["dense"], s) for g in cand + [shipped]], ctx.fast)
     st2[-1]["shipped"] = True
-    numbers = {"settings": {**s, "stage1": [list(x) for x in s["stage1"]]}, "stage1_reused": reused,
+    numbers = {"settings": _as_recorded(s), "stage1_reused": reused,
                "stage1": [{k: v for k, v in r.items() if k != "seconds"} for r in st1], "stage2": st2,
                "reproduced": [r["geometry"] for r in st2 if all(r["verdict"].values())]}
     md = section(numbers)
@@ -364,13 +364,18 @@ def run(ctx: Context) -> StudyOutput:
 STAGE1_SETTINGS = ("grid", "stage1", "revolutions", "transient", "max_revolutions")
 
 
+def _as_recorded(s: dict) -> dict:
+    """The settings as the report records them (the stage-1 runs as lists)."""
+    return {**s, "stage1": [list(x) for x in s["stage1"]]}
+
+
 def _recorded_stage1(ctx: Context, s: dict) -> list[dict] | None:
     """Stage 1 as recorded in the report by an earlier run with the same stage-1 settings, or None
     (then it is run again)."""
     rec = recorded_numbers(ctx.out / "reproduction.md").get(NAME)
     if not rec:
         return None
-    now = json.loads(to_json({**s, "stage1": [list(x) for x in s["stage1"]]}))
+    now = json.loads(to_json(_as_recorded(s)))
     same = all(rec["settings"].get(k) == now[k] for k in STAGE1_SETTINGS)
     return rec["stage1"] if same and len(rec["stage1"]) == len(geometries(s["grid"])) else None
 

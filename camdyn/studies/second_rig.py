@@ -34,18 +34,28 @@ def _run(args) -> dict:
     r = simulate(rig, SCENE, speed_rpm=speed, revolutions=revolutions, sample_rate_Hz=per_turn * speed / 60)
     keep_from = (revolutions - kept) * 60.0 / speed
     section = r.q[::per_turn][revolutions - kept:revolutions].tolist()
-    model = camdyn.Model(rig, SCENE, camdyn.ConstantSpeed(speed))
     K = SCENE.kernels()
+    times, approach = approach_speeds(rig, r)
+    impacts = times[(times >= keep_from) & (approach < -0.5)]
     kept_switches = r.switches.records[r.switches.t >= keep_from]
-    bounces = kept_switches[np.isin(kept_switches["transition"], impact_transitions(K))]
-    # the state recorded is the one after the reset: the approach is the rate before it, -1/xi times
-    approach = np.array([-model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, s["t"], s["alpha"], s["alpha_dot"]) / rig.xi
-                         for s in bounces])
-    impacts = bounces["t"][approach < -0.5] if bounces.size else np.empty(0)
     leaves = kept_switches["t"][(kept_switches["before"] == K.MODE_CONTACT) & (kept_switches["after"] == K.MODE_FREE)]
     return {"speed_rpm": speed, "outcome": r.outcome.name, "section": section,
             "impact_deg": _cam_angle_deg(rig, impacts, speed).tolist(),
             "leave_deg": _cam_angle_deg(rig, leaves, speed).tolist()}
+
+
+def approach_speeds(rig, result) -> tuple[np.ndarray, np.ndarray]:
+    """The Newton impacts of a run of the rigid scene (the switches whose reset is the impact law,
+    camdyn.engine.impact_transitions): their times and relative approach speeds (m/s, < 0). A
+    record holds the state after the reset, so the approach is -1/xi times the gap's rate there
+    (Newton's law), read under the free mode's laws."""
+    model = camdyn.Model(rig, SCENE, result.meta["cam"])
+    K = SCENE.kernels()
+    records = result.switches.records
+    bounces = records[np.isin(records["transition"], impact_transitions(K))]
+    after = np.array([model.surface(K.MODE_FREE, K.SURFACE_GAP_RATE, b["t"], b["alpha"], b["alpha_dot"])
+                      for b in bounces], dtype=float)
+    return bounces["t"].copy(), -after / rig.xi
 
 
 def _junctions_deg(rig) -> list[float]:

@@ -436,13 +436,23 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
 @jitable
 def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
     """A step that starts exactly on a watched surface (value 0) and ends strictly on its
-    leaving side has left mode m at its start: the transition's row, or -1."""
+    leaving side, moving that way (its declared rate, where it has one, on the leaving side
+    too), has left mode m at its start: the transition's row, or -1.
+
+    The rate's say keeps rounding from being read as a crossing: a rigid follower released at
+    rest on the cam (a lift-off that grazes, the plastic reset's zero relative velocity) ends a
+    short first step with the gap ~1e-15 m below zero by the gap's rounding while its rate is
+    already separating; read as an impact at the start, its chatter end would release it there
+    again, at the same instant, until the chatter guard ends the run."""
     tab = prob.tables
     for w in range(tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]):
         s = tab.data[tab.surface + w]
-        leaving = tab.data[tab.direction + w] * value(prob, m, s, t1, n0, n1) > 0.0
+        direction = tab.data[tab.direction + w]
+        leaving = direction * value(prob, m, s, t1, n0, n1) > 0.0
         if leaving and value(prob, m, s, t0, y0, y1) == 0.0:
-            return w
+            rate = tab.data[tab.surface_rate + s]
+            if rate < 0 or direction * value(prob, m, rate, t1, n0, n1) > 0.0:
+                return w
     return -1
 
 

@@ -300,7 +300,7 @@ FOLD_RIG = camdyn.example_rig().replace(Y_c=3e9, k_s=20000.0, zeta_A=2e-3)
 FOLD_SCENE = camdyn.Scene(contact="point", damping="A", friction="none")
 
 
-@pytest.mark.slow   # two curves, ~8 s
+@pytest.mark.slow   # two curves, ~10 s
 def test_the_grazing_fold_point_is_found_on_the_grazing_curve_and_on_the_fold_curve():
     """In (speed, Y_c): the grazing curve's multiplier at grazing passes +1 (grazing_fold, the
     codimension-2 locator of grazing_curve), and the fold curve's orbit grazes (the mirror,

@@ -290,3 +290,58 @@ def test_the_guessed_start_and_the_searched_one_find_the_same_grazing():
     firsts = [continue_grazing(RIG, SCENE, "k_s", 2000.0, 2001.0, search=search, guess=g)["speed_rpm"].values[0]
               for g in (guess, None, 1.02 * loss)]
     np.testing.assert_allclose(firsts, firsts[1], rtol=1e-6)
+
+
+# --- a codimension-2 point on a real rig, located on both curves that meet there (issue 29) -------------
+#: the example rig with a polymer cam (Y_c 3 GPa), a stiff spring and a crowned follower (point
+#: contact), lightly damped (law A, zeta_A 2e-3): its contact branch folds just below the jump speed
+#: (a resonance of the contact, bent by the Hertz law), and the fold curve meets the grazing curve
+FOLD_RIG = camdyn.example_rig().replace(Y_c=3e9, k_s=20000.0, zeta_A=2e-3)
+FOLD_SCENE = camdyn.Scene(contact="point", damping="A", friction="none")
+
+
+@pytest.mark.slow   # two curves, ~10 s
+def test_the_grazing_fold_point_is_found_on_the_grazing_curve_and_on_the_fold_curve():
+    """In (speed, Y_c): the grazing curve's multiplier at grazing passes +1 (grazing_fold, the
+    codimension-2 locator of grazing_curve), and the fold curve's orbit grazes (the mirror,
+    codim1.located) at the same point.  The two agree to the sum of what each locator leaves:
+    the brackets (locate_tol of each curve's scaled arclength: lambda2 in units of its range,
+    lambda1 of its start value); the grazing curve's orbits sitting gap_tol d below zero gap and the
+    fold curve's located orbit its codim2_max_gap from it (each gap over the fold curve's slope
+    d gap / d Y_c); the fold curve's det(M - I) solved only to DET_TOL (over the grazing curve's
+    slope d det(M - I) / d Y_c).  The slopes are secants over each curve's step at the point, and
+    the gap has a corner at zero: the first-order sum is doubled for their remainder."""
+    from camdyn.orbits.continuation import continue_bifurcation
+    from camdyn.orbits.continuation.codim1 import DET_TOL
+    from camdyn.orbits.continuation.events import CRITICAL
+    from camdyn.orbits.tangent import variational
+
+    loss = contact_loss_speed(FOLD_RIG)
+    graze = continue_grazing(FOLD_RIG, FOLD_SCENE, "Y_c", 3e9, 2.5e9, search=(0.95 * loss, 0.995 * loss),
+                             guess=0.988 * loss, settings=GrazingSettings(gap_tol=1e-8))
+    fold = continue_bifurcation(FOLD_RIG.replace(Y_c=2.55e9), FOLD_SCENE, "fold", "Y_c", 2.55e9, 2.7e9,
+                                search=(0.95 * loss, 0.98 * loss), phase_fraction=0.5, warm="quasistatic",
+                                jacobian=variational, det_step=1e-6)
+    for ds in (graze, fold):
+        assert ds.attrs["outcome"] == GrazingOutcome.END_REACHED.name, ds.attrs["outcome_message"]
+        assert ds.sizes["codim2"] == 1 and ds.attrs["codim2_kinds"].split()[int(ds["codim2_kind"][0])] == "grazing_fold"
+        assert abs(ds["codim2_multiplier_real"].values[0, 0] - 1.0) < CRITICAL
+    i, j = int(graze["codim2_point"][0]), int(fold["codim2_point"][0])
+    Y, S = fold["Y_c"].values[j:j + 2], fold["speed_rpm"].values[j:j + 2]
+    gap_slope = abs(np.diff(fold["max_gap"].values[j:j + 2])[0] / np.diff(Y)[0])
+    mu = graze["multiplier_real"].values[i:i + 2, :] + 1j * graze["multiplier_imag"].values[i:i + 2, :]
+    det = np.real(np.prod(1.0 - mu, axis=1))
+    det_slope = abs(np.diff(det)[0] / np.diff(graze["Y_c"].values[i:i + 2])[0])
+    margin = graze.attrs["settings_gap_tol"] * graze.attrs["deflection_scale_m"]
+    off = (margin + abs(fold["codim2_max_gap"].values[0])) / gap_slope + DET_TOL / det_slope
+    tol = ContinuationSettings().locate_tol
+    spans = abs(graze.attrs["end"] - graze.attrs["start"]) + abs(fold.attrs["end"] - fold.attrs["start"])
+    tol_Y = 2 * (tol * spans + off)
+    tol_S = 2 * (tol * (graze["speed_rpm"].values[0] + fold["speed_rpm"].values[0]) + abs(np.diff(S)[0] / np.diff(Y)[0]) * off)
+    assert abs(graze["codim2_Y_c"].values[0] - fold["codim2_Y_c"].values[0]) <= tol_Y
+    assert abs(graze["codim2_speed_rpm"].values[0] - fold["codim2_speed_rpm"].values[0]) <= tol_S
+
+
+def test_a_warm_start_not_offered_is_refused():
+    with pytest.raises(ParameterError, match="warm"):
+        continue_orbit(RIG, SCENE, "speed_rpm", 900.0, 1000.0, warm="equilibrium")

@@ -105,9 +105,9 @@ from ...model.rig import PARAMETERS, Rig
 from ...model.scene import Scene
 from ..derivatives import finite_differences
 from ..section_map import DEFAULT_OPTIONS
-from . import corrector as _corrector, events as _events, problem as _problem
+from . import corrector as _corrector, events as _events, follow as _follow, problem as _problem
 from .dataset import branch_dataset, events_table
-from .follow import run
+from .follow import check_warm, run
 from .problem import Branch, ContinuationOutcome, ContinuationSettings, Event, Point, Problem
 
 # the public constants, defined in the modules that use them and documented here
@@ -120,6 +120,11 @@ GAP_SAMPLES = _corrector.GAP_SAMPLES
 #: changed sign but the located orbit's multipliers are not critical (the map is not smooth there:
 #: the multipliers jump, e.g. where the orbit meets a new switching surface)
 EVENTS = _events.EVENTS
+#: the first orbit's warm starts (``warm`` of :func:`continue_orbit` and
+#: :func:`continue_bifurcation`): ``"run"``, a run of ``warmup_revolutions`` from the static
+#: equilibrium, or ``"quasistatic"``, the quasi-static contact orbit (which finds the contact branch
+#: where a weakly damped run settles on another, impacting, orbit)
+WARM_STARTS = _follow.WARM_STARTS
 
 
 # --- the public function ---------------------------------------------------------------------------
@@ -153,14 +158,15 @@ def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: fl
                  speed_rpm: float | None = None, periods: int = 1, phase_fraction: float = 0.0,
                  warmup_revolutions: int = 20, settings: ContinuationSettings = ContinuationSettings(),
                  options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
-                 backend: str = "compiled"):
+                 backend: str = "compiled", warm: str = "run"):
     """Follow the branch of period-``periods`` orbits through the orbit found at ``start`` as
     ``parameter`` goes toward ``end``; detect and locate folds, branch points, period doublings,
     Neimark-Sacker bifurcations and grazing, and switch to the doubled branches.
 
     ``parameter``: ``"speed_rpm"`` (the cam speed, rev/min), or a rig parameter by name (SI),
     continued at the constant cam speed ``speed_rpm``.  The first orbit is found by
-    :func:`camdyn.periodic_orbit` after ``warmup_revolutions`` from the static equilibrium.
+    :func:`camdyn.periodic_orbit` after ``warmup_revolutions`` from the static equilibrium, or,
+    with ``warm="quasistatic"``, from the quasi-static contact orbit (:data:`WARM_STARTS`).
     ``phase_fraction``: the section's time after each revolution's start, a fraction of T
     (0 gives the sections of :func:`camdyn.sweep.api.bifurcation`; choose another where the
     orbit is near a switching surface at 0).  ``jacobian(map, scale)`` makes the Jacobian
@@ -170,11 +176,12 @@ def continue_orbit(rig: Rig, scene: Scene, parameter: str, start: float, end: fl
     Returns an ``xarray.Dataset`` described in :func:`branch_dataset`.
     """
     _check(rig, scene, parameter, start, end, speed_rpm, periods, phase_fraction, settings)
+    check_warm(warm)
     problem = Problem(rig, scene, parameter, float(start), float(end), speed_rpm, periods, float(phase_fraction),
                       options, jacobian, backend)
     problem.model(problem.start)                 # a rig value the rig refuses raises here
     problem.model(problem.end)
-    branches, events, scale = run(problem, settings, warmup_revolutions)
+    branches, events, scale = run(problem, settings, warmup_revolutions, warm)
     return branch_dataset(problem, branches, events, scale)
 
 
@@ -182,4 +189,4 @@ from .charts import continue_bifurcation, continue_grazing, jump_chart  # noqa: 
 from .grazing_curve import GrazingOutcome, GrazingSettings  # noqa: E402
 
 __all__ = ["continue_grazing", "jump_chart", "continue_bifurcation", "GrazingSettings", "GrazingOutcome", "continue_orbit", "ContinuationSettings", "ContinuationOutcome", "branch_dataset", "events_table",
-           "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES"]
+           "Problem", "Point", "Branch", "Event", "SPEED", "EVENTS", "GAP_SAMPLES", "WARM_STARTS"]

@@ -26,10 +26,10 @@ from ...model.scene import Scene
 from ..derivatives import finite_differences
 from ..section_map import DEFAULT_OPTIONS
 from ..tangent import variational
-from .follow import run
+from .follow import check_warm, run
 from .grazing import GrazingSystem, Layout, gap_maximum
 from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
-from .codim1 import SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset
+from .codim1 import DET_STEP, SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset, located
 from .codim1 import first as codim1_first
 from .grazing_dataset import grazing_dataset
 from .problem import SPEED, ContinuationSettings, Problem
@@ -265,23 +265,30 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
                          phase_fraction: float = 0.0, warmup_revolutions: int = 20,
                          settings: ContinuationSettings = ContinuationSettings(switch_depth=0),
                          options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
-                         backend: str = "compiled"):
+                         backend: str = "compiled", warm: str = "run", det_step: float = DET_STEP):
     """The curve of a ``kind`` (``"fold"`` or ``"period_doubling"``) of period-1 orbits in two
     parameters, ``free`` (lambda1, default the cam speed) and ``parameter`` (lambda2) from
     ``start`` to ``end``: pseudo-arclength on the extended system of :mod:`.codim1`, from the
     bifurcation that the one-parameter continuation in ``free`` over ``search`` locates at
-    lambda2 = start.  ``jacobian``: the provider of dP/dx (as :func:`camdyn.continue_orbit`'s).
+    lambda2 = start, with the points where the curve's orbit grazes (the codimension-2 points
+    where it meets the grazing curve of :func:`continue_grazing`, :func:`.codim1.located`).
+    ``jacobian``: the provider of dP/dx, ``warm``: the first orbit's warm start (both as
+    :func:`camdyn.continue_orbit`'s); ``det_step``: the relative step of the determinant's
+    differences (:data:`.codim1.DET_STEP`).
     Raises only on bad input; how the curve ended is in the result's ``outcome``.  Returns the
     ``xarray.Dataset`` of :func:`.codim1.codim1_dataset`."""
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
     _settings(settings, ContinuationSettings)
     if kind not in SIGNS:
         raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}")
+    check_warm(warm)
+    real("det_step", det_step, "0 < det_step <= 0.1 (a relative step of the scaled unknowns)",
+         lambda v: 0 < v <= 0.1)
     system = Codim1System(rig, scene, free, parameter, float(start), float(end), speed_rpm, float(phase_fraction),
-                          options, backend, kind=kind, jacobian=jacobian)
+                          options, backend, kind=kind, jacobian=jacobian, det_step=float(det_step))
     problem = system.along(free, float(search[0]), float(start), float(search[1]) - float(search[0]))
     problem.model(float(search[1]))                            # a rig value the rig refuses raises here
-    branches, events, scale = run(problem, settings, warmup_revolutions)
+    branches, events, scale = run(problem, settings, warmup_revolutions, warm)
     found = [e for e in events if e.branch == 0 and e.kind == kind]
     if not found:
         why = f"no {kind} of the branch in {free} over {search[0]:.8g} to {search[1]:.8g} ({branches[0].message})"
@@ -292,4 +299,4 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
     p = codim1_first(leg, e.x, e.lam, branches[0].points[e.point].mode)
     if isinstance(p, str):
         return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, p), layout)
-    return codim1_dataset(system, follow(leg, p, advance, lambda *_: []), layout)
+    return codim1_dataset(system, follow(leg, p, advance, located), layout)

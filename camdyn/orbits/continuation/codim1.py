@@ -30,28 +30,32 @@ from ...errors import CamdynError
 from ..derivatives import finite_differences
 from ..section_map import derivative_at
 from ..shooting import sorted_multipliers
-from .corrector import chord, d_lambda, evaluate, orbit_run, tangent
-from .grazing_curve import Ended, GrazingOutcome
-from .grazing_dataset import common_attributes, unit
+from .corrector import chord, d_lambda, evaluate, gap, orbit_run, tangent
+from .events import Bracket, grazing_bracket
+from .grazing_curve import CODIM2, SIGNS, Codim2, Ended, GrazingOutcome, codim2_name, critical_det
+from .grazing_dataset import codim2_variables, common_attributes, unit
 from .problem import N_STATE, SPEED, ContinuationSettings, Leg as BranchLeg, Problem, TwoParameters
 
-#: the sign s of det(M + s I) per kind
-SIGNS = {"fold": -1.0, "period_doubling": 1.0}
 #: the determinant's tolerance: M by finite differences carries ~rtol^(2/3) (2e-7) of its scale,
 #: a determinant of 2 x 2 entries of order one twice that; DET_TOL leaves a margin of 50
 DET_TOL = 1e-5
 #: the relative step of the determinant's differences (its truncation error ~DET_STEP^2, 1e-6;
-#: M's noise over it ~2e-4 of the derivative)
+#: M's noise over it ~2e-4 of the derivative): the default of ``Codim1System.det_step``, for M by
+#: finite differences.  Where det(M -+ I) varies on a scale below it (a weakly damped stiff contact,
+#: whose M changes on the scale of the contact's deflection, ~1e-3 of the motion's size), a
+#: smaller step with M from the tangent dynamics (whose noise is ~rtol) resolves it
 DET_STEP = 1e-3
 
 
 @dataclass(frozen=True, kw_only=True)
 class Codim1System(TwoParameters):
     """What is continued (:class:`.problem.TwoParameters`), with the ``kind`` (``fold`` or
-    ``period_doubling``) and the Jacobian provider of dP/dx."""
+    ``period_doubling``), the Jacobian provider of dP/dx and the relative step of the
+    determinant's differences ``det_step`` (:data:`DET_STEP`)."""
 
     kind: str
     jacobian: object = finite_differences
+    det_step: float = DET_STEP
 
     def along(self, name: str, free: float, lam: float, sigma: float) -> Problem:
         """The branch problem in ``name`` (lambda1 or lambda2) with the other held, its span sigma."""
@@ -119,7 +123,7 @@ class Codim1Point(NamedTuple):
 
 
 def _det(system: Codim1System, M) -> float:
-    return float(np.linalg.det(M + SIGNS[system.kind] * np.eye(N_STATE)))
+    return critical_det(system.kind, M)
 
 
 def _monodromy(leg: CurveLeg, x, free: float, lam: float, mode, base=None) -> np.ndarray:
@@ -146,7 +150,7 @@ def jacobian(leg: CurveLeg, z, e: Evaluation) -> np.ndarray:
     A[:N_STATE, N_STATE + 1] = dP * leg.layout.sigma_range / leg.layout.scale
     weight = leg.settings.tol / DET_TOL
     for j in range(N_STATE + 2):
-        h = DET_STEP
+        h = leg.system.det_step
         plus, minus = z.copy(), z.copy()
         plus[j] += h
         minus[j] -= h
@@ -163,6 +167,33 @@ def _point(leg: CurveLeg, z, e: Evaluation, direction, iterations: int) -> Codim
     return Codim1Point(z, free, lam, x, e.M, tangent(A, direction), A, e, iterations, np.zeros(N_STATE + 2))
 
 
+def _residual(leg: CurveLeg, mode):
+    """The chord's residual function: z -> (the scaled residual, the evaluation)."""
+    def at(z):
+        e = residual(leg, z, mode)
+        return e.residual, e
+    return at
+
+
+def trial(leg: CurveLeg, p: Codim1Point, ds: float) -> Codim1Point | None:
+    """The orbit at arclength ds from p by the chord method, as a point with p's derivatives and
+    tangent (a trial of :func:`located`, which needs its largest gap alone): where the derivatives
+    cannot be evaluated (near a grazing the determinant's differences straddle it) the chord
+    keeps the last ones, the orbit itself still found; None when the chord fails."""
+    def derivatives(z, e):
+        try:
+            return jacobian(leg, z, e)
+        except CamdynError:
+            return p.A
+    z_pred = p.z + ds * p.tangent + 0.5 * ds * ds * p.curvature
+    found = chord(_residual(leg, p.evaluation.mode), derivatives, z_pred, p.tangent, p.A, leg.settings)
+    if found is None:
+        return None
+    z, e, iterations = found
+    x, free, lam = leg.layout.split(z)
+    return p._replace(z=z, free=free, lam=lam, x=x, M=e.M, evaluation=e, iterations=iterations)
+
+
 def advance(leg: CurveLeg, p: Codim1Point, ds: float, final: bool = False):
     """The point at arclength ds from p (the second-order predictor and the chord corrector, as
     :func:`.grazing_curve.corrected`): a point, None, or :class:`.grazing_curve.Ended`."""
@@ -172,9 +203,8 @@ def advance(leg: CurveLeg, p: Codim1Point, ds: float, final: bool = False):
         z_pred[-1] = leg.end / leg.layout.sigma_range
         direction = np.zeros(N_STATE + 2)
         direction[-1] = 1.0
-    mode = p.evaluation.mode
-    found = chord(lambda z: (lambda e: (e.residual, e))(residual(leg, z, mode)), lambda z, e: jacobian(leg, z, e),
-                  z_pred, direction, p.A, leg.settings)
+    found = chord(_residual(leg, p.evaluation.mode), lambda z, e: jacobian(leg, z, e), z_pred, direction, p.A,
+                  leg.settings)
     if found is None:
         return None
     z, e, iterations = found
@@ -195,8 +225,7 @@ def first(leg: CurveLeg, x, free: float, mode: int) -> Codim1Point | str:
         A0 = jacobian(leg, z0, e0)
     except CamdynError as failure:
         return f"the start orbit cannot be evaluated: {failure}"
-    found = chord(lambda z: (lambda e: (e.residual, e))(residual(leg, z, mode)), lambda z, e: jacobian(leg, z, e),
-                  z0, along, A0, leg.settings)
+    found = chord(_residual(leg, mode), lambda z, e: jacobian(leg, z, e), z0, along, A0, leg.settings)
     if found is None:
         return f"the extended system's corrector did not converge from the orbit at {leg.system.free} = {free:.8g}"
     try:
@@ -205,11 +234,40 @@ def first(leg: CurveLeg, x, free: float, mode: int) -> Codim1Point | str:
         return f"no derivatives at the first orbit: {failure}"
 
 
+def largest_gap(p: Codim1Point) -> float:
+    """The largest gap psi_i over the point's orbit (m; > 0: the follower leaves the cam), from
+    the run of its residual (:func:`.corrector.gap`)."""
+    return gap(p.evaluation.run)[0]
+
+
+def located(leg: CurveLeg, p: Codim1Point, q: Codim1Point, ds: float, index: int) -> list[Codim2]:
+    """The grazing of the curve's orbit between p and q (ds apart): its largest gap changes sign,
+    where the curve meets the grazing curve at the codimension-2 point named as on that curve
+    (:func:`.grazing_curve.codim2_name`: the mirror of :func:`.grazing_curve.located`), located in
+    arclength to ``locate_tol`` by the grazing trials from the contact side
+    (:func:`.events.grazing_bracket`; each trial an orbit of the curve without derivatives,
+    :func:`trial`, a failed one taken as past the grazing).  The located orbit is the last trial
+    on p's side."""
+    a, b = largest_gap(p), largest_gap(q)
+    if not (math.isfinite(a) and math.isfinite(b) and a * b < 0):
+        return []
+
+    def at(s: float):
+        r = trial(leg, p, s)
+        return (math.nan, None) if r is None else (largest_gap(r), r)
+    bracket = grazing_bracket(Bracket(0.0, ds, a, b, p), at, leg.settings.locate_tol)
+    return [Codim2(codim2_name(leg.system.kind), bracket.before, index)]
+
+
 def codim1_dataset(system: Codim1System, curve, layout):
     """The curve as an ``xarray.Dataset``: per point the two parameters by their names,
-    ``alpha``, ``alpha_dot``, the multipliers, ``residual`` and ``iterations``; attrs ``kind``,
-    ``free``, ``parameter``, their units, the range, the scene, ``outcome`` and
-    ``outcome_message``, the rig's parameters, ``camdyn_version`` (as :func:`.grazing_dataset.grazing_dataset`)."""
+    ``alpha``, ``alpha_dot``, the multipliers, ``max_gap`` (the orbit's largest gap),
+    ``residual`` and ``iterations``; dim ``codim2``: where the orbit grazes
+    (:func:`located`), with the variables of :func:`.grazing_dataset.codim2_variables` and
+    ``codim2_max_gap``; attrs
+    ``kind``, ``codim2_kinds``, ``free``, ``parameter``, their units, the range, the scene,
+    ``outcome`` and ``outcome_message``, the rig's parameters, ``camdyn_version``, ``det_step``
+    (as :func:`.grazing_dataset.grazing_dataset`)."""
     import xarray as xr
 
     points, P, PM = curve.points, ("point",), ("point", "multiplier")
@@ -222,10 +280,17 @@ def codim1_dataset(system: Codim1System, curve, layout):
                                                              "long_name": "alpha_dot at the section"}),
         "multiplier_real": (PM, mu.real, {"units": "1"}),
         "multiplier_imag": (PM, mu.imag, {"units": "1"}),
+        "max_gap": (P, np.array([largest_gap(p) for p in points]),
+                    {"units": "m", "long_name": "largest psi_i over the orbit (> 0: the follower leaves the cam)"}),
         "residual": (P, np.array([float(np.max(np.abs(p.evaluation.residual))) for p in points]), {"units": "1"}),
         "iterations": (P, np.array([p.iterations for p in points], dtype=int)),
+        **codim2_variables(system, curve.found, lambda at: at.free),
+        "codim2_max_gap": (("codim2",), np.array([largest_gap(c.at) for c in curve.found]),
+                           {"units": "m", "long_name": "largest psi_i over the located orbit (its distance "
+                                                       "from grazing)"}),
     }
     scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
-    attrs = {**common_attributes(system, curve, scale), "kind": system.kind,
+    attrs = {**common_attributes(system, curve, scale), "kind": system.kind, "codim2_kinds": " ".join(CODIM2),
+             "det_step": system.det_step,
              "title": f"camdyn {system.kind} curve in ({system.free}, {system.parameter}), rig {system.rig.name}"}
     return xr.Dataset(data, attrs=attrs)

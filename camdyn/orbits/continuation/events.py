@@ -232,21 +232,29 @@ def grazing_location(leg: Leg, kind: Kind, p: Point, q: Point, ds: float):
     (``kind.of_run``): it is a corrected orbit without derivatives (6 runs less by finite
     differences); the two points returned get theirs (after: None when a run fails there, as
     for a failed step; before: p then, the bracket's start, the location lost for that rare case)."""
-    tol = leg.settings.locate_tol
-    f_p, f_q = kind.test(p), kind.test(q)
-    bracket = Bracket(0.0, ds, f_p, f_q, p)
-    contact = [(0.0, f_p) if f_p < 0 else (ds, f_q)]
-    far = 1.0 if f_p < 0 else -1.0
+    def at(s: float):
+        r = corrected(leg, p, s)
+        return (math.nan if r is None else kind.of_run(r.run)), r
+    bracket = grazing_bracket(Bracket(0.0, ds, kind.test(p), kind.test(q), p), at, leg.settings.locate_tol)
+    return completed_ends(leg, p, bracket)
+
+
+def grazing_bracket(bracket: Bracket, at: Callable, tol: float) -> Bracket:
+    """``bracket`` of a grazing's test function (negative on the contact side, smooth there, with
+    a corner at the event) shrunk to ``tol`` (or MAX_BISECTIONS trials) by the trials aimed from
+    the contact side (:func:`grazing_trial`); ``at(s)``: the test function's value at a trial s
+    and the orbit there (NaN: a failed step, taken as past the event)."""
+    contact = [(bracket.lo, bracket.f_lo) if bracket.f_lo < 0 else (bracket.hi, bracket.f_hi)]
+    far = 1.0 if bracket.f_lo < 0 else -1.0
     for _ in range(MAX_BISECTIONS):
         if bracket.hi - bracket.lo <= tol:
             break
         s = grazing_trial(bracket.lo, bracket.hi, contact[-3:], far, tol)
-        r = corrected(leg, p, s)
-        f = math.nan if r is None else kind.of_run(r.run)
+        f, orbit = at(s)
         if f < 0:
             contact.append((s, f))
-        bracket.narrow(s, f, r)
-    return completed_ends(leg, p, bracket)
+        bracket.narrow(s, f, orbit)
+    return bracket
 
 
 def grazing_trial(lo: float, hi: float, contact: list, far: float, tol: float) -> float:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from ...errors import ParameterError
 from ..section_map import MapFailure
 from ..shooting import OrbitOutcome, ShootingSettings, periodic_orbit
 from .corrector import first_point, step
@@ -18,6 +19,16 @@ GROWTH = 1.5
 FLAT = 1e-12
 #: lambda is at an end of the range within this fraction of the range
 AT_END = 1e-9
+#: the first orbit's warm starts (:func:`camdyn.periodic_orbit`'s ``start``): a run of
+#: ``warmup_revolutions`` from the static equilibrium, or the quasi-static contact orbit (which
+#: finds the contact branch where a weakly damped run settles on another, impacting, orbit)
+WARM_STARTS = ("run", "quasistatic")
+
+
+def check_warm(warm) -> None:
+    """Refuse a warm start not in :data:`WARM_STARTS` (raises ParameterError)."""
+    if warm not in WARM_STARTS:
+        raise ParameterError("warm", warm, f"one of {WARM_STARTS} (the first orbit's warm start)")
 
 
 def clipped(start: float, end: float, span: float, lam: float, t_lam: float, ds: float) -> float:
@@ -83,13 +94,16 @@ def follow(leg: Leg, branch: Branch, index: int, first: Point, events: list) -> 
         p = q
 
 
-def start(problem: Problem, warmup_revolutions: int, settings: ContinuationSettings) -> tuple[Point, Leg] | str:
-    """The first orbit, by shooting at the start value, and its leg; or why there is none."""
+def start(problem: Problem, warmup_revolutions: int, settings: ContinuationSettings,
+          warm: str = "run") -> tuple[Point, Leg] | str:
+    """The first orbit, by shooting at the start value from the warm start ``warm`` (``"run"``:
+    ``warmup_revolutions`` from the static equilibrium; ``"quasistatic"``: the quasi-static
+    contact orbit, :func:`camdyn.periodic_orbit`'s ``start``), and its leg; or why there is none."""
     model = problem.model(problem.start)
     orbit = periodic_orbit(model.rig, problem.scene, model.cam, periods=problem.periods,
                            phase=problem.phase_fraction * model.period, warmup_revolutions=warmup_revolutions,
                            settings=ShootingSettings(settings.tol, max(20, settings.max_corrector)),
-                           options=problem.options, jacobian=problem.jacobian, backend=problem.backend)
+                           options=problem.options, jacobian=problem.jacobian, backend=problem.backend, start=warm)
     if not (orbit.ok or orbit.outcome is OrbitOutcome.MULTIPLIERS_UNRESOLVED):   # the orbit, not its multipliers
         return orbit.message
     leg = Leg(problem, problem.periods, orbit.scale, settings)
@@ -111,10 +125,11 @@ def _note_unresolved(problem: Problem, branch: Branch) -> None:
                            "an event next to them is a multiplier_jump (the switches change within a difference step)")
 
 
-def run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: int):
+def run(problem: Problem, settings: ContinuationSettings, warmup_revolutions: int, warm: str = "run"):
     """Every branch (the first, then those switched to at period doublings) and the events:
-    (branches, events, the motion's scale; None when the start failed)."""
-    started = start(problem, warmup_revolutions, settings)
+    (branches, events, the motion's scale; None when the start failed); ``warm``: the first
+    orbit's warm start (:func:`start`)."""
+    started = start(problem, warmup_revolutions, settings, warm)
     if isinstance(started, str):
         return [Branch(problem.periods, outcome=ContinuationOutcome.START_FAILED, message=started)], [], None
     first, leg = started

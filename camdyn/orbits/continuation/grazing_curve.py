@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -36,9 +37,25 @@ from .grazing import (G_RANGE, G_SIZE, Derivatives, Evaluation, GrazingSystem, L
                       free_at_zero_gap, is_largest)
 from .problem import ContinuationSettings
 
+#: the codimension-1 kinds a grazing curve meets, with the sign s of their test function
+#: det(M + s I) of the monodromy matrix M: a period doubling (a multiplier through -1) and a fold
+#: (through +1); the fold and period-doubling curves (:mod:`.codim1`) are continued on it
+SIGNS = {"period_doubling": 1.0, "fold": -1.0}
+
+
+def critical_det(kind: str, M) -> float:
+    """det(M + s I), s the sign of ``kind`` (:data:`SIGNS`): zero where M has the kind's critical multiplier."""
+    return float(np.linalg.det(M + SIGNS[kind] * np.eye(len(M))))
+
+
+def codim2_name(kind: str) -> str:
+    """The codimension-2 point where a grazing curve meets the curve of ``kind`` (a key of
+    :data:`SIGNS`), by the same name on either curve."""
+    return f"grazing_{kind}"
+
+
 #: the codimension-2 points' kinds and their test functions of the monodromy matrix M
-CODIM2 = {"grazing_period_doubling": lambda M: float(np.linalg.det(M + np.eye(len(M)))),
-          "grazing_fold": lambda M: float(np.linalg.det(M - np.eye(len(M))))}
+CODIM2 = {codim2_name(kind): partial(critical_det, kind) for kind in SIGNS}
 
 
 class GrazingOutcome(ActionableOutcome):
@@ -121,8 +138,9 @@ class Ended(NamedTuple):
 
 
 class Codim2(NamedTuple):
-    """A located codimension-2 point: its kind, the grazing orbit there, and the index of the
-    curve's point just before it."""
+    """A located codimension-2 point: its kind, the orbit there (a :class:`GrazingPoint` on a
+    grazing curve, a :class:`.codim1.Codim1Point` on a fold or period-doubling curve), and the
+    index of the curve's point just before it."""
 
     kind: str
     at: GrazingPoint

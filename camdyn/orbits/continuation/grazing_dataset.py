@@ -45,7 +45,7 @@ def grazing_dataset(system, curve, layout, settings):
     import xarray as xr
 
     points = curve.points
-    data = {**_point_variables(system, points), **_codim2_variables(system, curve.found)}
+    data = {**_point_variables(system, points), **codim2_variables(system, curve.found, lambda at: at.grazing)}
     return xr.Dataset(data, attrs=_attributes(system, curve, layout, settings))
 
 
@@ -87,14 +87,18 @@ def _point_variables(system, points) -> dict:
     }
 
 
-def _codim2_variables(system, found) -> dict:
+def codim2_variables(system, found, free) -> dict:
+    """The codimension-2 points ``found`` (:class:`.grazing_curve.Codim2`) along dim ``codim2``:
+    ``codim2_kind`` (an index into :data:`.grazing_curve.CODIM2`, the attribute
+    ``codim2_kinds``), both parameters (``codim2_<name>``; lambda1 is ``free(orbit)``),
+    ``codim2_point`` (the point just before it), ``codim2_multiplier_real``/``_imag``."""
     C, CM = ("codim2",), ("codim2", "multiplier")
     kinds = list(CODIM2)
     mu = np.array([sorted_multipliers(c.at.M) for c in found], dtype=complex).reshape(-1, N_STATE)
     return {
         "codim2_kind": (C, np.array([kinds.index(c.kind) for c in found], dtype=int),
                         {"long_name": "kind (index into the attribute codim2_kinds)"}),
-        f"codim2_{system.free}": (C, np.array([c.at.grazing for c in found]), {"units": unit(system.free)}),
+        f"codim2_{system.free}": (C, np.array([free(c.at) for c in found]), {"units": unit(system.free)}),
         f"codim2_{system.parameter}": (C, np.array([c.at.lam for c in found]), {"units": unit(system.parameter)}),
         "codim2_point": (C, np.array([c.point for c in found], dtype=int),
                          {"long_name": "index of the point just before it"}),

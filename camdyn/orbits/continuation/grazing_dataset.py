@@ -71,7 +71,8 @@ def _point_variables(system, points) -> dict:
         "grazing_phase": (P, phase, {"units": "1", "long_name": "time of the largest gap after the section, "
                                                                 "a fraction of the cam period"}),
         "grazing_gap": (P, np.array([p.evaluation.psi_g for p in points]),
-                        {"units": "m", "long_name": "psi_i at the largest gap (0 at grazing; the contact side)"}),
+                        {"units": system.boundary.unit, "long_name": f"{system.boundary.meaning} at its largest "
+                                                                     "(the contact side)"}),
         "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier at grazing (contact side), "
                                                                     "real part"}),
         "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier at grazing (contact side), "
@@ -133,6 +134,7 @@ def _attributes(system, curve, layout, settings) -> dict:
     return {
         "title": f"camdyn grazing curve in ({system.free}, {system.parameter}), rig {system.rig.name}",
         **common_attributes(system, curve, scale),
-        "codim2_kinds": " ".join(CODIM2), "deflection_scale_m": system.deflection,
+        "codim2_kinds": " ".join(CODIM2), "boundary": system.boundary.kind,
+        system.boundary.scale_attribute: system.deflection, "phase_pinned_at_corner": int(system.pinned),
         **{f"settings_{k}": v for k, v in plain.items()},
     }

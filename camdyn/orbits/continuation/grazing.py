@@ -188,9 +188,10 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     boundary = system.boundary
     psi_all = boundary.values(sm.model, sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend),
                               tr.mode)
-    psi = psi_all[k]
+    psi = psi_all[k]                  # inf where a rigid follower is in flight (.boundary._far): so is the residual
     margin = system.gap_tol * boundary.margins                                   # psi_i(t_g) = -margin
-    gap = _gap_rows(system, T, psi) + np.array([margin, 0.0]) + _pin(system, phase)
+    with np.errstate(invalid="ignore"):                                          # (inf - inf in flight)
+        gap = _gap_rows(system, T, psi) + np.array([margin, 0.0]) + _pin(system, phase)
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
     sampled = np.isin(tr.t, samples)

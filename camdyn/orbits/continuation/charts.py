@@ -104,7 +104,8 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     first grazing (the jump chart's: the contact-loss speed less its compliance shift), from whose
     periodic orbit the extended system is solved without the search, which runs only where that
     fails.  The scene needs the tangent dynamics (not damping C or E:
-    :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
+    :mod:`camdyn.orbits.tangent`).  On a rigid scene the curve is the lift-off's (the least
+    contact force through 0; the search finds the event ``lift_off``): :mod:`.boundary`.  Raises only on bad input; how the curve ended is in the
     result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
     """
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)

@@ -10,7 +10,10 @@ the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) s
     psi_i_dot(t_g) = 0              (t_g is the gap's maximum; the rate as a central
                                      difference over t_g +- WINDOW T, see WINDOW)
 
-4 equations in 5 unknowns: a curve.  This is the defining system of a codimension-1 boundary
+4 equations in 5 unknowns: a curve.  On a rigid contact the gap is 0 to rounding along the
+contact orbit: psi_i is replaced by -F_n, the constraint's force, whose largest value through 0
+is the lift-off, and at a corner of a cam of arcs the rate's row by the phase pinned past the
+junction (:mod:`.boundary`; the names below keep the gap's).  This is the defining system of a codimension-1 boundary
 continued in two parameters, the boundary's test functions appended to the orbit's equations
 (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10), here
 the grazing conditions of a periodic orbit of a hybrid system (Thota & Dankowicz, TC-HAT, SIAM
@@ -195,9 +198,10 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
     sampled = np.isin(tr.t, samples)
-    restarts = np.append(tr.switches.records["t"], t_g if system.pinned else [])    # (a junction's record may be
-    largest = boundary.largest(sm.model, psi_all[sampled], tr.mode[sampled], tr.t[sampled],    # missing: the run
-                               restarts) if dense else math.nan                                  # stepped over it)
+    # a pinned corner is a restart even where the run stepped over its junction without a record
+    restarts = np.append(tr.switches.records["t"], t_g if system.pinned else [])
+    largest = boundary.largest(sm.model, psi_all[sampled], tr.mode[sampled], tr.t[sampled],
+                               restarts) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
                       tr.mode[k].astype(int), psi, largest, sm)
 

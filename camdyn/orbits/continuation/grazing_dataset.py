@@ -34,12 +34,15 @@ def grazing_dataset(system, curve, layout, settings):
     the orbit itself, converged at psi_i(t_g) = -margin (``<free>_orbit``), ``alpha``, ``alpha_dot``
     at the section, ``grazing_time`` (t_g - t0, s after the section) and ``grazing_phase``
     (its fraction of T), ``grazing_gap`` (psi_i at t_g, m: within [-2, 0] gap_tol of the
-    deflection scale, the contact side), ``multiplier_real``/``_imag``/``_modulus`` (the
+    deflection scale, the contact side; on a rigid contact -F_n, N, within [-3, -1] gap_tol of
+    the force's scale: :mod:`.boundary`), ``multiplier_real``/``_imag``/``_modulus`` (the
     grazing orbit's, contact side), ``stable``, ``residual`` (scaled), ``iterations`` and
     ``one_sided`` (a lambda-derivative was one-sided there).  Per codimension-2 point:
     ``codim2_kind`` (code into attrs ``codim2_kinds``), both parameters (``codim2_<name>``),
     ``codim2_point`` (the point just before it), ``codim2_multiplier_real``/``_imag``.  Attrs:
-    ``outcome`` (a :class:`GrazingOutcome` name) and ``outcome_message``, the range, the scene,
+    ``outcome`` (a :class:`GrazingOutcome` name) and ``outcome_message``, ``boundary``
+    (``grazing``, or ``lift_off`` on a rigid contact), its scale (``deflection_scale_m``, or
+    ``force_scale_n``), ``phase_pinned_at_corner`` (1 or 0), the range, the scene,
     ``rig_<parameter>`` (SI), the settings (``settings_<name>``), the scales, ``camdyn_version``.
     """
     import xarray as xr

@@ -117,3 +117,18 @@ def test_a_corner_impact_curve_is_refused_by_name():
     """No two-parameter curve follows a corner impact: the kind is refused with what to do instead."""
     with pytest.raises(ParameterError, match=r"^kind = 'corner_impact' is not valid: .*continue_orbit"):
         continue_bifurcation(second_rig(), SECOND, "corner_impact", "k_s", 1430.8, 1500.0, search=(310.0, 360.0))
+
+
+@pytest.mark.parametrize("name", ["example", "second-rig"])
+def test_the_searched_start_finds_the_lift_off_too(name):
+    """Without the jump chart's guess, continue_grazing starts from the lift_off event that the
+    one-parameter continuation locates over its search range (the contact side's orbit first):
+    the first point is the same lift-off, at the inverse-kinematics speed to the case's tolerance."""
+    from camdyn.orbits.continuation import continue_grazing
+
+    rig, scene, parameter, start, end, phase_fraction, tol = CASES[name]
+    loss = contact_loss_speed(rig.replace(**{parameter: start}))
+    ds = continue_grazing(rig, scene, parameter, start, start + 0.1 * (end - start), search=(0.9 * loss, 1.05 * loss),
+                          phase_fraction=phase_fraction)
+    assert ds.attrs["outcome"] == GrazingOutcome.END_REACHED.name, ds.attrs["outcome_message"]
+    assert abs(ds["speed_rpm"].values[0] / loss - 1.0) <= tol

@@ -246,7 +246,8 @@ class Rig:
         missing = [n for n in names if getattr(self, n) is None]
         if missing:
             first, *others = missing
-            reason = "; ".join(x for x in (_BY_NAME[first].meaning, _BY_NAME[first].neutral_hint,
+            reason = "; ".join(x for x in (_BY_NAME[first].meaning, f"valid: {_BY_NAME[first].valid}",
+                                           _BY_NAME[first].neutral_hint,
                                            f"also not given: {', '.join(others)}" if others else "") if x)
             raise ParameterError(first, None, f"required by {why}" if why else "required", reason=reason)
 

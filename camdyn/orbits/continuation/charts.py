@@ -27,6 +27,7 @@ from ..derivatives import finite_differences
 from ..section_map import DEFAULT_OPTIONS
 from ..tangent import variational
 from .follow import check_warm, run
+from .boundary import boundary_of
 from .grazing import GrazingSystem, Layout, gap_maximum
 from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
 from .codim1 import DET_STEP, SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset, located
@@ -44,10 +45,7 @@ def _names() -> list[str]:
 
 
 def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction) -> None:
-    if not isinstance(rig, Rig):
-        raise ParameterError("rig", rig, "a camdyn.Rig")
-    if not isinstance(scene, Scene) or scene.motion != "constant":
-        raise ParameterError("scene", scene, "a camdyn.Scene with motion 'constant' (a cam at constant speed)")
+    _check_scene(rig, scene)
     names = _names()
     for name, value in (("parameter", parameter), ("free", free)):
         if value not in names:
@@ -76,6 +74,13 @@ def _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fra
     real("phase_fraction", phase_fraction, "0 <= phase_fraction < 1 (of the cam period)", lambda v: 0 <= v < 1)
 
 
+def _check_scene(rig, scene) -> None:
+    if not isinstance(rig, Rig):
+        raise ParameterError("rig", rig, "a camdyn.Rig")
+    if not isinstance(scene, Scene) or scene.motion != "constant":
+        raise ParameterError("scene", scene, "a camdyn.Scene with motion 'constant' (a cam at constant speed)")
+
+
 def _settings(settings, kind) -> None:
     if not isinstance(settings, kind):
         raise ParameterError("settings", settings, f"a camdyn.orbits.continuation.{kind.__name__}")
@@ -99,7 +104,8 @@ def continue_grazing(rig: Rig, scene: Scene, parameter: str, start: float, end: 
     first grazing (the jump chart's: the contact-loss speed less its compliance shift), from whose
     periodic orbit the extended system is solved without the search, which runs only where that
     fails.  The scene needs the tangent dynamics (not damping C or E:
-    :mod:`camdyn.orbits.tangent`).  Raises only on bad input; how the curve ended is in the
+    :mod:`camdyn.orbits.tangent`).  On a rigid scene the curve is the lift-off's (the least
+    contact force through 0; the search finds the event ``lift_off``): :mod:`.boundary`.  Raises only on bad input; how the curve ended is in the
     result (:class:`GrazingOutcome`).  Returns the ``xarray.Dataset`` of :func:`grazing_dataset`.
     """
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
@@ -142,11 +148,11 @@ def _curve(system: GrazingSystem, search, settings: GrazingSettings, warmup_revo
 def _first_from(system: GrazingSystem, layout: Layout, settings: GrazingSettings, x, free: float, mode):
     """(the first grazing point, the system with its gap's scale) from a candidate orbit, or why not."""
     try:
-        phase, deflection = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
+        near = gap_maximum(dataclasses.replace(system, free_start=free), x, free, mode)
     except CamdynError as failure:
         return f"the orbit at {system.free} = {free:.8g} cannot be run: {failure}"
-    at = dataclasses.replace(system, free_start=free, deflection=deflection)
-    p = first(Leg(at, layout, settings.continuation), x, phase, free, mode)
+    at = dataclasses.replace(system, free_start=free, deflection=near.scale, corner=near.corner)
+    p = first(Leg(at, layout, settings.continuation), x, near.phase, free, mode)
     return p if isinstance(p, str) else (p, at)
 
 
@@ -180,19 +186,20 @@ def _search(system: GrazingSystem, search, settings: GrazingSettings, warmup_rev
                       None if system.free == SPEED else speed, 1, system.phase_fraction, system.options, variational,
                       system.backend)
     branches, events, scale = run(problem, settings.search, warmup_revolutions)
-    points = branches[0].points
-    grazing = [e for e in events if e.branch == 0 and e.kind == "grazing"]
+    points, boundary = branches[0].points, system.boundary
+    grazing = [e for e in events if e.branch == 0 and e.kind == boundary.kind]
     if grazing:
         e, before = grazing[0], points[grazing[0].point]
         pair = [(e.x, e.lam, before.mode), (before.x, before.lam, before.mode)]
-        return (pair if e.max_gap < 0 else pair[::-1]), scale
+        in_contact = e.max_gap < 0 and not boundary.contact_only     # a rigid orbit's gap is rounding: no side
+        return (pair if in_contact else pair[::-1]), scale
     why = f"{branches[0].outcome.message if branches[0].outcome else ''} {branches[0].message}".strip()
     if not points:
         return f"no orbit at {system.free} = {search[0]:.8g}: {why}"
-    last = points[-1]
-    if not (last.max_gap < 0 and -last.max_gap <= NEAR * -points[0].max_gap):
-        return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no grazing: its last orbit's "
-                f"largest gap is {last.max_gap:.3g} m ({why})")
+    last, test = points[-1], boundary.of_point
+    if not (test(last) < 0 and -test(last) <= NEAR * -test(points[0])):
+        return (f"the branch in {system.free} over {search[0]:.8g} to {search[1]:.8g} has no {boundary.kind}: its last "
+                f"orbit's largest {boundary.meaning} is {test(last):.3g} {boundary.unit} ({why})")
     return [(last.x, last.lam, last.mode)], scale
 
 
@@ -211,6 +218,13 @@ GUESS_BELOW = 1e-4
 #: difference there (its default, 20000, costs 0.18 s a point; with 3600, 0.1 degree apart, the
 #: second difference's truncation error is ~(0.1 degree)^2 of the curvature's scale, 3e-6)
 SHIFT_SAMPLES = 3600
+#: why the event kinds that no two-parameter curve follows are refused as ``kind``
+NOT_FOLLOWED = {
+    "grazing": "a grazing curve is continue_grazing's, a lift-off one too (on a rigid scene)",
+    "lift_off": "a lift-off curve is continue_grazing's on a rigid scene",
+    "corner_impact": "a corner impact is not followed in two parameters: locate it at fixed values of the "
+                     "second parameter with continue_orbit (event corner_impact)",
+}
 
 
 def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float, *, search: tuple | None = None,
@@ -222,7 +236,10 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
     (:func:`continue_grazing` in (``speed_rpm``, ``parameter``)), beside its quasi-static
     limit, the inverse-kinematics contact-loss speed (:func:`camdyn.analysis.contact_loss_speed`)
     at each point's parameter value, and the first-order shift between them by the contact's
-    compliance (:func:`camdyn.analysis.compliance_shift`).
+    compliance (:func:`camdyn.analysis.compliance_shift`).  On a rigid contact (:mod:`.boundary`)
+    the jump is the lift-off, where the least contact force of the contact orbit reaches 0, and
+    the inverse kinematics is that orbit: the shift is 0 and the jump speed is the contact-loss
+    speed to the continuation's tolerance (docs/continuation.md).
 
     The first grazing is solved for from the orbit at the guess :data:`GUESS_BELOW` below the
     contact-loss speed less its compliance shift at ``start``; where that fails it is searched
@@ -236,6 +253,7 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
         raise ParameterError("parameter", parameter, f"a rig parameter ({', '.join(_names()[1:])}): the jump "
                                                      "speed is charted against it")
     finite("start", start)
+    _check_scene(rig, scene)
     at_start = rig.replace(**{parameter: float(start)})
     loss = contact_loss_speed(at_start)
     if not (math.isfinite(loss) and loss > 0):
@@ -243,7 +261,11 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
                                              f"at some speed (contact-loss speed {loss} rev/min there)")
     if search is None:
         search = (JUMP_SEARCH[0] * loss, JUMP_SEARCH[1] * loss)
-    guess = loss * (1.0 + compliance_shift(at_start, scene, samples=SHIFT_SAMPLES, loss_rpm=loss)) * (1.0 - GUESS_BELOW)
+    rigid = boundary_of(scene.kernels()).contact_only
+
+    def shift(r, loss_rpm) -> float:          # a rigid contact does not deflect: its contact orbit is the IK's
+        return 0.0 if rigid else compliance_shift(r, scene, samples=SHIFT_SAMPLES, loss_rpm=loss_rpm)
+    guess = loss * (1.0 + shift(at_start, loss)) * (1.0 - GUESS_BELOW)
     ds = continue_grazing(rig, scene, parameter, start, end, search=search, phase_fraction=phase_fraction,
                           warmup_revolutions=warmup_revolutions, settings=settings, options=options,
                           backend=backend, guess=guess)
@@ -252,10 +274,10 @@ def jump_chart(rig: Rig, scene: Scene, parameter: str, start: float, end: float,
     ds["contact_loss_rpm"] = ("point", np.array(losses),
                               {"units": "rev/min", "long_name": "contact-loss speed by inverse kinematics "
                                                                 "(the quasi-static limit)"})
-    shifts = [compliance_shift(r, scene, samples=SHIFT_SAMPLES, loss_rpm=loss) for r, loss in zip(rigs, losses)]
-    ds["compliance_shift"] = ("point", np.array(shifts),
-                              {"units": "1", "long_name": "first-order relative shift of the contact-loss speed "
-                                                          "by the contact's compliance"})
+    why = ("0: a rigid contact does not deflect (its contact orbit is the inverse kinematics')" if rigid else
+           "first-order relative shift of the contact-loss speed by the contact's compliance")
+    ds["compliance_shift"] = ("point", np.array([shift(r, v) for r, v in zip(rigs, losses)]),
+                              {"units": "1", "long_name": why})
     ds.attrs["title"] = f"camdyn jump chart: the jump speed against {parameter}, rig {rig.name}"
     return ds
 
@@ -280,7 +302,7 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
     _settings(settings, ContinuationSettings)
     if kind not in SIGNS:
-        raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}")
+        raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}", reason=NOT_FOLLOWED.get(kind))
     check_warm(warm)
     real("det_step", det_step, "0 < det_step <= 0.1 (a relative step of the scaled unknowns)",
          lambda v: 0 < v <= 0.1)

@@ -10,7 +10,10 @@ the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) s
     psi_i_dot(t_g) = 0              (t_g is the gap's maximum; the rate as a central
                                      difference over t_g +- WINDOW T, see WINDOW)
 
-4 equations in 5 unknowns: a curve.  This is the defining system of a codimension-1 boundary
+4 equations in 5 unknowns: a curve.  On a rigid contact the gap is 0 to rounding along the
+contact orbit: psi_i is replaced by -F_n, the constraint's force, whose largest value through 0
+is the lift-off, and at a corner of a cam of arcs the rate's row by the phase pinned past the
+junction (:mod:`.boundary`; the names below keep the gap's).  This is the defining system of a codimension-1 boundary
 continued in two parameters, the boundary's test functions appended to the orbit's equations
 (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10), here
 the grazing conditions of a periodic orbit of a hybrid system (Thota & Dankowicz, TC-HAT, SIAM
@@ -45,7 +48,7 @@ from __future__ import annotations
 import math
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import partial
+from functools import cached_property, partial
 from typing import NamedTuple
 
 import numpy as np
@@ -55,7 +58,8 @@ from ..derivatives import SHRINK, Column, Unresolved, same_path
 from ..section_map import MapFailure, MapValue, StroboscopicMap
 from ..shooting import newton_matrix
 from ..tangent import TangentFailure, tangent
-from .corrector import gap_samples, refined_max
+from .boundary import WINDOW, Boundary, boundary_of, onset
+from .corrector import gap_samples
 from .problem import N_STATE, TwoParameters
 
 #: the layout of z: x's components, the grazing's phase phi_g, lambda1 (the free parameter),
@@ -68,15 +72,6 @@ G_SIZE = N_STATE + 3
 #: the central difference of the generated psi_i in alpha (rad) and alpha_dot (rad/s): an
 #: analytic function, no run; its rounding error over this step is ~1e-10 of the derivative
 OUTPUT_STEP = 1e-6
-#: the gap's rate at t_g is its central difference over t_g +- WINDOW T, not the pointwise
-#: psi_i_dot: on a stiff contact the state carries a ripple at the contact's frequency (period
-#: 1.5e-4 s on reference-experiment, whose deflection is 2e-10 m) that puts ~2e-4 of the rate's
-#: scale d 2 pi / T of noise on psi_i_dot and makes psi_i_ddot meaningless, while psi_i's own
-#: noise is ~2e-17 m (1e-7 d); over WINDOW T the difference's noise is ~1e-6 of the scale (it
-#: enters the parameter derivatives divided by their relative step, ~3e-5).  The difference
-#: vanishes at the maximum of a parabola exactly; a cubic term moves its root by ~(2 pi WINDOW)^2
-#: / 6 of the period's radian, and psi_i(t_g) from the maximum by the square of that: ~1e-7 d
-WINDOW = 1e-2
 #: the rate row's tolerance, RATE_TOL sqrt(gap_tol) of its scale: a rate error e moves t_g by
 #: e / psi_i'' and psi_i(t_g) from the maximum by only ~e^2 / (2 psi_i''), second order
 RATE_TOL = 0.1
@@ -85,15 +80,27 @@ RATE_TOL = 0.1
 @dataclass(frozen=True, kw_only=True)
 class GrazingSystem(TwoParameters):
     """What is continued (:class:`.problem.TwoParameters`), with lambda1 at the start
-    (``free_start``), the gap's scale d (``deflection``, m, :func:`gap_maximum`), the
-    corrector's tolerance ``tol`` on the scaled residual, the gap's ``gap_tol`` (a fraction
-    of d) and the ``threads`` :func:`derivatives` runs its independent runs on."""
+    (``free_start``), the gap's scale d (``deflection``, m, or N on a rigid contact:
+    :func:`gap_maximum`), the corrector's tolerance ``tol`` on the scaled residual, the gap's
+    ``gap_tol`` (a fraction of d), the ``threads`` :func:`derivatives` runs its independent runs
+    on, and ``corner``: the grazing's phase pinned just past a junction of the cam (NaN: the
+    gap's smooth maximum; :mod:`.boundary`)."""
 
     free_start: float
     deflection: float
     tol: float = 1e-8
     gap_tol: float = 1e-6
     threads: int = 1
+    corner: float = math.nan
+
+    @cached_property
+    def boundary(self) -> Boundary:
+        """The test output whose largest value is the "gap" (:mod:`.boundary`): psi_i, or -F_n on a rigid contact."""
+        return boundary_of(self.scene.kernels())
+
+    @property
+    def pinned(self) -> bool:
+        return not math.isnan(self.corner)
 
     def section_map(self, free: float, lam: float, mode: int | None) -> StroboscopicMap:
         model = self.model(free, lam)
@@ -141,17 +148,25 @@ class Evaluation(NamedTuple):
 
 def _row_weights(system: GrazingSystem) -> np.ndarray:
     """The residual rows' factors: 1 on the orbit's, tol / gap_tol on the gap's and
-    tol / (RATE_TOL sqrt(gap_tol)) on its rate's (see the module docstring)."""
-    rate = system.tol / (RATE_TOL * math.sqrt(system.gap_tol))
+    tol / (RATE_TOL sqrt(gap_tol)) on its rate's (see the module docstring); 1 on the pinned
+    phase's row, which replaces the rate's at a corner."""
+    rate = 1.0 if system.pinned else system.tol / (RATE_TOL * math.sqrt(system.gap_tol))
     return np.array([1.0] * N_STATE + [system.tol / system.gap_tol, rate])
 
 
 def _gap_rows(system: GrazingSystem, T: float, psi: np.ndarray) -> np.ndarray:
     """psi_i(t_g) / d and the gap's rate over the window, (psi_i(t_g + delta) - psi_i(t_g -
     delta)) / (2 delta), over d 2 pi / T, of psi_i at the window's times (linear in them): the
-    gap's rows before the margin and the row weights."""
-    d, delta = system.deflection, WINDOW * T
-    return np.array([psi[1] / d, (psi[2] - psi[0]) / (2 * delta) * T / (2 * math.pi * d)])
+    gap's rows before the margin and the row weights.  At a corner (``system.pinned``) the rate's
+    row is the phase's distance from the junction instead (:func:`_pin`), 0 here."""
+    d, delta = system.deflection, system.boundary.window * T
+    rate = 0.0 if system.pinned else (psi[2] - psi[0]) / (2 * delta) * T / (2 * math.pi * d)
+    return np.array([psi[1] / d, rate])
+
+
+def _pin(system: GrazingSystem, phase: float) -> np.ndarray:
+    """The pinned phase's row at a corner, phi_g less the junction's phase (else 0), after the gap's."""
+    return np.array([0.0, phase - system.corner if system.pinned else 0.0])
 
 
 def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | None,
@@ -165,19 +180,28 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     sm = system.section_map(free, lam, mode)
     t0, t1 = sm.t_span
     T = t1 - t0
-    if not WINDOW < phase < 1.0 - WINDOW:
+    window = system.boundary.window
+    if not window < phase < 1.0 - window:
         raise MapFailure(f"the grazing's phase {phase:.6g} left the period (0, 1)")
     t_g = t0 + phase * T
-    times = t_g + WINDOW * T * np.array([-1.0, 0.0, 1.0])
+    times = t_g + window * T * np.array([-1.0, 0.0, 1.0])
     samples = np.linspace(t0, t1, gap_samples(sm.model) + 1) if dense else np.array([t1])
     value, tr = sm.run(x, np.unique(np.concatenate([samples, times])))
     k = np.searchsorted(tr.t, times)
-    psi_all = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I]
-    psi = psi_all[k]
-    gap = _gap_rows(system, T, psi) + np.array([system.gap_tol, 0.0])          # psi_i(t_g) = -margin
+    boundary = system.boundary
+    psi_all = boundary.values(sm.model, sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend),
+                              tr.mode)
+    psi = psi_all[k]                  # inf where a rigid follower is in flight (.boundary._far): so is the residual
+    margin = system.gap_tol * boundary.margins                                   # psi_i(t_g) = -margin
+    with np.errstate(invalid="ignore"):                                          # (inf - inf in flight)
+        gap = _gap_rows(system, T, psi) + np.array([margin, 0.0]) + _pin(system, phase)
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
-    largest = refined_max(psi_all[np.isin(tr.t, samples)]) if dense else math.nan
+    sampled = np.isin(tr.t, samples)
+    # a pinned corner is a restart even where the run stepped over its junction without a record
+    restarts = np.append(tr.switches.records["t"], t_g if system.pinned else [])
+    largest = boundary.largest(sm.model, psi_all[sampled], tr.mode[sampled], tr.t[sampled],
+                               restarts) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
                       tr.mode[k].astype(int), psi, largest, sm)
 
@@ -248,15 +272,15 @@ def _fundamental(base: Evaluation, x) -> list[np.ndarray]:
     return out
 
 
-def _psi_gradient(model: Model, m: int, t: float, y) -> np.ndarray:
-    """d(psi_i)/d(alpha, alpha_dot) at (t, y) in mode m, by central differences of the generated
-    output (no run)."""
+def _psi_gradient(boundary: Boundary, model: Model, m: int, t: float, y) -> np.ndarray:
+    """d(psi_i)/d(alpha, alpha_dot) at (t, y) in mode m (the boundary's test output: -F_n on a
+    rigid contact), by central differences of the generated output (no run)."""
     g = np.empty(N_STATE)
     for j in range(N_STATE):
         h = OUTPUT_STEP * max(abs(float(y[j])), 1.0)
         e = np.zeros(N_STATE)
         e[j] = h
-        g[j] = (model.outputs(m, t, *(y + e))["psi_i"] - model.outputs(m, t, *(y - e))["psi_i"]) / (2 * h)
+        g[j] = (boundary.at(model, m, t, y + e) - boundary.at(model, m, t, y - e)) / (2 * h)
     return g
 
 
@@ -264,7 +288,7 @@ def _state_columns(system: GrazingSystem, layout: Layout, base: Evaluation, M, w
     """d(residual)/dx: M - I on the orbit's rows; the gap's rows from d psi_i(t)/dx =
     grad psi_i(t) Phi(t) at the window's times."""
     model = base.section_map.model
-    dpsi = np.array([_psi_gradient(model, int(base.modes[i]), float(base.times[i]), base.states[:, i]) @ window[i]
+    dpsi = np.array([_psi_gradient(system.boundary, model, int(base.modes[i]), float(base.times[i]), base.states[:, i]) @ window[i]
                      for i in range(3)])
     out = np.empty((N_STATE + 2, N_STATE))
     out[:N_STATE] = newton_matrix(M, layout.scale)
@@ -275,9 +299,13 @@ def _state_columns(system: GrazingSystem, layout: Layout, base: Evaluation, M, w
 
 def _phase_column(system: GrazingSystem, base: Evaluation) -> np.ndarray:
     """d(residual)/d(phi_g) from the window's samples: T psi_i' and T psi_i'' at t_g by central
-    differences over delta (psi_i'' over delta^2)."""
+    differences over delta (psi_i'' over delta^2); at a corner, T psi_i' by the forward
+    difference (the window's first time is before the junction) and 1 on the pinned phase's row."""
     T = base.section_map.model.period
-    psi, delta = base.psi, WINDOW * T
+    psi, delta = base.psi, system.boundary.window * T
+    if system.pinned:
+        rows = np.array([(psi[2] - psi[1]) / delta * T / system.deflection, 1.0])
+        return np.concatenate([np.zeros(N_STATE), rows]) * _row_weights(system)
     second = (psi[2] - 2 * psi[1] + psi[0]) / delta ** 2
     rows = np.array([(psi[2] - psi[0]) / (2 * delta) * T / system.deflection,
                      second * T * T / (2 * math.pi * system.deflection)])
@@ -337,20 +365,17 @@ def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict:
     raise Unresolved(f"no step down to {column.floor:.3g} keeps the grazing orbit's path on either side")
 
 
-def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> tuple[float, float]:
-    """phi_g of the largest psi_i over one period from x at lambda1 = ``free``, lambda2 = start
-    (the largest of :func:`gap_samples` samples, refined by the parabola through it and its
-    neighbours: the first guess of the extended system's phase), and the largest deflection
-    -min psi_i over the period (m: the gap's scale d).  Raises MapFailure."""
+def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None):
+    """Where the orbit from x at lambda1 = ``free``, lambda2 = start comes nearest the boundary
+    (:func:`.boundary.onset` of its :func:`gap_samples` samples over one period): phi_g of the
+    largest psi_i (the first guess of the extended system's phase, or a corner's pinned one), the
+    largest deflection -min psi_i over the period (m, or the largest force on a rigid contact,
+    N: the gap's scale d) and the corner (NaN: none).  Raises MapFailure."""
     sm = system.section_map(free, system.start, mode)
     t0, t1 = sm.t_span
     samples = np.linspace(t0, t1, gap_samples(sm.model) + 1)
     _, tr = sm.run(x, samples)
-    psi = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I][:-1]
-    k = int(np.argmax(psi))
-    a, b, c = psi[k - 1], psi[k], psi[(k + 1) % psi.size]
-    shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0
-    return float(((k + shift) / psi.size) % 1.0), float(-np.min(psi))
+    return onset(system.boundary, sm.model, sm.backend, tr, sm.t_span)
 
 
 def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A: np.ndarray) -> float:
@@ -358,7 +383,7 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
     the same lambda2: one Newton step of the system without the margin, ``[A; e_lambda2] dz =
     -(residual without the margin)`` (the error is second order in the margin, gap_tol^2 d)."""
     margin = np.zeros(N_STATE + 2)
-    margin[N_STATE] = system.gap_tol * _row_weights(system)[N_STATE]
+    margin[N_STATE] = system.gap_tol * system.boundary.margins * _row_weights(system)[N_STATE]
     along = np.zeros(G_SIZE)
     along[G_RANGE] = 1.0
     dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))

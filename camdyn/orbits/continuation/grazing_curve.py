@@ -230,8 +230,9 @@ def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
         return None
     z, e, iterations = found
     if not is_largest(leg.system, e):
-        return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} m over the orbit "
-                                                   f"against {e.psi_g:.3g} m at the grazing's t_g")
+        unit = leg.system.boundary.unit
+        return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} {unit} over the "
+                                                   f"orbit against {e.psi_g:.3g} {unit} at the grazing's t_g")
     try:
         q = _point(leg, z, e, p.tangent, iterations, p.derivatives.steps)
         return q._replace(curvature=(q.tangent - p.tangent) / ds)
@@ -266,7 +267,8 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
                 f"{system.free} = {free:.8g}")
     z, e, iterations = found
     if not is_largest(system, e):
-        return f"the located orbit's largest gap is not at its t_g ({e.max_gap:.3g} m against {e.psi_g:.3g} m)"
+        unit = system.boundary.unit
+        return f"the located orbit's largest gap is not at its t_g ({e.max_gap:.3g} {unit} against {e.psi_g:.3g} {unit})"
     try:
         return _point(leg, z, e, along, iterations)
     except CamdynError as failure:

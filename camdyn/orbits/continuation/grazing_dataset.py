@@ -34,12 +34,15 @@ def grazing_dataset(system, curve, layout, settings):
     the orbit itself, converged at psi_i(t_g) = -margin (``<free>_orbit``), ``alpha``, ``alpha_dot``
     at the section, ``grazing_time`` (t_g - t0, s after the section) and ``grazing_phase``
     (its fraction of T), ``grazing_gap`` (psi_i at t_g, m: within [-2, 0] gap_tol of the
-    deflection scale, the contact side), ``multiplier_real``/``_imag``/``_modulus`` (the
+    deflection scale, the contact side; on a rigid contact -F_n, N, within [-3, -1] gap_tol of
+    the force's scale: :mod:`.boundary`), ``multiplier_real``/``_imag``/``_modulus`` (the
     grazing orbit's, contact side), ``stable``, ``residual`` (scaled), ``iterations`` and
     ``one_sided`` (a lambda-derivative was one-sided there).  Per codimension-2 point:
     ``codim2_kind`` (code into attrs ``codim2_kinds``), both parameters (``codim2_<name>``),
     ``codim2_point`` (the point just before it), ``codim2_multiplier_real``/``_imag``.  Attrs:
-    ``outcome`` (a :class:`GrazingOutcome` name) and ``outcome_message``, the range, the scene,
+    ``outcome`` (a :class:`GrazingOutcome` name) and ``outcome_message``, ``boundary``
+    (``grazing``, or ``lift_off`` on a rigid contact), its scale (``deflection_scale_m``, or
+    ``force_scale_n``), ``phase_pinned_at_corner`` (1 or 0), the range, the scene,
     ``rig_<parameter>`` (SI), the settings (``settings_<name>``), the scales, ``camdyn_version``.
     """
     import xarray as xr
@@ -71,7 +74,8 @@ def _point_variables(system, points) -> dict:
         "grazing_phase": (P, phase, {"units": "1", "long_name": "time of the largest gap after the section, "
                                                                 "a fraction of the cam period"}),
         "grazing_gap": (P, np.array([p.evaluation.psi_g for p in points]),
-                        {"units": "m", "long_name": "psi_i at the largest gap (0 at grazing; the contact side)"}),
+                        {"units": system.boundary.unit, "long_name": f"{system.boundary.meaning} at its largest "
+                                                                     "(the contact side)"}),
         "multiplier_real": (PM, mu.real, {"units": "1", "long_name": "Floquet multiplier at grazing (contact side), "
                                                                     "real part"}),
         "multiplier_imag": (PM, mu.imag, {"units": "1", "long_name": "Floquet multiplier at grazing (contact side), "
@@ -137,6 +141,7 @@ def _attributes(system, curve, layout, settings) -> dict:
     return {
         "title": f"camdyn grazing curve in ({system.free}, {system.parameter}), rig {system.rig.name}",
         **common_attributes(system, curve, scale),
-        "codim2_kinds": " ".join(CODIM2), "deflection_scale_m": system.deflection,
+        "codim2_kinds": " ".join(CODIM2), "boundary": system.boundary.kind,
+        system.boundary.scale_attribute: system.deflection, "phase_pinned_at_corner": int(system.pinned),
         **{f"settings_{k}": v for k, v in plain.items()},
     }

@@ -96,7 +96,12 @@ def restart_force(run, records: np.ndarray) -> float:
     has jumped); inf without switches."""
     if not records.size:
         return math.inf
-    model = run.section_map.model
+    return float(np.min(forces_after(run.section_map.model, run.section_map.backend, records)))
+
+
+def forces_after(model, backend: str, records: np.ndarray) -> np.ndarray:
+    """F_n (N) RESTART_NUDGE T past each switch record (``t``, ``after``, ``alpha``,
+    ``alpha_dot``) of a rigid contact orbit of ``model``: the force on the arc the follower rides on next."""
     t = records["t"] + RESTART_NUDGE * model.period
-    out = model.outputs_at(records["after"], t, records["alpha"], records["alpha_dot"], run.section_map.backend)
-    return float(np.min(out[model.kernels.OUT_F_N]))
+    out = model.outputs_at(records["after"], t, records["alpha"], records["alpha_dot"], backend)
+    return out[model.kernels.OUT_F_N]

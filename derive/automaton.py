@@ -102,6 +102,11 @@ class Automaton:
     #: the rigid law's chatter end: a transition of the same source, surface and direction as the impact
     #: it replaces where the engine finds the impacts converging geometrically (camdyn.engine.rules.chatter_ends)
     chatter: Transition | None = None
+    #: the surfaces whose value is a function of time alone (derived: free of the state, e.g. a cam of arcs'
+    #: junctions under a translating follower, of Theta(t) only): the engine steps to their crossings
+    #: (camdyn.engine.rules.time_bound) instead of searching a step for them, as a field that jumps there
+    #: could not be stepped across
+    timed: tuple[str, ...] = ()
 
     def mode(self, name: str) -> Mode:
         return next(m for m in self.modes if m.name == name)

@@ -514,6 +514,9 @@ def _automaton_code(A: Automaton) -> list[str]:
         lines += ["#: per mode: the run ends on entering it (Outcome.OFF_FACE: the contact beyond the face's end)",
                   "TERMINAL_OF_MODE = " + repr(tuple(m.terminal for m in A.modes))]
     lines += _named("SURFACES", "SURFACE", A.surfaces)
+    if A.timed:  # (a module without it has none: camdyn.engine.tables)
+        lines += ["#: the surfaces of time alone (the cam angle's): the engine steps to their crossings",
+                  "TIMED_SURFACES = (" + "".join(f"{surf[s]}, " for s in A.timed) + ")"]
     rate = [surf[A.rates[s]] if s in A.rates else "-1" for s in A.surfaces]
     lines += ["#: per surface: the surface that is its time derivative (-1: none); an excursion across",
               "#: zero and back inside one step is found where the derivative changes sign",

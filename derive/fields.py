@@ -179,6 +179,21 @@ def jacobian(spec: SceneSpec, mode: Mode) -> Kernel:
     return Kernel(f.definitions + by_alpha + by_rate, results).pruned()
 
 
+def timed_surfaces(spec: SceneSpec, modes, surfaces: tuple[str, ...]) -> tuple[str, ...]:
+    """The surfaces whose value is a function of time alone: free of the follower's state in every
+    mode where it has a meaning (e.g. a cam of arcs' junction indicator under a translating
+    follower, whose contact angle is Theta(t)'s alone).  Judged under the first mode where it has a
+    meaning: a surface is the same function in every mode that watches it."""
+    q = coordinate(spec)
+    state = {q.plain, q.rate}
+
+    def free_of_state(name: str) -> bool:
+        kernel = next((k for k in (surface(spec, mode, name) for mode in modes) if k is not None), None)
+        return kernel is not None and not any(sp.sympify(d.expr).free_symbols & state for d in kernel.definitions)
+
+    return tuple(s for s in surfaces if free_of_state(s))
+
+
 def surface(spec: SceneSpec, mode: Mode, name: str) -> Kernel | None:
     """The value of surface ``name`` under the mode's laws (None where it has no meaning)."""
     if name == "gap":

@@ -30,6 +30,7 @@ tangent dynamics and the parameter continuation import (:attr:`SceneModule.varia
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -249,6 +250,7 @@ def _static_functions(spec: SceneSpec) -> list[Function]:
 def build(spec: SceneSpec) -> SceneModule:
     """Everything a scene's module holds (see the module docstring)."""
     A = build_automaton(spec)
+    A = dataclasses.replace(A, timed=fields.timed_surfaces(spec, A.modes, A.surfaces))
     functions = []
     if spec.motion != "user":
         sub = motion_substitution(spec.motion)

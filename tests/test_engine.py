@@ -103,7 +103,9 @@ def test_tables_encode_the_generated_automaton(slug):
         watched = {tr[1] for tr in K.TRANSITIONS if tr[0] == m}
         assert len(evaluated) == len(set(evaluated))
         assert set(evaluated) == watched | {K.RATE_OF_SURFACE[s] for s in watched if K.RATE_OF_SURFACE[s] >= 0}
-    assert tab.data.size == tab.sampled + data["sampled_start"][tab.n_modes] and tab.n_surfaces == len(K.SURFACES)
+    assert tab.surface_timed == tab.sampled + data["sampled_start"][tab.n_modes] and tab.n_surfaces == len(K.SURFACES)
+    timed = getattr(K, "TIMED_SURFACES", ())  # the surfaces of time alone, a flag per surface, last
+    assert data["surface_timed"].tolist() == [int(s in timed) for s in range(len(K.SURFACES))]
 
 
 # --- trap 1: the gap as a difference of nearly equal angles --------------------------------

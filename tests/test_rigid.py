@@ -246,3 +246,28 @@ def test_continuation_of_a_rigid_impacting_branch_finds_its_period_doubling():
     assert np.max(np.abs(below.multipliers)) < 1
     real = above.multipliers[np.abs(above.multipliers.imag) < 1e-12].real
     assert real.size and real.min() < -1
+
+
+def test_a_junction_of_time_alone_is_stepped_to_so_the_tightest_tolerances_hold():
+    """Under a translating follower a cam of arcs' junction is a function of the cam angle alone
+    (derived: TIMED_SURFACES), and the rigid follower's kinematic acceleration jumps there (0 to
+    323 m/s^2 at the dwell's end): the loop steps to the float before it and switches just past it
+    (camdyn.engine.rules.time_bound), so no step straddles the jump.  Stepping across it, atol 1e-14
+    needed a step below 10 float spacings of t and failed (Outcome.STEP_FAILED at t = 2.40 s,
+    docs/second-rig.md).  Now it holds, and the impacts agree with atol 1e-13's to the location's
+    resolution (1e-10 s: a tenth of the impact-time error at rtol 1e-6 against the exact solution)."""
+    from camdyn.model.presets import second_rig
+    from camdyn.studies.second_rig import approach_speeds
+    scene = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")
+    runs = {atol: camdyn.simulate(second_rig(), scene, speed_rpm=256, revolutions=30, rtol=1e-12, atol=atol)
+            for atol in (1e-13, 1e-14)}
+    assert all(run.ok for run in runs.values())
+    impacts = {}
+    for atol, run in runs.items():  # the impacts faster than 0.5 m/s (a chatter's tail depends on atol)
+        t, speed = approach_speeds(second_rig(), run)
+        impacts[atol] = t[speed < -0.5]
+    assert impacts[1e-13].size == impacts[1e-14].size > 0
+    assert np.max(np.abs(impacts[1e-13] - impacts[1e-14])) < 1e-10
+    assert scene.kernels().TIMED_SURFACES == (scene.kernels().SURFACE_JUNCTION,)
+    rocker = camdyn.Scene(contact="rigid", damping="none", friction="none", profile="arcs")
+    assert not hasattr(rocker.kernels(), "TIMED_SURFACES")  # its contact angle moves with alpha

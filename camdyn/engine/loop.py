@@ -31,7 +31,7 @@ from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
 from .rules import (CHATTER_COUNT, NONFINITE, across, chatter_ends, chattering, clear_of_surfaces, first_crossing,
-                    initial_mode, left_at_start, scratch, switch, value, zero_at_start)
+                    initial_mode, left_at_start, scratch, switch, time_bound, value, zero_at_start)
 from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coefficients, dense_eval, initial_step
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -127,6 +127,33 @@ def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tm
         samples.mode[i] = m
         i += 1
     return i
+
+
+@allocating
+def _switched(prob, cfg, w, t_cross, c0, c1, m, history, sw, n_sw, buf):
+    """Transition w fires at t_cross from (c0, c1) in mode m: the chatter's end in place of an impact
+    where its sequence has converged (rules.chatter_ends), the reset, the record, and whether the run
+    ends there.  (mode, state after, sw, n_sw, capped: contact starts, outcome)."""
+    tab = prob.tables
+    row = w
+    if w == tab.chatter:  # an impact
+        rate = value(prob, m, tab.data[tab.surface_rate + tab.data[tab.surface + w]], t_cross, c0, c1)
+        if chatter_ends(history, t_cross, rate, cfg.atol, cfg.xtol * max(1.0, abs(t_cross))):
+            row = tab.n_transitions + 1
+    else:
+        history[CHATTER_COUNT] = 0.0
+    m_new, c0, c1 = switch(prob, row, t_cross, c0, c1, cfg, buf)
+    capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
+    sw = _record(sw, n_sw, t_cross, row, m, m_new, c0, c1)
+    n_sw += 1
+    outcome = SUCCESS
+    if tab.data[tab.mode_terminal + m_new] == 1:
+        outcome = OFF_FACE
+    elif n_sw >= cfg.max_events:
+        outcome = MAX_EVENTS
+    elif chattering(sw[SW_T], n_sw, cfg.chatter_window, cfg.chatter_switches):
+        outcome = CHATTER
+    return m_new, c0, c1, sw, n_sw, capped, outcome
 
 
 @jitable
@@ -236,7 +263,13 @@ def run(prob, method, cfg, start, samples):
         watched = n_watched > 0
         have_start = False
         while t < t_end:
-            r = accepted_step(rhs, p, m, t, y0, y1, h_abs, t_end, method, K, cfg, err_prev)
+            w, t_before, t_after = time_bound(prob, m, t, min(t_end, t + min(h_abs, cfg.max_step)), y0, y1)
+            if w >= 0 and t_before <= t:  # at a surface of time alone: its transition, just past it
+                m, y0, y1, sw, n_sw, capped, outcome = _switched(prob, cfg, w, t_after, y0, y1, m, history, sw, n_sw,
+                                                                 buf)
+                t = t_after
+                break
+            r = accepted_step(rhs, p, m, t, y0, y1, h_abs, t_before if w >= 0 else t_end, method, K, cfg, err_prev)
             t_new, n0, n1, h_next, err_prev = r.t, r.y0, r.y1, r.h_next, r.err
             nfev += r.nfev
             rejected += r.rejected
@@ -277,24 +310,9 @@ def run(prob, method, cfg, start, samples):
                     have_start, retries = False, retries + 1
                     continue
                 retries = 0
-                row = w
-                if w == tab.chatter:  # an impact: the chatter's end where its sequence has converged
-                    rate = value(prob, m, tab.data[tab.surface_rate + tab.data[tab.surface + w]], t_cross, c0, c1)
-                    if chatter_ends(history, t_cross, rate, cfg.atol, cfg.xtol * max(1.0, abs(t_cross))):
-                        row = tab.n_transitions + 1
-                else:
-                    history[CHATTER_COUNT] = 0.0
-                m_new, c0, c1 = switch(prob, row, t_cross, c0, c1, cfg, buf)
-                capped = tab.data[tab.mode_contact + m] == 0 and tab.data[tab.mode_contact + m_new] == 1
-                sw = _record(sw, n_sw, t_cross, row, m, m_new, c0, c1)
-                n_sw += 1
-                t, y0, y1, m = t_cross, c0, c1, m_new
-                if tab.data[tab.mode_terminal + m] == 1:
-                    outcome = OFF_FACE
-                elif n_sw >= cfg.max_events:
-                    outcome = MAX_EVENTS
-                elif chattering(sw[SW_T], n_sw, cfg.chatter_window, cfg.chatter_switches):
-                    outcome = CHATTER
+                m, y0, y1, sw, n_sw, capped, outcome = _switched(prob, cfg, w, t_cross, c0, c1, m, history, sw, n_sw,
+                                                                 buf)
+                t = t_cross
                 break
             t, y0, y1, h_abs = t_new, n0, n1, h_next
             retries = 0

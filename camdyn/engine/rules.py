@@ -111,6 +111,56 @@ def value(prob, m, s, t, a, ad):
     return prob.kernels.surface(m, s, t, a, ad, prob.p)
 
 
+# --- surfaces of time alone -----------------------------------------------------------------
+#: how many equal parts of a step's span time_bound samples a surface of time alone at
+TIME_SAMPLES = 4
+
+
+@jitable
+def time_bound(prob, m, t, t_far, a, ad):
+    """The first crossing within (t, t_far] of a surface of time alone (``TIMED_SURFACES``: a cam
+    of arcs' junction under a translating follower) that mode m watches, in its transition's
+    direction: (w, t_before, t_after), the transition's row and the adjacent floats around the
+    crossing (the old side at t_before, across at t_after); (-1, t_far, t_far) for none.
+
+    The loop steps to t_before and takes the transition at t_after, as a field that jumps at the
+    surface (a rigid follower's kinematic acceleration at a change of curvature) cannot be stepped
+    across: a step over the jump errs by the jump times the time it spends beyond it, which the
+    error control can only shrink down to the floats' spacing.  The crossing is found on
+    TIME_SAMPLES samples of the span (a crossing and its return within one part is missed, as on a
+    watched surface's samples), then bisected to adjacent floats.  The state does not enter."""
+    tab = prob.tables
+    best, t_before, t_after = -1, t_far, t_far
+    for w in range(tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]):
+        s = tab.data[tab.surface + w]
+        if tab.data[tab.surface_timed + s] == 1:
+            found, lo, hi = _timed_crossing(prob, m, s, tab.data[tab.direction + w], t, t_before, a, ad)
+            if found:  # (searched up to the best so far only: it is the earlier)
+                best, t_before, t_after = w, lo, hi
+    return best, t_before, t_after
+
+
+@jitable
+def _timed_crossing(prob, m, s, direction, t, t_far, a, ad):
+    """Surface s's first crossing in ``direction`` within (t, t_far]: (True, t_before, t_after) as
+    adjacent floats; (False, t_far, t_far) for none (see :func:`time_bound`)."""
+    ta, ga = t, direction * value(prob, m, s, t, a, ad)
+    for k in range(1, TIME_SAMPLES + 1):
+        tb = t_far if k == TIME_SAMPLES else t + (t_far - t) * (k / TIME_SAMPLES)
+        gb = direction * value(prob, m, s, tb, a, ad)
+        if ga <= 0.0 < gb:
+            while True:  # bisection to adjacent floats: direction * value <= 0 at ta, > 0 at tb
+                mid = ta + (tb - ta) * 0.5
+                if mid <= ta or mid >= tb:
+                    return True, ta, tb
+                if direction * value(prob, m, s, mid, a, ad) > 0.0:
+                    tb = mid
+                else:
+                    ta = mid
+        ta, ga = tb, gb
+    return False, t_far, t_far
+
+
 # --- targets ------------------------------------------------------------------------------
 @jitable
 def side(prob, m, s, t, a, ad, look_ahead):

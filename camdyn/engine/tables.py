@@ -2,7 +2,7 @@
 
 A generated module states its automaton as data (``MODES``, ``SURFACES``, ``INITIAL``,
 ``TRANSITIONS``, ``RESETS``, ``RATE_OF_SURFACE``, ``CONTACT_OF_MODE``, ``TERMINAL_OF_MODE`` where a
-mode ends the run; see
+mode ends the run, ``TIMED_SURFACES`` where a surface's value is of time alone; see
 ``camdyn.derive.automaton`` for the rules).  :func:`tables` packs it into :class:`Tables`:
 compressed rows, so that mode m's transitions are ``watch_start[m]:watch_start[m + 1]`` and a
 transition's candidate targets are ``target_start[w]:target_start[w + 1]``; the initial choice
@@ -45,6 +45,7 @@ class Tables(NamedTuple):
     flows: int                     # the outputs integrated by the energy ledger (P_in, D_c, D_f)
     sampled_start: int             # per mode, and one past the end: its sampled surfaces (rows)
     sampled: int                   # per row: a surface mode m samples, once, with its rate if it has one
+    surface_timed: int             # per surface: 1 where its value is of time alone (stepped to, rules.time_bound)
     n_modes: int
     n_transitions: int
     n_surfaces: int
@@ -83,10 +84,11 @@ def _tables(K) -> Tables:
     resets = [IDENTITY if K.RESETS[tr[RESET]] == "identity" else tr[RESET] for tr in transitions]
     sampled_start, sampled = sampled_surfaces(K, transitions, watch_start)
     terminal = getattr(K, "TERMINAL_OF_MODE", (False,) * n_modes)  # declared by a scene that has one
+    timed = getattr(K, "TIMED_SURFACES", ())  # likewise
     parts = [K.CONTACT_OF_MODE, terminal, watch_start, [tr[SURFACE] for tr in transitions], [tr[DIRECTION] for tr in transitions],
              resets,
              target_start, target_mode, condition_start, condition_surface, condition_sign, K.RATE_OF_SURFACE,
-             [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled]
+             [K.OUTPUTS.index(f) for f in FLOWS], sampled_start, sampled, [int(s in timed) for s in range(len(K.SURFACES))]]
     starts = np.cumsum([0] + [len(part) for part in parts])[:-1]
     data = np.ascontiguousarray(np.concatenate([np.asarray(part, dtype=np.int64) for part in parts]), dtype=np.int64)
     replaced, reset = _chatter(K, transitions, chatter)

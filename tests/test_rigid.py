@@ -171,17 +171,21 @@ def test_the_second_rig_leaves_its_arc_cam_at_the_inverse_kinematics_speed_and_c
 #: orbits' default options) once ended in Outcome.CHATTER: every point 0.05 rev/min apart from 238.9 to
 #: 245 was run, and these five failed (commit 569f601; a grazing release read as an impact at its start)
 GRAZING_RELEASES_RPM = tuple(float(np.linspace(238.9, 245.0, 123)[k]) for k in (6, 37, 55, 57, 92))
+#: and one where the flight's first step (the contact mode's last, 4 ms) spanned the whole brief flight
+#: after a mid-arc lift-off: its end inside the cam was read as an impact at its start (rules.SHORTER)
+LONG_FIRST_FLIGHT_RPM = 239.03003
 
 
-@pytest.mark.parametrize("speed_rpm", GRAZING_RELEASES_RPM)
+@pytest.mark.parametrize("speed_rpm", GRAZING_RELEASES_RPM + (LONG_FIRST_FLIGHT_RPM,))
 def test_a_follower_released_where_the_force_just_turns_negative_flies_instead_of_chattering_in_place(speed_rpm):
     """Flung at a corner where the needed force is barely negative (-0.66 N at 239.2 rev/min), the
     follower starts its flight at rest on the cam (the plastic reset); its first, short step ends
-    with the gap ~1e-15 m below zero by rounding while its rate already separates.  That is not an
-    impact at the flight's start (camdyn.engine.rules.left_at_start reads the rate too): read as one,
-    its chatter end released the follower at the same instant again and again until the chatter
-    guard ended the run.  The run must reach its end, and no switch may repeat another's instant
-    and state."""
+    with the gap ~1e-15 m below zero by rounding while its rate already separates; or a long first
+    step ends inside the cam after the brief flight.  Neither is an impact at the flight's start
+    (camdyn.engine.rules.left_at_start reads the rate at both ends: the first, no crossing; the
+    second, the step again shorter): read as one, its chatter end released the follower at the same
+    instant again and again until the chatter guard ended the run.  The run must reach its end,
+    and no switch may repeat another's instant and state."""
     from camdyn.model.presets import second_rig
     from camdyn.orbits.section_map import DEFAULT_OPTIONS
     scene = camdyn.Scene(follower="translating", contact="rigid", damping="none", friction="none", profile="arcs")

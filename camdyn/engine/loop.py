@@ -30,7 +30,7 @@ from ..vocabulary import STATE, STATE_ALPHA, STATE_ALPHA_DOT
 from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
-from .rules import (CHATTER_COUNT, NONFINITE, across, chatter_ends, chattering, clear_of_surfaces, first_crossing,
+from .rules import (CHATTER_COUNT, NONFINITE, SHORTER, across, chatter_ends, chattering, clear_of_surfaces, first_crossing,
                     initial_mode, left_at_start, scratch, switch, time_bound, value, zero_at_start)
 from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coefficients, dense_eval, initial_step
 
@@ -129,6 +129,22 @@ def _sample(prob, samples, i, t_stop, m, t, h, y0, y1, Q, ledger_work, ledger_tm
     return i
 
 
+@jitable
+def _held(samples, i, t_stop, m, y0, y1, ledger_work):
+    """Write the samples at times <= t_stop as the state (y0, y1) held, with the works so far: the
+    float a transition of time alone steps over (rules.time_bound); the next index."""
+    n = samples.t.shape[0]
+    ledger = samples.y.shape[0] > STATE_ROWS
+    while i < n and samples.t[i] <= t_stop:
+        samples.y[ALPHA, i], samples.y[ALPHA_DOT, i] = y0, y1
+        if ledger:
+            for k in range(N_FLOWS):  # element by element, as in _record
+                samples.y[WORK + k, i] = ledger_work[k]
+        samples.mode[i] = m
+        i += 1
+    return i
+
+
 @allocating
 def _switched(prob, cfg, w, t_cross, c0, c1, m, history, sw, n_sw, buf):
     """Transition w fires at t_cross from (c0, c1) in mode m: the chatter's end in place of an impact
@@ -169,6 +185,11 @@ def _first_step(prob, method, cfg, m, t, y0, y1, t_end, h_last, capped, K):
     return h_abs, 1
 
 
+#: a step whose crossing is inside it but read at its start (rules.left_at_start's SHORTER) is taken
+#: again from its start this much shorter, down to the event time resolution (EventSettings.xtol)
+SHORTEN = 0.125
+
+
 #: _restart_state's verdicts
 ACROSS, NOT_YET, UNUSABLE = 1, 0, -1
 
@@ -194,12 +215,13 @@ def _restart_state(prob, method, m, w, t, y0, y1, h, Q, t_cross, K, may_retry):
 def _crossed(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, on_surface, work):
     """The first transition whose surface the step [t, t_new] crosses, and when: (w, t_cross); w
     NONFINITE for a non-finite value, -1 for none (t_cross = t_new).  A step that starts on a
-    surface (``on_surface``) and leaves it at once is a crossing at its start."""
+    surface (``on_surface``) and leaves it at once is a crossing at its start; one that turns back
+    across it within the step is SHORTER (rules.left_at_start), to be taken again shorter."""
     w, t_cross = first_crossing(prob, m, t, t_new, y0, y1, n0, n1, Q, cfg, have_start, work)
     if w == NONFINITE or w >= 0:
         return w, t_cross
     if on_surface:
-        w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1)
+        w = left_at_start(prob, m, t, t_new, y0, y1, n0, n1, t_new - t > cfg.xtol * max(1.0, abs(t)))
         return w, (t if w >= 0 else t_new)
     return w, t_new
 
@@ -265,6 +287,7 @@ def run(prob, method, cfg, start, samples):
         while t < t_end:
             w, t_before, t_after = time_bound(prob, m, t, min(t_end, t + min(h_abs, cfg.max_step)), y0, y1)
             if w >= 0 and t_before <= t:  # at a surface of time alone: its transition, just past it
+                i_sample = _held(samples, i_sample, t_after, m, y0, y1, ledger_work)
                 m, y0, y1, sw, n_sw, capped, outcome = _switched(prob, cfg, w, t_after, y0, y1, m, history, sw, n_sw,
                                                                  buf)
                 t = t_after
@@ -294,6 +317,9 @@ def run(prob, method, cfg, start, samples):
                     if w == NONFINITE:
                         outcome = NONFINITE_STATE
                         break
+                    if w == SHORTER:  # the step again from its start (K[0] = f there still), shorter
+                        h_abs = SHORTEN * h
+                        continue
                 have_start = True
             if i_sample < samples.t.shape[0] and samples.t[i_sample] <= t_cross:
                 i_sample = _sample(prob, samples, i_sample, t_cross, m, t, h, y0, y1, Q, ledger_work, ledger_tmp, buf)

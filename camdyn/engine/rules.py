@@ -68,6 +68,8 @@ from .stepper import dense_eval
 
 #: first_crossing's transition index when a surface value is not finite
 NONFINITE = -2
+#: left_at_start's verdict: the step must be taken again, shorter (its crossing is inside it)
+SHORTER = -3
 
 
 #: rows of first_crossing's work array (:func:`scratch`): per watched transition of the mode
@@ -484,16 +486,21 @@ def first_crossing(prob, m, t0, t1, y0, y1, n0, n1, Q, cfg, have_start, work):
 
 
 @jitable
-def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
+def left_at_start(prob, m, t0, t1, y0, y1, n0, n1, may_shorten):
     """A step that starts exactly on a watched surface (value 0) and ends strictly on its
-    leaving side, moving that way (its declared rate, where it has one, on the leaving side
-    too), has left mode m at its start: the transition's row, or -1.
+    leaving side has left mode m at its start, the transition's row, where the surface's
+    declared rate leaves at the start too (or the surface has none, or ``may_shorten`` is False:
+    the step is already at the time resolution); -1 for none.
 
-    The rate's say keeps rounding from being read as a crossing: a rigid follower released at
-    rest on the cam (a lift-off that grazes, the plastic reset's zero relative velocity) ends a
-    short first step with the gap ~1e-15 m below zero by the gap's rounding while its rate is
-    already separating; read as an impact at the start, its chatter end would release it there
-    again, at the same instant, until the chatter guard ends the run."""
+    Where the rate does not leave at the start (a rigid follower released at rest on the cam: the
+    plastic reset's zero relative velocity) the value first moves the other way or not at all:
+    if the rate at the end leaves, the value turns back within the step, and the crossing is inside
+    it, not at its start: SHORTER, the step must be taken again shorter (a long first step of a
+    flight after a lift-off that grazes spans the whole brief flight); if it does not, the end's
+    value is rounding (~1e-15 m of the gap below zero after a short first step while the rate
+    already separates), no crossing.  Read as an impact at the start, either had its chatter end
+    release the follower at the same instant again and again until the chatter guard ended the
+    run."""
     tab = prob.tables
     for w in range(tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]):
         s = tab.data[tab.surface + w]
@@ -501,8 +508,10 @@ def left_at_start(prob, m, t0, t1, y0, y1, n0, n1):
         leaving = direction * value(prob, m, s, t1, n0, n1) > 0.0
         if leaving and value(prob, m, s, t0, y0, y1) == 0.0:
             rate = tab.data[tab.surface_rate + s]
-            if rate < 0 or direction * value(prob, m, rate, t1, n0, n1) > 0.0:
+            if rate < 0 or not may_shorten or direction * value(prob, m, rate, t0, y0, y1) > 0.0:
                 return w
+            if direction * value(prob, m, rate, t1, n0, n1) > 0.0:
+                return SHORTER
     return -1
 
 

@@ -14,9 +14,9 @@ the grazing orbits form a curve, the unknowns z = (x, phi_g, lambda1, lambda2) s
 continued in two parameters, the boundary's test functions appended to the orbit's equations
 (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10), here
 the grazing conditions of a periodic orbit of a hybrid system (Thota & Dankowicz, TC-HAT, SIAM
-J. Appl. Dyn. Syst. 7 (2008) 1283).  ``margin`` is ``gap_tol`` times the gap's scale d, the
-largest deflection over the first orbit: the orbit is converged on the contact side, so its run
-never lifts off and its derivatives are the contact flow's.
+J. Appl. Dyn. Syst. 7 (2008) 1283).  ``margin`` is :data:`MARGIN` ``gap_tol`` times the gap's
+scale d, the largest deflection over the first orbit: the orbit is converged on the contact side,
+so its run never lifts off and its derivatives are the contact flow's.
 
 **Scaling.**  z = (x / s, phi_g, lambda1 / sigma1, lambda2 / sigma2): s the motion's size (as
 in :mod:`camdyn.orbits.shooting`), phi_g the fraction of the period, sigma2 the range of
@@ -65,6 +65,8 @@ G_PHASE = N_STATE
 G_FREE = N_STATE + 1
 G_RANGE = N_STATE + 2
 G_SIZE = N_STATE + 3
+#: the residual's rows: the orbit's (N_STATE), the gap's psi_i(t_g) + margin, and its rate
+R_GAP = N_STATE
 #: the central difference of the generated psi_i in alpha (rad) and alpha_dot (rad/s): an
 #: analytic function, no run; its rounding error over this step is ~1e-10 of the derivative
 OUTPUT_STEP = 1e-6
@@ -80,6 +82,12 @@ WINDOW = 1e-2
 #: the rate row's tolerance, RATE_TOL sqrt(gap_tol) of its scale: a rate error e moves t_g by
 #: e / psi_i'' and psi_i(t_g) from the maximum by only ~e^2 / (2 psi_i''), second order
 RATE_TOL = 0.1
+#: the margin in units of gap_tol d: the corrector's tolerance on the gap's row is gap_tol d
+#: either side, so the converged orbit has psi_i(t_g) within [-3, -1] gap_tol d, on the contact
+#: side, and an iterate lifts off only when it lies more than 2 gap_tol d past the target (at 1,
+#: the band reached zero gap: on reference-experiment against k_s, the chord's last iterates
+#: landed past it at 24 of its 45 steps, the flight's gap and rate then no residual to converge on)
+MARGIN = 2.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -174,7 +182,7 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     k = np.searchsorted(tr.t, times)
     psi_all = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I]
     psi = psi_all[k]
-    gap = _gap_rows(system, T, psi) + np.array([system.gap_tol, 0.0])          # psi_i(t_g) = -margin
+    gap = _gap_rows(system, T, psi) + np.array([MARGIN * system.gap_tol, 0.0])   # psi_i(t_g) = -margin
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
     largest = refined_max(psi_all[np.isin(tr.t, samples)]) if dense else math.nan
@@ -356,9 +364,9 @@ def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None) -> tupl
 def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A: np.ndarray) -> float:
     """lambda1 where the orbit at z, converged at psi_i(t_g) = -margin, would touch zero gap at
     the same lambda2: one Newton step of the system without the margin, ``[A; e_lambda2] dz =
-    -(residual without the margin)`` (the error is second order in the margin, gap_tol^2 d)."""
+    -(residual without the margin)`` (the error is second order in the margin, (MARGIN gap_tol)^2 d)."""
     margin = np.zeros(N_STATE + 2)
-    margin[N_STATE] = system.gap_tol * _row_weights(system)[N_STATE]
+    margin[R_GAP] = MARGIN * system.gap_tol * _row_weights(system)[R_GAP]
     along = np.zeros(G_SIZE)
     along[G_RANGE] = 1.0
     dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))
@@ -367,10 +375,10 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
 
 def is_largest(system: GrazingSystem, evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
-    parabola) stays below +margin (gap_tol d), else another maximum of the gap has overtaken the
-    one at t_g and the follower first leaves the cam elsewhere.  Not below zero: the orbit is
-    converged with psi_i(t_g) within [-2, 0] margin, so a largest sample up to +margin is that
-    maximum (or another within the corrector's tolerance of it) and the psi_i noise of a stiff
-    contact (measured: 1.9e-17 m against -4.3e-18 m at t_g, margin 4.7e-16 m, on
+    parabola) stays below gap_tol d, else another maximum of the gap has overtaken the one at
+    t_g and the follower first leaves the cam elsewhere.  Not below zero: the orbit is converged
+    with psi_i(t_g) within [-3, -1] gap_tol d (:data:`MARGIN`), so a largest sample up to
+    +gap_tol d is that maximum (or another within the corrector's tolerance of it) and the psi_i
+    noise of a stiff contact (measured: 1.9e-17 m against -4.3e-18 m at t_g, gap_tol d 4.7e-16 m, on
     reference-experiment at k_s = 30 N/m, which ended the jump chart there as a double grazing)."""
     return evaluation.max_gap < system.gap_tol * system.deflection

@@ -68,7 +68,7 @@ class GrazingSettings:
     ``search``: the one-parameter continuation that finds the first grazing (its orbit only
     starts the extended system's Newton, which locates the grazing itself: a coarse one);
     ``gap_tol``: the gap's tolerance, a fraction of the largest deflection over the first orbit
-    (the grazing orbit is converged to psi_i(t_g) within [-2, 0] gap_tol of it); ``threads``:
+    (the grazing orbit is converged to psi_i(t_g) within [-3, -1] gap_tol of it); ``threads``:
     how many of a point's independent runs (the tangent dynamics and the two parameter
     differences, :func:`.grazing.derivatives`) run at once; the curve is the same for any value."""
 

@@ -295,3 +295,27 @@ def test_the_guessed_start_and_the_searched_one_find_the_same_grazing():
     firsts = [continue_grazing(RIG, SCENE, "k_s", 2000.0, 2001.0, search=search, guess=g)["speed_rpm"].values[0]
               for g in (guess, None, 1.02 * loss)]
     np.testing.assert_allclose(firsts, firsts[1], rtol=1e-6)
+
+
+def test_the_chord_steps_on_from_an_iterate_off_the_smooth_side_without_new_derivatives():
+    """An iterate whose run left the cam has a residual above the smooth one (the flight's gap;
+    here three times it): the chord step from it lands on the contact side, and with ``smooth``
+    told, the next iterate's contraction is not measured against it: no derivatives are
+    evaluated (without it, a Newton step's are), and the corrector converges to the same z."""
+    from camdyn.orbits.continuation.corrector import chord
+
+    def residual(z):
+        g = z[0] - 1.0
+        return np.array([3.0 * g if g > 0 else g]), g <= 0
+
+    calls = []
+
+    def derivatives(z, payload):
+        calls.append(z.copy())
+        return np.array([[1.0, 0.0]])
+    settings = ContinuationSettings(tol=1e-12)
+    z_pred, direction, A = np.array([1.5, 0.2]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]])
+    z, smooth_side, iterations = chord(residual, derivatives, z_pred, direction, A, settings, lambda s: s)
+    assert not calls and smooth_side and iterations == 2 and np.allclose(z, [1.0, 0.2], atol=1e-12)
+    chord(residual, derivatives, z_pred, direction, A, settings)
+    assert calls

@@ -155,14 +155,17 @@ def correct(leg: Leg, z_pred, direction, A, mode) -> Corrected | None:
     return None if found is None else Corrected(*found)
 
 
-def chord(residual, derivatives, z_pred, direction, A, settings):
+def chord(residual, derivatives, z_pred, direction, A, settings, smooth=None):
     """The pseudo-arclength corrector of any extended system: the chord method on
     ``residual(z) = 0, direction . (z - z_pred) = 0`` from the derivatives ``A`` of the last
     point, stopping at ``max |residual| <= settings.tol``.  It keeps ``A`` while each
     iteration shrinks the residual by CHORD_CONTRACTION or more and evaluates it anew at z when
     it does not (a Newton step); ``residual(z)`` gives (the scaled residual, a payload: the
     run), ``derivatives(z, payload)`` the scaled Jacobian; both raise CamdynError where they
-    cannot be evaluated.  Returns (z, payload, iterations), or None when it fails (an
+    cannot be evaluated.  ``smooth(payload)``, when given, tells whether an iterate's residual is
+    the smooth system's: one that is not (a grazing orbit's run that left the cam, whose gap is
+    the flight's) is stepped from with the same derivatives, and the next iterate's contraction
+    is not measured against it.  Returns (z, payload, iterations), or None when it fails (an
     evaluation fails, the residual grows, a Newton step shrinks it by less than
     NEWTON_CONTRACTION, or ``settings.max_corrector`` is reached)."""
     z, last, fresh = z_pred.copy(), math.inf, False
@@ -181,7 +184,7 @@ def chord(residual, derivatives, z_pred, direction, A, settings):
             return None
         if not math.isfinite(r) or (it >= 2 and r > last):
             return None
-        last = r
+        last = r if smooth is None or smooth(payload) else math.inf
         H = np.vstack([A, direction])
         rhs = np.concatenate([G, [direction @ (z - z_pred)]])
         try:

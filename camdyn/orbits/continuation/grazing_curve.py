@@ -185,7 +185,7 @@ def corrected(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
     direction = _along(1.0) if final else p.tangent
     return chord(lambda z: _residual(leg, z, mode),
                  lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
-                 z_pred, direction, p.derivatives.A, leg.settings)
+                 z_pred, direction, p.derivatives.A, leg.settings, in_contact)
 
 
 def _along(sign: float) -> np.ndarray:
@@ -193,6 +193,13 @@ def _along(sign: float) -> np.ndarray:
     t = np.zeros(G_SIZE)
     t[G_RANGE] = sign
     return t
+
+
+def in_contact(e: Evaluation) -> bool:
+    """Whether the run of an evaluation kept the follower on the cam (its largest gap is
+    negative): its residual is then the extended system's, smooth; past the grazing it is the
+    flight's gap, above the smooth one, and the chord step from it lands on the contact side."""
+    return e.max_gap < 0.0
 
 
 def _residual(leg: Leg, z, mode):
@@ -241,8 +248,8 @@ def first(leg: Leg, x, phase: float, free: float, mode: int) -> GrazingPoint | s
     except CamdynError as failure:
         return f"the start orbit cannot be evaluated: {failure}"
     found = chord(lambda z: _residual(leg, z, mode), lambda z, e: derivatives(system, layout, z, e, None, False).A, z0,
-                  along,
-                  A0, dataclasses.replace(leg.settings, max_corrector=max(20, leg.settings.max_corrector)))
+                  along, A0, dataclasses.replace(leg.settings, max_corrector=max(20, leg.settings.max_corrector)),
+                  in_contact)
     if found is None:
         return (f"the extended system's corrector did not converge from the near-grazing orbit at "
                 f"{system.free} = {free:.8g}")

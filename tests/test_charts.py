@@ -189,7 +189,7 @@ def test_a_multiplier_through_minus_one_at_grazing_is_located_in_arclength(monke
     def orbit(s: float):
         M = np.diag([-1.0 + 3.0 * (s - root), 0.5])
         return C.GrazingPoint(np.full(5, s), 1000.0 + s, 2000.0 + s, np.zeros(2), 0.5, M, np.eye(5)[4], None, None,
-                              1, 1000.0 + s, np.zeros(5))
+                              1, 1000.0 + s, np.zeros(5), np.nan)
     monkeypatch.setattr(C, "step", lambda leg, p, s, final=False: orbit(float(p.z[0]) + s))
     leg = C.Leg(None, None, settings)
     found = C.located(leg, orbit(0.0), orbit(0.03), 0.03, 7)
@@ -268,6 +268,7 @@ def test_a_step_whose_orbit_has_no_contact_side_difference_is_retried_shorter(mo
     leg = SimpleNamespace(system=SimpleNamespace(free="speed_rpm", parameter="k_s"),
                           layout=SimpleNamespace(split=lambda z: (None, 0.5, 1000.0, 2000.0)))
     p = SimpleNamespace(tangent=np.zeros(5), derivatives=SimpleNamespace(steps=np.ones(2)))
+    monkeypatch.setattr(grazing_curve, "predicted", lambda *a: None)
     monkeypatch.setattr(grazing_curve, "corrected", lambda *a: (np.zeros(5), SimpleNamespace(max_gap=-1.0), 2))
     monkeypatch.setattr(grazing_curve, "is_largest", lambda system, e: True)
     for failure, ends in ((Unresolved("no step keeps the path"), False), (MapFailure("no tangent dynamics"), True)):
@@ -295,6 +296,27 @@ def test_the_guessed_start_and_the_searched_one_find_the_same_grazing():
     firsts = [continue_grazing(RIG, SCENE, "k_s", 2000.0, 2001.0, search=search, guess=g)["speed_rpm"].values[0]
               for g in (guess, None, 1.02 * loss)]
     np.testing.assert_allclose(firsts, firsts[1], rtol=1e-6)
+
+
+def test_a_prediction_moves_to_the_contact_side_by_its_expected_error():
+    """The corrector starts from the prediction moved CONTACT_SIDE times its expected error
+    (the last step's, ``miss ds^2``) down the gap's row: the linearised residual changes in that
+    row alone, by that amount, and the move stays on the arclength hyperplane (the arclength
+    condition is the prediction's); the first point (miss NaN) is not moved."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.grazing import R_GAP
+    from camdyn.orbits.continuation.grazing_curve import CONTACT_SIDE, contact_side
+
+    rng = np.random.default_rng(7)
+    A, direction = rng.normal(size=(4, 5)), rng.normal(size=5)
+    p = SimpleNamespace(miss=3e-4, derivatives=SimpleNamespace(A=A))
+    move = contact_side(p, direction, 0.05)
+    expected = np.zeros(4)
+    expected[R_GAP] = -CONTACT_SIDE * 3e-4 * 0.05 ** 2
+    np.testing.assert_allclose(A @ move, expected, atol=1e-15)
+    assert abs(direction @ move) < 1e-15
+    assert not np.any(contact_side(SimpleNamespace(miss=np.nan, derivatives=p.derivatives), direction, 0.05))
 
 
 def test_the_chord_steps_on_from_an_iterate_off_the_smooth_side_without_new_derivatives():

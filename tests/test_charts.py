@@ -341,3 +341,24 @@ def test_the_chord_steps_on_from_an_iterate_off_the_smooth_side_without_new_deri
     assert not calls and smooth_side and iterations == 2 and np.allclose(z, [1.0, 0.2], atol=1e-12)
     chord(residual, derivatives, z_pred, direction, A, settings)
     assert calls
+
+
+def test_an_iterate_outside_the_last_modes_domain_starts_in_the_initial_rules_mode(monkeypatch):
+    """The corrector runs each iterate in the last point's start mode, unless its state is
+    outside that mode's domain at the section (across a surface the orbit passes close to
+    there): then in the mode the automaton's initial rule chooses (mode None), not a failure."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation import grazing_curve
+
+    modes = []
+
+    def evaluate(system, layout, z, mode):
+        modes.append(mode)
+        return SimpleNamespace(residual=np.zeros(4))
+    monkeypatch.setattr(grazing_curve, "evaluate", evaluate)
+    for admitted, expected in ((True, 3), (False, None)):
+        system = SimpleNamespace(section_map=lambda free, lam, mode, ok=admitted: SimpleNamespace(admits=lambda x: ok))
+        leg = SimpleNamespace(system=system, layout=SimpleNamespace(split=lambda z: (np.zeros(2), 0.5, 1.0, 2.0)))
+        grazing_curve._residual(leg, np.zeros(5), 3)
+        assert modes[-1] == expected

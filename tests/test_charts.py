@@ -362,3 +362,23 @@ def test_an_iterate_outside_the_last_modes_domain_starts_in_the_initial_rules_mo
         leg = SimpleNamespace(system=system, layout=SimpleNamespace(split=lambda z: (np.zeros(2), 0.5, 1.0, 2.0)))
         grazing_curve._residual(leg, np.zeros(5), 3)
         assert modes[-1] == expected
+
+
+def test_the_last_step_is_predicted_along_the_tangent_to_the_ranges_end():
+    """The final step's prediction reaches lambda2's end exactly, moved there along the tangent
+    from the second-order prediction (not lambda2 alone set: the other unknowns keep their place
+    on the curve to first order)."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.grazing import G_RANGE
+    from camdyn.orbits.continuation.grazing_curve import predicted
+
+    t = np.array([0.1, -0.2, 0.05, 0.9, 0.36])
+    t /= np.linalg.norm(t)
+    p = SimpleNamespace(z=np.array([1.0, 2.0, 0.5, 1.0, 0.2]), tangent=t, curvature=np.full(5, 0.3), miss=np.nan,
+                        derivatives=SimpleNamespace(A=np.zeros((4, 5))))
+    leg = SimpleNamespace(end=30.0, layout=SimpleNamespace(sigma_range=100.0))
+    got = predicted(leg, p, 0.25, final=True)
+    assert got.z[G_RANGE] == 0.3 and np.array_equal(got.direction, np.eye(5)[G_RANGE])
+    moved = got.z - (p.z + 0.25 * t + 0.5 * 0.25 ** 2 * p.curvature)
+    np.testing.assert_allclose(moved, moved[G_RANGE] / t[G_RANGE] * t, atol=1e-15)

@@ -355,13 +355,27 @@ def test_an_iterate_outside_the_last_modes_domain_starts_in_the_initial_rules_mo
 
     def evaluate(system, layout, z, mode):
         modes.append(mode)
-        return SimpleNamespace(residual=np.zeros(4))
+        return SimpleNamespace(residual=np.zeros(4), max_gap=-1.0)
     monkeypatch.setattr(grazing_curve, "evaluate", evaluate)
     for admitted, expected in ((True, 3), (False, None)):
         system = SimpleNamespace(section_map=lambda free, lam, mode, ok=admitted: SimpleNamespace(admits=lambda x: ok))
         leg = SimpleNamespace(system=system, layout=SimpleNamespace(split=lambda z: (np.zeros(2), 0.5, 1.0, 2.0)))
         grazing_curve._residual(leg, np.zeros(5), 3)
         assert modes[-1] == expected
+
+
+def test_a_run_that_left_the_cam_gives_the_corrector_its_largest_gap_alone():
+    """The residual of a lifted-off run: the gap's row from the run's largest gap (positive, so
+    the chord step from it is toward the contact side; the same row a contact run with that
+    psi_i(t_g) would have), zeros in the orbit's and the rate's rows."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.grazing import MARGIN, R_GAP, flight_residual
+
+    system = SimpleNamespace(deflection=4.7e-10, gap_tol=1e-6, tol=1e-8)
+    r = flight_residual(system, SimpleNamespace(max_gap=4.7e-14))
+    assert r[R_GAP] == pytest.approx((1e-4 + MARGIN * 1e-6) * 1e-8 / 1e-6, rel=1e-12)
+    assert np.count_nonzero(r) == 1
 
 
 def test_the_last_step_is_predicted_along_the_tangent_to_the_ranges_end():

@@ -373,6 +373,18 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
     return layout.split(z + dz)[2]
 
 
+def flight_residual(system: GrazingSystem, evaluation: Evaluation) -> np.ndarray:
+    """The residual the corrector is given for a run that left the cam (its largest gap
+    positive): the gap's row from the run's largest gap, the flight's, which lies above the
+    smooth system's psi_i(t_g) (a follower held to the cam stays closer to it), and zeros in the
+    other rows: the orbit's and the rate's, after the flight and its impact, say nothing of the
+    smooth system (a chord step from them sent the grazing's phase out of the period at each
+    try of the first step on reference-experiment against k_s, and the step was halved 4 times)."""
+    out = np.zeros(N_STATE + 2)
+    out[R_GAP] = (evaluation.max_gap / system.deflection + MARGIN * system.gap_tol) * _row_weights(system)[R_GAP]
+    return out
+
+
 def is_largest(system: GrazingSystem, evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
     parabola) stays below gap_tol d, else another maximum of the gap has overtaken the one at

@@ -33,7 +33,7 @@ from .corrector import chord, tangent
 from .events import Bracket, secant_bracket
 from .follow import AT_END, FLAT, GROWTH, clipped, left_range
 from .grazing import (G_RANGE, G_SIZE, R_GAP, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
-                      free_at_zero_gap, is_largest)
+                      flight_residual, free_at_zero_gap, is_largest)
 from .problem import ContinuationSettings
 
 #: a step's prediction is moved to the contact side by this many times its expected error in the
@@ -254,12 +254,14 @@ def _residual(leg: Leg, z, mode):
     outside that mode's domain at the section (a prediction across a surface the orbit passes
     close to there: on reference-experiment against k_s at phase_fraction 0.5, 0.02 T after
     the grazing, the gap's rate is -4e-10 m/s and an iterate's error reverses it, which ended
-    3 of the curve's steps)."""
+    3 of the curve's steps).  Where the run left the cam (:func:`in_contact`), the residual is
+    :func:`.grazing.flight_residual`'s: the chord step from it moves z to the contact side along
+    the gap's row alone."""
     x, _, free, lam = leg.layout.split(z)
     if mode is not None and not leg.system.section_map(free, lam, mode).admits(x):
         mode = None
     e = evaluate(leg.system, leg.layout, z, mode)
-    return e.residual, e
+    return (e.residual if in_contact(e) else flight_residual(leg.system, e)), e
 
 
 def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):

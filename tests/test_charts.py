@@ -396,3 +396,21 @@ def test_the_last_step_is_predicted_along_the_tangent_to_the_ranges_end():
     assert got.z[G_RANGE] == 0.3 and np.array_equal(got.direction, np.eye(5)[G_RANGE])
     moved = got.z - (p.z + 0.25 * t + 0.5 * 0.25 ** 2 * p.curvature)
     np.testing.assert_allclose(moved, moved[G_RANGE] / t[G_RANGE] * t, atol=1e-15)
+
+
+def test_the_step_grows_to_where_the_predictions_expected_error_is_easy():
+    """After an easy point the step grows by GROWTH, or up to MAX_GROWTH times where the
+    prediction's error per ds^2 puts the step of EASY_MISS tol further, never beyond max_step; a
+    point without the estimate (NaN, a codimension-1 curve's) grows by GROWTH."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.follow import GROWTH
+    from camdyn.orbits.continuation.grazing_curve import EASY_MISS, MAX_GROWTH, grown
+
+    settings = ContinuationSettings(step=0.01, max_step=0.05, tol=1e-8)
+    at = lambda h: SimpleNamespace(miss=EASY_MISS * settings.tol / h ** 2)      # noqa: E731  the miss for step h
+    assert grown(settings, SimpleNamespace(miss=np.nan), 0.01) == pytest.approx(GROWTH * 0.01)
+    assert grown(settings, at(0.025), 0.01) == pytest.approx(0.025)
+    assert grown(settings, at(1.0), 0.01) == pytest.approx(MAX_GROWTH * 0.01)
+    assert grown(settings, at(1.0), 0.02) == settings.max_step
+    assert grown(settings, at(0.001), 0.01) == pytest.approx(GROWTH * 0.01)

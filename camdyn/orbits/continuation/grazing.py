@@ -178,16 +178,27 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     t_g = t0 + phase * T
     times = t_g + WINDOW * T * np.array([-1.0, 0.0, 1.0])
     samples = np.linspace(t0, t1, gap_samples(sm.model) + 1) if dense else np.array([t1])
-    value, tr = sm.run(x, np.unique(np.concatenate([samples, times])))
+    t_eval, sampled = _merged(samples, times)
+    value, tr = sm.run(x, t_eval)
     k = np.searchsorted(tr.t, times)
     psi_all = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I]
     psi = psi_all[k]
     gap = _gap_rows(system, T, psi) + np.array([MARGIN * system.gap_tol, 0.0])   # psi_i(t_g) = -margin
     residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
-    largest = refined_max(psi_all[np.isin(tr.t, samples)]) if dense else math.nan
+    largest = refined_max(psi_all[sampled]) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
                       tr.mode[k].astype(int), psi, largest, sm)
+
+
+def _merged(samples: np.ndarray, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The increasing ``samples`` with the increasing ``times`` (within them) inserted where they
+    are not samples already, and which of the merged times are samples: the sorted union and its
+    membership test without sorting the ~5e4 samples of a stiff contact's period (np.unique and
+    np.isin took a fifth of a dense evaluation on reference-experiment)."""
+    at = np.searchsorted(samples, times)
+    new = samples[at] != times
+    return np.insert(samples, at[new], times[new]), np.insert(np.ones(samples.size, bool), at[new], False)
 
 
 class Derivatives(NamedTuple):

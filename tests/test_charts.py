@@ -433,3 +433,32 @@ def test_the_default_section_is_half_a_period_from_the_grazing(chart):
     _, curvature, spring = camdyn.analysis.statics.rigid_kinematics(rig, np.array([theta]))
     moment = rig.inertia * curvature[0] * (loss * RPM) ** 2 + spring[0]
     assert abs(moment) < 1e-3 * abs(spring[0])        # the rigid contact's moment vanishes there, at the loss speed
+
+
+def test_a_parameter_differences_side_that_surely_lifts_off_is_not_run():
+    """A side whose linearised gap lies SURE_LIFT margins past zero gap is not run: the
+    difference is the one-sided one the run would have given (that run leaving the path), from
+    one run instead of two; a side the linearisation keeps in contact is run."""
+    from types import SimpleNamespace
+
+    from camdyn.orbits.continuation.grazing import MARGIN, SURE_LIFT, R_GAP, _lifts, contact_side_difference
+    from camdyn.orbits.derivatives import Column
+    from camdyn.orbits.section_map import MapValue
+
+    base = MapValue(np.array([0.0, 0.0, 0.5, 0.0]), 0, 0, 100, (3,))
+    offsets = []
+
+    def evaluate_at(offset):           # +offset lifts off (another path), -offset keeps it: slope 2
+        offsets.append(offset)
+        return MapValue(base.state + 2.0 * offset, 0, 0, 100, (3,) if offset < 0 else (3, 4, 5))
+    column = Column.of(1.0, np.ones(4), 1e-10, first=1e-3)
+    plain = contact_side_difference(evaluate_at, base, column)
+    assert offsets == [1e-3, -1e-3]
+    system = SimpleNamespace(tol=1e-8)
+    lifts = _lifts(system, SimpleNamespace(residual=np.array([0.0, 0.0, 0.0, 0.0])), 1.0)
+    assert lifts(1e-3) and not lifts(-1e-3) and not lifts((SURE_LIFT + 0.5) * MARGIN * 1e-8)
+    offsets.clear()
+    skipped = contact_side_difference(evaluate_at, base, column, lifts=lifts)
+    assert offsets == [-1e-3]
+    np.testing.assert_array_equal(skipped[0], plain[0])
+    assert skipped[1:] == plain[1:] and skipped[0][R_GAP] == pytest.approx(2.0)

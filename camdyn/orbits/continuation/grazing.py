@@ -79,6 +79,11 @@ OUTPUT_STEP = 1e-6
 #: vanishes at the maximum of a parabola exactly; a cubic term moves its root by ~(2 pi WINDOW)^2
 #: / 6 of the period's radian, and psi_i(t_g) from the maximum by the square of that: ~1e-7 d
 WINDOW = 1e-2
+#: a parameter difference's run whose linearised gap lies past zero gap by more than this many
+#: margins is not run (:func:`_lifts`): on reference-experiment against k_s (jump_chart's section)
+#: the side of each difference that left the path lay, linearised, 250 margins or more past zero
+#: gap, the side that kept it 250 or more inside
+SURE_LIFT = 10.0
 #: the rate row's tolerance, RATE_TOL sqrt(gap_tol) of its scale: a rate error e moves t_g by
 #: e / psi_i'' and psi_i(t_g) from the maximum by only ~e^2 / (2 psi_i''), second order
 RATE_TOL = 0.1
@@ -212,14 +217,11 @@ class Derivatives(NamedTuple):
 
 
 def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Evaluation,
-                previous: np.ndarray | None = None, strict: bool = True) -> Derivatives:
+                previous: Derivatives | None = None, strict: bool = True) -> Derivatives:
     """The derivatives of the residual at z (see the module docstring; raises MapFailure where
-    the tangent dynamics or a difference cannot be evaluated).  ``previous``: the lambda steps
-    of the last point's derivatives; each difference then starts SHRINK times above its step
-    (not at the rule's first step, which a grazing orbit lifts off at on both sides: 2-4 runs
-    per column instead of ~6; starting at the step itself, the steps only shrink along the
-    curve, and on reference-experiment against k_s the curve took 48 orbits instead of 38);
-    ``strict``: False at a corrector's iterate (:func:`contact_side_difference`).  The tangent
+    the tangent dynamics or a difference cannot be evaluated).  ``previous``: the last point's
+    derivatives, which start each difference (:func:`_parameter_column`); ``strict``: False at a
+    corrector's iterate (:func:`contact_side_difference`).  The tangent
     dynamics and the two differences are independent runs: they run on ``system.threads``
     threads at once (the same numbers as in turn: each run is the same computation).  A failure
     raises from the first of them that failed, in that order: the tangent dynamics, then each
@@ -227,11 +229,8 @@ def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Eval
     A = np.zeros((N_STATE + 2, G_SIZE))
     columns = ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range))
 
-    def parameter_column(column: int, index: int):
-        first = None if previous is None else SHRINK * float(previous[column])
-        return _parameter_column(system, layout, z, base, index, first, strict)
     tasks = [partial(_fundamental, base, layout.split(z)[0])] + [
-        partial(parameter_column, column, index) for column, index, _ in columns]
+        partial(_parameter_column, system, layout, z, base, index, previous, strict) for _, index, _ in columns]
     if system.threads > 1:
         with ThreadPoolExecutor(system.threads) as pool:      # the compiled loop releases the GIL
             futures = [pool.submit(task) for task in tasks]
@@ -304,23 +303,41 @@ def _phase_column(system: GrazingSystem, base: Evaluation) -> np.ndarray:
 
 
 def _parameter_column(system: GrazingSystem, layout: Layout, z, base: Evaluation, index: int,
-                      first: float | None, strict: bool):
-    """d(residual)/d(lambda) in the parameter's unit (:func:`contact_side_difference`), the step
-    from ``first``, or the rule's ``rtol^(1/3) max(|lambda|, sigma)``, down to its floor."""
+                      previous: Derivatives | None, strict: bool):
+    """d(residual)/d(lambda) in the parameter's unit (:func:`contact_side_difference`), from the
+    rule's step ``rtol^(1/3) max(|lambda|, sigma)`` down to its floor, or, after a point
+    (``previous``), from SHRINK times its step (not at the rule's first step, which a grazing
+    orbit lifts off at on both sides: 2-4 runs per column instead of ~6; starting at the step
+    itself, the steps only shrink along the curve, and on reference-experiment against k_s the
+    curve took 48 orbits instead of 38), not running a side that surely lifts off
+    (:func:`_lifts`, for ``strict`` differences)."""
     sigma = layout.sigma_free if index == G_FREE else layout.sigma_range
     lam = float(z[index] * sigma)
+    column_of = index - G_FREE                                   # the lambda's place in Derivatives.steps
 
     def value(offset: float) -> MapValue:
         shifted = z.copy()
         shifted[index] = (lam + offset) / sigma
         return evaluate(system, layout, shifted, base.value.start_mode, dense=False).value
     column = Column.of(max(abs(lam), sigma), np.ones(N_STATE + 2), system.options.rtol)
-    if first is not None and column.floor <= first < column.first:
+    if previous is None:
+        return contact_side_difference(value, base.value, column, strict)
+    first = SHRINK * float(previous.steps[column_of])
+    if column.floor <= first < column.first:
         column = column._replace(first=first)
-    return contact_side_difference(value, base.value, column, strict)
+    lifts = _lifts(system, base, previous.A[R_GAP, index] / sigma) if strict else None
+    return contact_side_difference(value, base.value, column, strict, lifts)
 
 
-def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict: bool = True):
+def _lifts(system: GrazingSystem, base: Evaluation, slope: float):
+    """Whether the run at a parameter offset surely leaves the cam, told without the run: the
+    gap's row there, linearised with ``slope`` (its derivative in the parameter at the last
+    point), lies past zero gap by more than SURE_LIFT times the margin."""
+    edge = MARGIN * system.tol                  # the gap's row at zero gap (psi_i(t_g) = 0)
+    return lambda offset: float(base.residual[R_GAP]) + slope * offset - edge > SURE_LIFT * edge
+
+
+def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict: bool = True, lifts=None):
     """The derivative of ``evaluate_at`` (the value at a signed offset) at 0, under the rule of
     :mod:`camdyn.orbits.derivatives` as far as a grazing orbit allows: from ``column.first``,
     the central difference where the runs at +-h both take ``base``'s path; where one of them
@@ -329,12 +346,18 @@ def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict:
     ``column.floor``.  Without ``strict`` (a corrector's iterate, which may lie past the
     grazing, lifted off), where neither run keeps the base path the one with fewer switches
     (the contact side) gives the one-sided difference: a direction for the corrector, no
-    derivative.  Returns (derivative, h, note: '' or why one-sided); raises
+    derivative.  ``lifts(offset)``, when given (``strict`` differences), tells without a run that
+    the run at that offset leaves the cam: it is not run, and that side does not keep the path
+    (the difference is the one its run would have given, whenever it would have lifted off).
+    Returns (derivative, h, note: '' or why one-sided); raises
     :class:`~camdyn.orbits.derivatives.Unresolved` when no step works."""
     h = column.first
     while h >= column.floor:
         values = []
         for sign in (1.0, -1.0):
+            if lifts is not None and lifts(sign * h):
+                values.append(None)
+                continue
             try:
                 values.append(evaluate_at(sign * h))
             except MapFailure as failure:

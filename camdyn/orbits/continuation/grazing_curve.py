@@ -174,7 +174,7 @@ class Leg(NamedTuple):
 
 def _point(leg: Leg, z, e: Evaluation, direction, iterations: int, previous=None) -> GrazingPoint:
     """The grazing orbit at z as a point: its derivatives (raises MapFailure; ``previous``: the
-    last point's lambda steps) and tangent."""
+    last point's) and tangent."""
     d = derivatives(leg.system, leg.layout, z, e, previous)
     x, phase, free, lam = leg.layout.split(z)
     return GrazingPoint(z, free, lam, x, phase, d.M, tangent(d.A, direction), d, e, iterations,
@@ -234,9 +234,8 @@ def corrected(leg: Leg, p: GrazingPoint, prediction: Prediction):
     condition through it is the prediction's), without its derivatives: (z, evaluation,
     iterations), or None when the corrector fails."""
     mode = p.evaluation.value.start_mode
-    steps = p.derivatives.steps
     return chord(lambda z: _residual(leg, z, mode),
-                 lambda z, e: derivatives(leg.system, leg.layout, z, e, steps, False).A,
+                 lambda z, e: derivatives(leg.system, leg.layout, z, e, p.derivatives, False).A,
                  prediction.start, prediction.direction, p.derivatives.A, leg.settings, in_contact)
 
 
@@ -285,7 +284,7 @@ def step(leg: Leg, p: GrazingPoint, ds: float, final: bool = False):
         return Ended(GrazingOutcome.MAXIMUM_MOVED, f"at {_where(leg, z)}: a gap of {e.max_gap:.3g} m over the orbit "
                                                    f"against {e.psi_g:.3g} m at the grazing's t_g")
     try:
-        q = _point(leg, z, e, p.tangent, iterations, p.derivatives.steps)
+        q = _point(leg, z, e, p.tangent, iterations, p.derivatives)
     except Unresolved:
         return None
     except CamdynError as failure:

@@ -373,7 +373,8 @@ def test_a_run_that_left_the_cam_gives_the_corrector_its_largest_gap_alone():
     from camdyn.orbits.continuation.grazing import MARGIN, R_GAP, flight_residual
 
     system = SimpleNamespace(deflection=4.7e-10, gap_tol=1e-6, tol=1e-8)
-    r = flight_residual(system, SimpleNamespace(max_gap=4.7e-14))
+    period = SimpleNamespace(model=SimpleNamespace(period=0.46))
+    r = flight_residual(system, SimpleNamespace(max_gap=4.7e-14, section_map=period))
     assert r[R_GAP] == pytest.approx((1e-4 + MARGIN * 1e-6) * 1e-8 / 1e-6, rel=1e-12)
     assert np.count_nonzero(r) == 1
 
@@ -454,7 +455,7 @@ def test_a_parameter_differences_side_that_surely_lifts_off_is_not_run():
     column = Column.of(1.0, np.ones(4), 1e-10, first=1e-3)
     plain = contact_side_difference(evaluate_at, base, column)
     assert offsets == [1e-3, -1e-3]
-    system = SimpleNamespace(tol=1e-8)
+    system = SimpleNamespace(tol=1e-8, gap_tol=1e-6, deflection=4.7e-10)      # the margin: 2e-8 in the gap's row
     lifts = _lifts(system, SimpleNamespace(residual=np.array([0.0, 0.0, 0.0, 0.0])), 1.0)
     assert lifts(1e-3) and not lifts(-1e-3) and not lifts((SURE_LIFT + 0.5) * MARGIN * 1e-8)
     offsets.clear()

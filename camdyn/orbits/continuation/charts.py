@@ -221,7 +221,7 @@ def section_away_from_loss(rig: Rig, loss_rpm: float) -> float:
     the grazing a stiff contact's state lies within a prediction's error of the loading /
     unloading surface (reference-experiment at phase_fraction 0.5, 0.02 T after it: a gap rate of
     -4e-10 m/s), so that iterates and parameter differences left the start mode's domain or
-    switched there: 30 % more parameter-difference runs and 20 % more corrector runs than here."""
+    switched there: 40 % more parameter-difference runs and 20 % more corrector runs than here."""
     from ...analysis.statics import contact_loss_angle
 
     theta = contact_loss_angle(rig, samples=SHIFT_SAMPLES, loss_rpm=loss_rpm)

@@ -167,6 +167,18 @@ def _gap_rows(system: GrazingSystem, T: float, psi: np.ndarray) -> np.ndarray:
     return np.array([psi[1] / d, (psi[2] - psi[0]) / (2 * delta) * T / (2 * math.pi * d)])
 
 
+def _gap_residual(system: GrazingSystem, T: float, psi: np.ndarray) -> np.ndarray:
+    """The residual's gap rows, weighted, from psi_i at the window's times (m): psi_i(t_g) / d +
+    MARGIN gap_tol (zero at psi_i(t_g) = -margin) and the gap's rate (:func:`_gap_rows`)."""
+    return (_gap_rows(system, T, psi) + np.array([MARGIN * system.gap_tol, 0.0])) * _row_weights(system)[N_STATE:]
+
+
+def _zero_gap(system: GrazingSystem) -> float:
+    """The gap's row (weighted) of an orbit at zero gap, psi_i(t_g) = 0: the margin in the
+    residual's units."""
+    return float(_gap_residual(system, 1.0, np.zeros(3))[0])
+
+
 def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | None,
              dense: bool = True) -> Evaluation:
     """The scaled residual at z by one run of P from x (raises MapFailure, or the rig's error for
@@ -188,8 +200,8 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     k = np.searchsorted(tr.t, times)
     psi_all = sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend)[sm.model.kernels.OUT_PSI_I]
     psi = psi_all[k]
-    gap = _gap_rows(system, T, psi) + np.array([MARGIN * system.gap_tol, 0.0])   # psi_i(t_g) = -margin
-    residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
+    residual = np.concatenate([(value.state - x) / layout.scale * _row_weights(system)[:N_STATE],
+                               _gap_residual(system, T, psi)])
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
     largest = refined_max(psi_all[sampled]) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
@@ -221,11 +233,10 @@ def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Eval
     """The derivatives of the residual at z (see the module docstring; raises MapFailure where
     the tangent dynamics or a difference cannot be evaluated).  ``previous``: the last point's
     derivatives, which start each difference (:func:`_parameter_column`); ``strict``: False at a
-    corrector's iterate (:func:`contact_side_difference`).  The tangent
-    dynamics and the two differences are independent runs: they run on ``system.threads``
-    threads at once (the same numbers as in turn: each run is the same computation).  A failure
-    raises from the first of them that failed, in that order: the tangent dynamics, then each
-    column."""
+    corrector's iterate (:func:`contact_side_difference`).  The tangent dynamics and the two
+    differences are independent runs: they run on ``system.threads`` threads at once (the same
+    numbers as in turn: each run is the same computation).  A failure raises from the first of
+    them that failed, in that order: the tangent dynamics, then each column."""
     A = np.zeros((N_STATE + 2, G_SIZE))
     columns = ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range))
 
@@ -333,7 +344,7 @@ def _lifts(system: GrazingSystem, base: Evaluation, slope: float):
     """Whether the run at a parameter offset surely leaves the cam, told without the run: the
     gap's row there, linearised with ``slope`` (its derivative in the parameter at the last
     point), lies past zero gap by more than SURE_LIFT times the margin."""
-    edge = MARGIN * system.tol                  # the gap's row at zero gap (psi_i(t_g) = 0)
+    edge = _zero_gap(system)
     return lambda offset: float(base.residual[R_GAP]) + slope * offset - edge > SURE_LIFT * edge
 
 
@@ -400,7 +411,7 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
     the same lambda2: one Newton step of the system without the margin, ``[A; e_lambda2] dz =
     -(residual without the margin)`` (the error is second order in the margin, (MARGIN gap_tol)^2 d)."""
     margin = np.zeros(N_STATE + 2)
-    margin[R_GAP] = MARGIN * system.gap_tol * _row_weights(system)[R_GAP]
+    margin[R_GAP] = _zero_gap(system)
     along = np.zeros(G_SIZE)
     along[G_RANGE] = 1.0
     dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))
@@ -415,7 +426,7 @@ def flight_residual(system: GrazingSystem, evaluation: Evaluation) -> np.ndarray
     smooth system (a chord step from them sent the grazing's phase out of the period at each
     try of the first step on reference-experiment against k_s, and the step was halved 4 times)."""
     out = np.zeros(N_STATE + 2)
-    out[R_GAP] = (evaluation.max_gap / system.deflection + MARGIN * system.gap_tol) * _row_weights(system)[R_GAP]
+    out[N_STATE:] = _gap_residual(system, evaluation.section_map.model.period, np.full(3, evaluation.max_gap))
     return out
 
 

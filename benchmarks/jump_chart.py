@@ -42,8 +42,9 @@ from camdyn.orbits.continuation import ContinuationSettings, GrazingSettings, ju
 
 SCENE = camdyn.Scene(contact="line", damping="D", friction="coulomb")
 #: the scaled arclength of the curve over the decade (measured on a run: lambda2's range is 1,
-#: the speed's change 2.2 times its start value), divided among the points (the corrector halves
-#: the steps it fails at: 36 orbits for 30 points)
+#: the speed's change 2.2 times its start value), divided among the points (the first step,
+#: predicted along the tangent alone, is halved until it converges and the step then regrown:
+#: 32 orbits for 30 points)
 ARCLENGTH = 2.5
 
 

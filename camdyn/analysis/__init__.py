@@ -11,6 +11,7 @@ _EXPORTS = {
     'ResidualStats': '.statics',
     'alpha_spectrum': '.statics',
     'compliance_shift': '.statics',
+    'contact_loss_angle': '.statics',
     'contact_loss_speed': '.statics',
     'energy_balance_peak': '.statics',
     'natural_frequency': '.statics',

@@ -168,6 +168,27 @@ def contact_loss_speed(rig: Rig, *, friction_coefficient: float = 0.0, samples: 
     return math.sqrt(omega2) / RPM
 
 
+def _contact_moment(rig: Rig, omega: float, samples: int):
+    """The moment rigid contact needs, M_c(Theta) = I_Pb alpha_i''(Theta) Omega^2 + F_s d_x
+    (:func:`contact_loss_speed`), at ``samples`` cam angles over a revolution at Omega (rad/s):
+    (Theta, M_c, alpha_i'')."""
+    theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
+    _, curvature, spring = rigid_kinematics(rig, theta)
+    return theta, rig.inertia * curvature * omega ** 2 + spring, curvature
+
+
+def contact_loss_angle(rig: Rig, *, samples: int = 3600, loss_rpm: float | None = None) -> float:
+    """The cam angle Theta* (rad, from theta0 over a revolution) at which rigid contact is lost
+    first: where the moment M_c is least at the contact-loss speed (:func:`contact_loss_speed`;
+    ``loss_rpm`` where the caller has it), to one of ``samples`` angles.  NaN when the follower
+    never leaves the cam."""
+    loss = contact_loss_speed(rig) if loss_rpm is None else float(loss_rpm)
+    if not math.isfinite(loss) or loss == 0:
+        return math.nan
+    theta, M, _ = _contact_moment(rig, loss * RPM, samples)
+    return float(theta[int(np.argmin(M))])
+
+
 def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 20000,
                      loss_rpm: float | None = None) -> float:
     """The relative shift of the contact-loss speed by the contact's compliance, to first order:
@@ -190,10 +211,7 @@ def compliance_shift(rig: Rig, scene: Scene | None = None, *, samples: int = 200
     if not math.isfinite(loss) or loss == 0:
         return 0.0
     scene = scene or _static_scene("line", rig)
-    omega = loss * RPM
-    theta = rig.theta0 + np.linspace(0.0, 2 * math.pi, samples, endpoint=False)
-    _, curvature, spring = rigid_kinematics(rig, theta)
-    M = rig.inertia * curvature * omega ** 2 + spring
+    theta, M, curvature = _contact_moment(rig, loss * RPM, samples)
     k, h = int(np.argmin(M)), theta[1] - theta[0]
     M2 = (M[k - 1] - 2 * M[k] + M[(k + 1) % samples]) / h ** 2
     vartheta = Model(rig, scene, ConstantSpeed(0.0)).equilibrium.vartheta

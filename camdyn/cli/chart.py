@@ -60,8 +60,9 @@ def add_chart(sub) -> None:
     g.add_argument("--search", type=float, nargs=2, metavar=("LOW", "HIGH"),
                    help="the speeds (rev/min) the first grazing is searched between (default: 0.9 and 1.05 times "
                         "the contact-loss speed at --start)")
-    g.add_argument("--phase-fraction", type=float, default=0.5, dest="phase_fraction", metavar="F",
-                   help="the section's time in the cam period, away from the gap's maximum (default: 0.5)")
+    g.add_argument("--phase-fraction", type=float, default=None, dest="phase_fraction", metavar="F",
+                   help="the section's time in the cam period, away from the gap's maximum (default: half a period "
+                        "from where the inverse kinematics lose contact)")
     g.add_argument("--warmup", type=int, default=20, metavar="N",
                    help="revolutions from the static equilibrium before the first orbit's search (default: 20)")
     g.add_argument("--gap-tol", type=float, default=1e-6, dest="gap_tol", metavar="TOL",

@@ -108,7 +108,8 @@ class Evaluation(NamedTuple):
 
 class Codim1Point(NamedTuple):
     """One orbit of the curve: z, lambda1, lambda2, x, M, the unit tangent, the scaled Jacobian
-    A, its evaluation, the corrector's iterations, the tangent's change per arclength."""
+    A, its evaluation, the corrector's iterations, the tangent's change per arclength, and the
+    prediction's error (not estimated here: NaN; :func:`.grazing_curve.grown`)."""
 
     z: np.ndarray
     free: float
@@ -120,6 +121,7 @@ class Codim1Point(NamedTuple):
     evaluation: Evaluation
     iterations: int
     curvature: np.ndarray
+    miss: float = math.nan
 
 
 def _det(system: Codim1System, M) -> float:

@@ -155,16 +155,19 @@ def correct(leg: Leg, z_pred, direction, A, mode) -> Corrected | None:
     return None if found is None else Corrected(*found)
 
 
-def chord(residual, derivatives, z_pred, direction, A, settings):
+def chord(residual, derivatives, z_pred, direction, A, settings, smooth=None):
     """The pseudo-arclength corrector of any extended system: the chord method on
     ``residual(z) = 0, direction . (z - z_pred) = 0`` from the derivatives ``A`` of the last
     point, stopping at ``max |residual| <= settings.tol``.  It keeps ``A`` while each
     iteration shrinks the residual by CHORD_CONTRACTION or more and evaluates it anew at z when
     it does not (a Newton step); ``residual(z)`` gives (the scaled residual, a payload: the
     run), ``derivatives(z, payload)`` the scaled Jacobian; both raise CamdynError where they
-    cannot be evaluated.  Returns (z, payload, iterations), or None when it fails (an
-    evaluation fails, the residual grows, a Newton step shrinks it by less than
-    NEWTON_CONTRACTION, or ``settings.max_corrector`` is reached)."""
+    cannot be evaluated.  ``smooth(payload)``, when given, tells whether an iterate's residual is
+    the smooth system's: one that is not (a grazing orbit's run that left the cam, whose gap is
+    the flight's) is stepped from with the same derivatives, never new ones, and the next
+    iterate's contraction is not measured against it.  Returns (z, payload, iterations), or None
+    when it fails (an evaluation fails, the residual grows, a Newton step shrinks it by less than
+    NEWTON_CONTRACTION, or ``settings.max_corrector`` is reached), before any new derivatives."""
     z, last, fresh = z_pred.copy(), math.inf, False
     for it in range(settings.max_corrector + 1):
         try:                           # MapFailure, or a rig value the rig refuses
@@ -172,16 +175,15 @@ def chord(residual, derivatives, z_pred, direction, A, settings):
             r = float(np.max(np.abs(G)))
             if r <= settings.tol:
                 return z, payload, it
-            if fresh and not r <= NEWTON_CONTRACTION * last:
+            if (fresh and not r <= NEWTON_CONTRACTION * last) or not math.isfinite(r) or (it >= 2 and r > last):
                 return None
-            fresh = math.isfinite(r) and r > CHORD_CONTRACTION * last
+            on_side = smooth is None or smooth(payload)
+            fresh = on_side and r > CHORD_CONTRACTION * last
             if fresh:
                 A = derivatives(z, payload)
         except CamdynError:
             return None
-        if not math.isfinite(r) or (it >= 2 and r > last):
-            return None
-        last = r
+        last = r if on_side else math.inf
         H = np.vstack([A, direction])
         rhs = np.concatenate([G, [direction @ (z - z_pred)]])
         try:

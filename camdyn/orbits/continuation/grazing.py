@@ -17,9 +17,9 @@ junction (:mod:`.boundary`; the names below keep the gap's).  This is the defini
 continued in two parameters, the boundary's test functions appended to the orbit's equations
 (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10), here
 the grazing conditions of a periodic orbit of a hybrid system (Thota & Dankowicz, TC-HAT, SIAM
-J. Appl. Dyn. Syst. 7 (2008) 1283).  ``margin`` is ``gap_tol`` times the gap's scale d, the
-largest deflection over the first orbit: the orbit is converged on the contact side, so its run
-never lifts off and its derivatives are the contact flow's.
+J. Appl. Dyn. Syst. 7 (2008) 1283).  ``margin`` is the boundary's ``margins`` ``gap_tol`` times the gap's
+scale d, the largest deflection over the first orbit: the orbit is converged on the contact side,
+so its run never lifts off and its derivatives are the contact flow's.
 
 **Scaling.**  z = (x / s, phi_g, lambda1 / sigma1, lambda2 / sigma2): s the motion's size (as
 in :mod:`camdyn.orbits.shooting`), phi_g the fraction of the period, sigma2 the range of
@@ -69,9 +69,16 @@ G_PHASE = N_STATE
 G_FREE = N_STATE + 1
 G_RANGE = N_STATE + 2
 G_SIZE = N_STATE + 3
+#: the residual's rows: the orbit's (N_STATE), the gap's psi_i(t_g) + margin, and its rate
+R_GAP = N_STATE
 #: the central difference of the generated psi_i in alpha (rad) and alpha_dot (rad/s): an
 #: analytic function, no run; its rounding error over this step is ~1e-10 of the derivative
 OUTPUT_STEP = 1e-6
+#: a parameter difference's run whose linearised gap lies past zero gap by more than this many
+#: margins is not run (:func:`_lifts`): on reference-experiment against k_s (jump_chart's section)
+#: the side of each difference that left the path lay, linearised, 250 margins or more past zero
+#: gap, the side that kept it 250 or more inside
+SURE_LIFT = 10.0
 #: the rate row's tolerance, RATE_TOL sqrt(gap_tol) of its scale: a rate error e moves t_g by
 #: e / psi_i'' and psi_i(t_g) from the maximum by only ~e^2 / (2 psi_i''), second order
 RATE_TOL = 0.1
@@ -169,6 +176,23 @@ def _pin(system: GrazingSystem, phase: float) -> np.ndarray:
     return np.array([0.0, phase - system.corner if system.pinned else 0.0])
 
 
+def _gap_residual(system: GrazingSystem, T: float, psi: np.ndarray, phase: float | None = None) -> np.ndarray:
+    """The residual's gap rows, weighted, from psi_i at the window's times (m): psi_i(t_g) / d +
+    margins gap_tol (zero at psi_i(t_g) = -margin; the boundary's ``margins``) and the gap's rate
+    (:func:`_gap_rows`), or at a corner the phase's distance from it (:func:`_pin`; none without
+    ``phase``)."""
+    pin = np.zeros(2) if phase is None else _pin(system, phase)
+    with np.errstate(invalid="ignore"):                                          # (inf - inf in flight)
+        rows = _gap_rows(system, T, psi) + np.array([system.boundary.margins * system.gap_tol, 0.0]) + pin
+    return rows * _row_weights(system)[N_STATE:]
+
+
+def _zero_gap(system: GrazingSystem) -> float:
+    """The gap's row (weighted) of an orbit at zero gap, psi_i(t_g) = 0: the margin in the
+    residual's units."""
+    return float(_gap_residual(system, 1.0, np.zeros(3))[0])
+
+
 def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | None,
              dense: bool = True) -> Evaluation:
     """The scaled residual at z by one run of P from x (raises MapFailure, or the rig's error for
@@ -186,24 +210,32 @@ def evaluate(system: GrazingSystem, layout: Layout, z: np.ndarray, mode: int | N
     t_g = t0 + phase * T
     times = t_g + window * T * np.array([-1.0, 0.0, 1.0])
     samples = np.linspace(t0, t1, gap_samples(sm.model) + 1) if dense else np.array([t1])
-    value, tr = sm.run(x, np.unique(np.concatenate([samples, times])))
+    t_eval, sampled = _merged(samples, times)
+    value, tr = sm.run(x, t_eval)
     k = np.searchsorted(tr.t, times)
     boundary = system.boundary
     psi_all = boundary.values(sm.model, sm.model.outputs_at(tr.mode, tr.t, tr.alpha, tr.alpha_dot, sm.backend),
                               tr.mode)
     psi = psi_all[k]                  # inf where a rigid follower is in flight (.boundary._far): so is the residual
-    margin = system.gap_tol * boundary.margins                                   # psi_i(t_g) = -margin
-    with np.errstate(invalid="ignore"):                                          # (inf - inf in flight)
-        gap = _gap_rows(system, T, psi) + np.array([margin, 0.0]) + _pin(system, phase)
-    residual = np.concatenate([(value.state - x) / layout.scale, gap]) * _row_weights(system)
+    residual = np.concatenate([(value.state - x) / layout.scale * _row_weights(system)[:N_STATE],
+                               _gap_residual(system, T, psi, phase)])
     path = MapValue(residual, value.start_mode, value.end_mode, value.steps, value.transitions)
-    sampled = np.isin(tr.t, samples)
     # a pinned corner is a restart even where the run stepped over its junction without a record
     restarts = np.append(tr.switches.records["t"], t_g if system.pinned else [])
     largest = boundary.largest(sm.model, psi_all[sampled], tr.mode[sampled], tr.t[sampled],
                                restarts) if dense else math.nan
     return Evaluation(residual, path, value.state, t_g, times, np.vstack([tr.alpha[k], tr.alpha_dot[k]]),
                       tr.mode[k].astype(int), psi, largest, sm)
+
+
+def _merged(samples: np.ndarray, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The increasing ``samples`` with the increasing ``times`` (within them) inserted where they
+    are not samples already, and which of the merged times are samples: the sorted union and its
+    membership test without sorting the ~5e4 samples of a stiff contact's period (np.unique and
+    np.isin took a fifth of a dense evaluation on reference-experiment)."""
+    at = np.searchsorted(samples, times)
+    new = samples[at] != times
+    return np.insert(samples, at[new], times[new]), np.insert(np.ones(samples.size, bool), at[new], False)
 
 
 class Derivatives(NamedTuple):
@@ -217,26 +249,19 @@ class Derivatives(NamedTuple):
 
 
 def derivatives(system: GrazingSystem, layout: Layout, z: np.ndarray, base: Evaluation,
-                previous: np.ndarray | None = None, strict: bool = True) -> Derivatives:
+                previous: Derivatives | None = None, strict: bool = True) -> Derivatives:
     """The derivatives of the residual at z (see the module docstring; raises MapFailure where
-    the tangent dynamics or a difference cannot be evaluated).  ``previous``: the lambda steps
-    of the last point's derivatives; each difference then starts SHRINK times above its step
-    (not at the rule's first step, which a grazing orbit lifts off at on both sides: 2-4 runs
-    per column instead of ~6; starting at the step itself, the steps only shrink along the
-    curve, and on reference-experiment against k_s the curve took 48 orbits instead of 38);
-    ``strict``: False at a corrector's iterate (:func:`contact_side_difference`).  The tangent
-    dynamics and the two differences are independent runs: they run on ``system.threads``
-    threads at once (the same numbers as in turn: each run is the same computation).  A failure
-    raises from the first of them that failed, in that order: the tangent dynamics, then each
-    column."""
+    the tangent dynamics or a difference cannot be evaluated).  ``previous``: the last point's
+    derivatives, which start each difference (:func:`_parameter_column`); ``strict``: False at a
+    corrector's iterate (:func:`contact_side_difference`).  The tangent dynamics and the two
+    differences are independent runs: they run on ``system.threads`` threads at once (the same
+    numbers as in turn: each run is the same computation).  A failure raises from the first of
+    them that failed, in that order: the tangent dynamics, then each column."""
     A = np.zeros((N_STATE + 2, G_SIZE))
     columns = ((0, G_FREE, layout.sigma_free), (1, G_RANGE, layout.sigma_range))
 
-    def parameter_column(column: int, index: int):
-        first = None if previous is None else SHRINK * float(previous[column])
-        return _parameter_column(system, layout, z, base, index, first, strict)
     tasks = [partial(_fundamental, base, layout.split(z)[0])] + [
-        partial(parameter_column, column, index) for column, index, _ in columns]
+        partial(_parameter_column, system, layout, z, base, index, previous, strict) for _, index, _ in columns]
     if system.threads > 1:
         with ThreadPoolExecutor(system.threads) as pool:      # the compiled loop releases the GIL
             futures = [pool.submit(task) for task in tasks]
@@ -313,23 +338,41 @@ def _phase_column(system: GrazingSystem, base: Evaluation) -> np.ndarray:
 
 
 def _parameter_column(system: GrazingSystem, layout: Layout, z, base: Evaluation, index: int,
-                      first: float | None, strict: bool):
-    """d(residual)/d(lambda) in the parameter's unit (:func:`contact_side_difference`), the step
-    from ``first``, or the rule's ``rtol^(1/3) max(|lambda|, sigma)``, down to its floor."""
+                      previous: Derivatives | None, strict: bool):
+    """d(residual)/d(lambda) in the parameter's unit (:func:`contact_side_difference`), from the
+    rule's step ``rtol^(1/3) max(|lambda|, sigma)`` down to its floor, or, after a point
+    (``previous``), from SHRINK times its step (not at the rule's first step, which a grazing
+    orbit lifts off at on both sides: 2-4 runs per column instead of ~6; starting at the step
+    itself, the steps only shrink along the curve, and on reference-experiment against k_s the
+    curve took 48 orbits instead of 38), not running a side that surely lifts off
+    (:func:`_lifts`, for ``strict`` differences)."""
     sigma = layout.sigma_free if index == G_FREE else layout.sigma_range
     lam = float(z[index] * sigma)
+    column_of = index - G_FREE                                   # the lambda's place in Derivatives.steps
 
     def value(offset: float) -> MapValue:
         shifted = z.copy()
         shifted[index] = (lam + offset) / sigma
         return evaluate(system, layout, shifted, base.value.start_mode, dense=False).value
     column = Column.of(max(abs(lam), sigma), np.ones(N_STATE + 2), system.options.rtol)
-    if first is not None and column.floor <= first < column.first:
+    if previous is None:
+        return contact_side_difference(value, base.value, column, strict)
+    first = SHRINK * float(previous.steps[column_of])
+    if column.floor <= first < column.first:
         column = column._replace(first=first)
-    return contact_side_difference(value, base.value, column, strict)
+    lifts = _lifts(system, base, previous.A[R_GAP, index] / sigma) if strict else None
+    return contact_side_difference(value, base.value, column, strict, lifts)
 
 
-def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict: bool = True):
+def _lifts(system: GrazingSystem, base: Evaluation, slope: float):
+    """Whether the run at a parameter offset surely leaves the cam, told without the run: the
+    gap's row there, linearised with ``slope`` (its derivative in the parameter at the last
+    point), lies past zero gap by more than SURE_LIFT times the margin."""
+    edge = _zero_gap(system)
+    return lambda offset: float(base.residual[R_GAP]) + slope * offset - edge > SURE_LIFT * edge
+
+
+def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict: bool = True, lifts=None):
     """The derivative of ``evaluate_at`` (the value at a signed offset) at 0, under the rule of
     :mod:`camdyn.orbits.derivatives` as far as a grazing orbit allows: from ``column.first``,
     the central difference where the runs at +-h both take ``base``'s path; where one of them
@@ -338,12 +381,18 @@ def contact_side_difference(evaluate_at, base: MapValue, column: Column, strict:
     ``column.floor``.  Without ``strict`` (a corrector's iterate, which may lie past the
     grazing, lifted off), where neither run keeps the base path the one with fewer switches
     (the contact side) gives the one-sided difference: a direction for the corrector, no
-    derivative.  Returns (derivative, h, note: '' or why one-sided); raises
+    derivative.  ``lifts(offset)``, when given (``strict`` differences), tells without a run that
+    the run at that offset leaves the cam: it is not run, and that side does not keep the path
+    (the difference is the one its run would have given, whenever it would have lifted off).
+    Returns (derivative, h, note: '' or why one-sided); raises
     :class:`~camdyn.orbits.derivatives.Unresolved` when no step works."""
     h = column.first
     while h >= column.floor:
         values = []
         for sign in (1.0, -1.0):
+            if lifts is not None and lifts(sign * h):
+                values.append(None)
+                continue
             try:
                 values.append(evaluate_at(sign * h))
             except MapFailure as failure:
@@ -381,21 +430,33 @@ def gap_maximum(system: GrazingSystem, x, free: float, mode: int | None):
 def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A: np.ndarray) -> float:
     """lambda1 where the orbit at z, converged at psi_i(t_g) = -margin, would touch zero gap at
     the same lambda2: one Newton step of the system without the margin, ``[A; e_lambda2] dz =
-    -(residual without the margin)`` (the error is second order in the margin, gap_tol^2 d)."""
+    -(residual without the margin)`` (the error is second order in the margin, (margins gap_tol)^2 d)."""
     margin = np.zeros(N_STATE + 2)
-    margin[N_STATE] = system.gap_tol * system.boundary.margins * _row_weights(system)[N_STATE]
+    margin[R_GAP] = _zero_gap(system)
     along = np.zeros(G_SIZE)
     along[G_RANGE] = 1.0
     dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))
     return layout.split(z + dz)[2]
 
 
+def flight_residual(system: GrazingSystem, evaluation: Evaluation) -> np.ndarray:
+    """The residual the corrector is given for a run that left the cam (its largest gap
+    positive): the gap's row from the run's largest gap, the flight's, which lies above the
+    smooth system's psi_i(t_g) (a follower held to the cam stays closer to it), and zeros in the
+    other rows: the orbit's and the rate's, after the flight and its impact, say nothing of the
+    smooth system (a chord step from them sent the grazing's phase out of the period at each
+    try of the first step on reference-experiment against k_s, and the step was halved 4 times)."""
+    out = np.zeros(N_STATE + 2)
+    out[N_STATE:] = _gap_residual(system, evaluation.section_map.model.period, np.full(3, evaluation.max_gap))
+    return out
+
+
 def is_largest(system: GrazingSystem, evaluation: Evaluation) -> bool:
     """Whether t_g is the orbit's largest gap: the largest over the run's samples (refined by a
-    parabola) stays below +margin (gap_tol d), else another maximum of the gap has overtaken the
-    one at t_g and the follower first leaves the cam elsewhere.  Not below zero: the orbit is
-    converged with psi_i(t_g) within [-2, 0] margin, so a largest sample up to +margin is that
-    maximum (or another within the corrector's tolerance of it) and the psi_i noise of a stiff
-    contact (measured: 1.9e-17 m against -4.3e-18 m at t_g, margin 4.7e-16 m, on
+    parabola) stays below gap_tol d, else another maximum of the gap has overtaken the one at
+    t_g and the follower first leaves the cam elsewhere.  Not below zero: the orbit is converged
+    with psi_i(t_g) within [-3, -1] gap_tol d (the boundary's ``margins``, 2), so a largest sample up to
+    +gap_tol d is that maximum (or another within the corrector's tolerance of it) and the psi_i
+    noise of a stiff contact (measured: 1.9e-17 m against -4.3e-18 m at t_g, gap_tol d 4.7e-16 m, on
     reference-experiment at k_s = 30 N/m, which ended the jump chart there as a double grazing)."""
     return evaluation.max_gap < system.gap_tol * system.deflection

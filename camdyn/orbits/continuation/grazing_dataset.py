@@ -33,7 +33,7 @@ def grazing_dataset(system, curve, layout, settings):
     by their names (attrs ``free``: lambda1, at zero gap; ``parameter``: lambda2), lambda1 of
     the orbit itself, converged at psi_i(t_g) = -margin (``<free>_orbit``), ``alpha``, ``alpha_dot``
     at the section, ``grazing_time`` (t_g - t0, s after the section) and ``grazing_phase``
-    (its fraction of T), ``grazing_gap`` (psi_i at t_g, m: within [-2, 0] gap_tol of the
+    (its fraction of T), ``grazing_gap`` (psi_i at t_g, m: within [-3, -1] gap_tol of the
     deflection scale, the contact side; on a rigid contact -F_n, N, within [-3, -1] gap_tol of
     the force's scale: :mod:`.boundary`), ``multiplier_real``/``_imag``/``_modulus`` (the
     grazing orbit's, contact side), ``stable``, ``residual`` (scaled), ``iterations`` and

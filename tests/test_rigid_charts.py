@@ -113,10 +113,35 @@ def test_a_rigid_scene_without_restitution_is_refused_with_its_range():
         jump_chart(camdyn.example_rig(), ROCKER, "k_s", 2000.0, 2400.0)
 
 
-def test_a_corner_impact_curve_is_refused_by_name():
-    """No two-parameter curve follows a corner impact: the kind is refused with what to do instead."""
-    with pytest.raises(ParameterError, match=r"^kind = 'corner_impact' is not valid: .*continue_orbit"):
-        continue_bifurcation(second_rig(), SECOND, "corner_impact", "k_s", 1430.8, 1500.0, search=(310.0, 360.0))
+#: the second rig's corner impact: the unstable period-1 orbit with three impacts a turn between these
+#: speeds (rev/min), one of whose impacts lands on a junction at 331.204 (docs/second-rig.md)
+CORNER_SEARCH = (310.0, 360.0)
+
+
+def test_the_corner_impact_curve_meets_the_one_parameter_corner_impacts():
+    """The second rig's corner impact followed in (speed, k_s) over 1 % of k_s (continue_bifurcation,
+    kind corner_impact): the curve's speed with the impact on the junction (``speed_rpm_at_corner``:
+    one Newton step across the ANGLE_MARGIN the curve is held at, off the set where the map's
+    Jacobian jumps) against continue_orbit's corner_impact event at the curve's two ends.  Tolerance:
+    the one-parameter location's bracket (locate_tol of its 50 rev/min range) plus the Newton step's
+    own size (a one-step correction across the margin errs by less than the step it takes)."""
+    from camdyn.orbits.continuation import events_table
+
+    settings = ContinuationSettings(step=0.1, max_step=0.25, switch_depth=0)
+    ds = continue_bifurcation(second_rig(), SECOND, "corner_impact", "k_s", 1430.8, 1.01 * 1430.8,
+                              search=CORNER_SEARCH, settings=settings)
+    assert ds.attrs["outcome"] == GrazingOutcome.END_REACHED.name, ds.attrs["outcome_message"]
+    assert ds.attrs["corner_impacts"] == 3
+    bracket = ContinuationSettings().locate_tol * (CORNER_SEARCH[1] - CORNER_SEARCH[0])
+    for i in (0, -1):
+        k_s = float(ds["k_s"].values[i])
+        one = continue_orbit(second_rig().replace(k_s=k_s), SECOND, "speed_rpm", *CORNER_SEARCH,
+                             settings=ContinuationSettings(switch_depth=0))
+        located = [speed for kind, speed, *_ in events_table(one) if kind == "corner_impact"]
+        at_corner, held = float(ds["speed_rpm_at_corner"].values[i]), float(ds["speed_rpm"].values[i])
+        assert len(located) == 1
+        assert abs(at_corner - located[0]) <= bracket + abs(held - at_corner)
+    assert ds["speed_rpm"].values[-1] > ds["speed_rpm"].values[0] + 1.0   # it moved: 1.37 rev/min over the 1 %
 
 
 @pytest.mark.parametrize("name", ["example", "second-rig"])

@@ -30,9 +30,10 @@ from .follow import check_warm, run
 from .boundary import boundary_of
 from .grazing import GrazingSystem, Layout, gap_maximum
 from .grazing_curve import Curve, GrazingOutcome, GrazingSettings, Leg, first, follow
-from .codim1 import DET_STEP, SIGNS, Codim1System, CurveLeg, Layout as Codim1Layout, advance, codim1_dataset, located
+from .codim1 import (CORNER, DET_STEP, KINDS, Codim1System, CurveLeg, Layout as Codim1Layout, advance,
+                     codim1_dataset, corner_of, free_at_corner, located)
 from .codim1 import first as codim1_first
-from .grazing_dataset import grazing_dataset
+from .grazing_dataset import grazing_dataset, unit
 from .problem import SPEED, ContinuationSettings, Problem
 
 #: a one-parameter branch that stops short of its grazing starts the curve from its last orbit
@@ -222,8 +223,6 @@ SHIFT_SAMPLES = 3600
 NOT_FOLLOWED = {
     "grazing": "a grazing curve is continue_grazing's, a lift-off one too (on a rigid scene)",
     "lift_off": "a lift-off curve is continue_grazing's on a rigid scene",
-    "corner_impact": "a corner impact is not followed in two parameters: locate it at fixed values of the "
-                     "second parameter with continue_orbit (event corner_impact)",
 }
 
 
@@ -306,12 +305,13 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
                          settings: ContinuationSettings = ContinuationSettings(switch_depth=0),
                          options: SolverOptions = DEFAULT_OPTIONS, jacobian=finite_differences,
                          backend: str = "compiled", warm: str = "run", det_step: float = DET_STEP):
-    """The curve of a ``kind`` (``"fold"`` or ``"period_doubling"``) of period-1 orbits in two
-    parameters, ``free`` (lambda1, default the cam speed) and ``parameter`` (lambda2) from
-    ``start`` to ``end``: pseudo-arclength on the extended system of :mod:`.codim1`, from the
-    bifurcation that the one-parameter continuation in ``free`` over ``search`` locates at
-    lambda2 = start, with the points where the curve's orbit grazes (the codimension-2 points
-    where it meets the grazing curve of :func:`continue_grazing`, :func:`.codim1.located`).
+    """The curve of a ``kind`` (``"fold"``, ``"period_doubling"`` or ``"corner_impact"``:
+    :data:`.codim1.KINDS`) of period-1 orbits in two parameters, ``free`` (lambda1, default the cam
+    speed) and ``parameter`` (lambda2) from ``start`` to ``end``: pseudo-arclength on the extended
+    system of :mod:`.codim1`, from the bifurcation that the one-parameter continuation in ``free``
+    over ``search`` locates at lambda2 = start (a corner impact: its impact and junction,
+    :func:`.codim1.corner_of`), with the points where the curve's orbit grazes (the codimension-2
+    points where it meets the grazing curve of :func:`continue_grazing`, :func:`.codim1.located`).
     ``jacobian``: the provider of dP/dx, ``warm``: the first orbit's warm start (both as
     :func:`camdyn.continue_orbit`'s); ``det_step``: the relative step of the determinant's
     differences (:data:`.codim1.DET_STEP`).
@@ -319,8 +319,8 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
     ``xarray.Dataset`` of :func:`.codim1.codim1_dataset`."""
     _check(rig, scene, parameter, start, end, free, search, speed_rpm, phase_fraction)
     _settings(settings, ContinuationSettings)
-    if kind not in SIGNS:
-        raise ParameterError("kind", kind, f"one of {tuple(SIGNS)}", reason=NOT_FOLLOWED.get(kind))
+    if kind not in KINDS:
+        raise ParameterError("kind", kind, f"one of {KINDS}", reason=NOT_FOLLOWED.get(kind))
     check_warm(warm)
     real("det_step", det_step, "0 < det_step <= 0.1 (a relative step of the scaled unknowns)",
          lambda v: 0 < v <= 0.1)
@@ -336,7 +336,19 @@ def continue_bifurcation(rig: Rig, scene: Scene, kind: str, parameter: str, star
     e = found[0]
     layout = Codim1Layout(np.asarray(scale, dtype=float), abs(e.lam), system.span)
     leg = CurveLeg(system, layout, settings)
-    p = codim1_first(leg, e.x, e.lam, branches[0].points[e.point].mode)
+    mode = branches[0].points[e.point].mode
+    if kind == CORNER:
+        corner = corner_of(leg, e.x, e.lam, mode)
+        if isinstance(corner, str):
+            return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, corner), layout)
+        system = dataclasses.replace(system, corner=corner)
+        leg = CurveLeg(system, layout, settings)
+    p = codim1_first(leg, e.x, e.lam, mode)
     if isinstance(p, str):
         return codim1_dataset(system, Curve([], [], GrazingOutcome.START_FAILED, p), layout)
-    return codim1_dataset(system, follow(leg, p, advance, located), layout)
+    curve = follow(leg, p, advance, located)
+    ds = codim1_dataset(system, curve, layout)
+    if kind == CORNER:    # the curve held ANGLE_MARGIN off the corner, and on it (codim1.free_at_corner)
+        ds[f"{free}_at_corner"] = ("point", np.array([free_at_corner(leg, q) for q in curve.points], dtype=float),
+                                   {"units": unit(free), "long_name": f"{free} with the impact on the junction"})
+    return ds

@@ -1,15 +1,25 @@
-"""Fold and period-doubling curves in two parameters: the extended system, its steps, its Dataset.
+"""Fold, period-doubling and corner-impact curves in two parameters: the extended system, its
+steps, its Dataset.
 
 A fold (a multiplier through +1) or a period doubling (through -1) of a period-1 orbit is a
-codimension-1 point: with two parameters they form curves, the unknowns z = (x, lambda1,
-lambda2) solving the defining system (Kuznetsov, *Elements of Applied Bifurcation Theory*, 3rd
-ed., Springer 2004, Ch. 10: the test function appended to the orbit's equations)::
+codimension-1 point, and so is a corner impact (an impact of a rigid follower landing on a
+junction of a cam of arcs: :mod:`.corners`): with two parameters they form curves, the unknowns
+z = (x, lambda1, lambda2) solving the defining system (Kuznetsov, *Elements of Applied
+Bifurcation Theory*, 3rd ed., Springer 2004, Ch. 10: the test function appended to the orbit's
+equations)::
 
     P(x; lambda) - x = 0
-    det(M -+ I) = 0          (M = dP/dx; - for a fold, + for a period doubling)
+    det(M -+ I) = 0               (M = dP/dx; - for a fold, + for a period doubling)
+    phi_i - a_j - s margin = 0    (a corner impact: impact i's landing angle by junction j)
 
-scaled as the branch's z (x / s, lambda1 / sigma1, lambda2 / sigma2), the determinant's row
-multiplied by tol / DET_TOL.  Pseudo-arclength on it is the grazing curve's loop
+scaled as the branch's z (x / s, lambda1 / sigma1, lambda2 / sigma2), the test's row
+multiplied by tol / DET_TOL (a determinant) or tol / ANGLE_TOL (an angle, rad).  A corner impact
+is followed for the impact and junction it was located with (:class:`Corner`; the impacts are
+matched by their order in the period from the section, so the curve ends where their number
+changes), held ANGLE_MARGIN on the side s it was located from: on the corner-impact set itself the
+map's Jacobian jumps (the arc the impact lands on changes), and its differences would straddle it;
+a margin to one side lets the differences' rule (:mod:`camdyn.orbits.derivatives`) shrink its steps
+onto that side, where the map is smooth.  Pseudo-arclength on it is the grazing curve's loop
 (:func:`.grazing_curve.follow`) with this module's step.
 
 **Derivatives.**  The orbit's rows are the branch's (:func:`.corrector.evaluate`: dP/dx from the
@@ -30,6 +40,7 @@ from ...errors import CamdynError
 from ..derivatives import finite_differences
 from ..section_map import derivative_at
 from ..shooting import sorted_multipliers
+from .corners import distance_of, landings, near_bound, signed_distances
 from .corrector import chord, d_lambda, evaluate, gap, orbit_run, tangent
 from .events import Bracket, grazing_bracket
 from .grazing_curve import CODIM2, SIGNS, Codim2, Ended, GrazingOutcome, codim2_name, critical_det
@@ -45,17 +56,48 @@ DET_TOL = 1e-5
 #: whose M changes on the scale of the contact's deflection, ~1e-3 of the motion's size), a
 #: smaller step with M from the tangent dynamics (whose noise is ~rtol) resolves it
 DET_STEP = 1e-3
+#: the corner impact's tolerance on its landing angle (rad): an impact time ~1e-9 / Omega_c, far
+#: above the engine's location of the impact (EventSettings.xtol, 1e-14 s)
+ANGLE_TOL = 1e-9
+#: the corner impact's margin (rad): its orbit is held this far from the junction, on the side it
+#: was located from; the curve so offset, by margin / |d phi / d lambda1| in lambda1 (0.006 rev/min,
+#: 1.8e-5 of the speed, on the second rig), is reported on the corner-impact set too, one Newton step
+#: across the margin at the same lambda2 (:func:`free_at_corner`)
+ANGLE_MARGIN = 1e-6
+#: the relative step of the landing angle's differences: its change over it (~1e-7 rad) stays well
+#: inside the margin, on the smooth side
+ANGLE_STEP = 1e-8
+#: the kinds of curve this module follows: the determinant's (grazing_curve.SIGNS) and the corner impact's
+CORNER = "corner_impact"
+KINDS = tuple(SIGNS) + (CORNER,)
+
+
+class Corner(NamedTuple):
+    """Which corner impact a curve follows: impact ``impact`` (by order from the section) of an orbit
+    with ``impacts`` of them, on junction ``junction`` (an index of :func:`.corners.profile_junctions`),
+    from the ``side`` (+1 or -1) of the signed distance it was located on."""
+
+    impacts: int
+    impact: int
+    junction: int
+    side: float
 
 
 @dataclass(frozen=True, kw_only=True)
 class Codim1System(TwoParameters):
-    """What is continued (:class:`.problem.TwoParameters`), with the ``kind`` (``fold`` or
-    ``period_doubling``), the Jacobian provider of dP/dx and the relative step of the
-    determinant's differences ``det_step`` (:data:`DET_STEP`)."""
+    """What is continued (:class:`.problem.TwoParameters`), with the ``kind`` (one of
+    :data:`KINDS`), the Jacobian provider of dP/dx, the relative step of the determinant's
+    differences ``det_step`` (:data:`DET_STEP`) and, for a corner impact, which one (``corner``)."""
 
     kind: str
     jacobian: object = finite_differences
     det_step: float = DET_STEP
+    corner: Corner | None = None
+
+    @property
+    def test_step(self) -> float:
+        """The relative step of the test function's differences: det_step, or ANGLE_STEP."""
+        return ANGLE_STEP if self.kind == CORNER else self.det_step
 
     def along(self, name: str, free: float, lam: float, sigma: float) -> Problem:
         """The branch problem in ``name`` (lambda1 or lambda2) with the other held, its span sigma."""
@@ -124,8 +166,21 @@ class Codim1Point(NamedTuple):
     miss: float = math.nan
 
 
-def _det(system: Codim1System, M) -> float:
-    return critical_det(system.kind, M)
+def _test(leg: CurveLeg, z, mode, run=None) -> float:
+    """The test function's row at z, scaled (tol / DET_TOL or tol / ANGLE_TOL): det(M -+ I), or the
+    corner impact's landing angle less its junction's less the margin on its side (rad; raises
+    CamdynError where the orbit has another number of impacts).  ``run``: the orbit's run at z,
+    where it is made already."""
+    system, (x, free, lam) = leg.system, leg.layout.split(z)
+    if system.kind != CORNER:
+        M = _monodromy(leg, x, free, lam, mode, None if run is None else run.value)
+        return critical_det(system.kind, M) * leg.settings.tol / DET_TOL
+    run = orbit_run(leg.branch(system.free, free, lam), free, x, mode) if run is None else run
+    corner = system.corner
+    d = distance_of(landings(run), corner.impacts, (corner.impact, corner.junction))
+    if not math.isfinite(d):
+        raise CamdynError(f"the orbit has not {corner.impacts} impacts a period: the corner impact's impact is lost")
+    return (d - corner.side * ANGLE_MARGIN) * leg.settings.tol / ANGLE_TOL
 
 
 def _monodromy(leg: CurveLeg, x, free: float, lam: float, mode, base=None) -> np.ndarray:
@@ -139,8 +194,7 @@ def residual(leg: CurveLeg, z, mode) -> Evaluation:
     x, free, lam = leg.layout.split(z)
     run = orbit_run(leg.branch(leg.system.free, free, lam), free, x, mode)
     M = _monodromy(leg, x, free, lam, mode, run.value)
-    det = _det(leg.system, M) * leg.settings.tol / DET_TOL
-    return Evaluation(np.append((run.P - x) / leg.layout.scale, det), M, run, mode)
+    return Evaluation(np.append((run.P - x) / leg.layout.scale, _test(leg, z, mode, run)), M, run, mode)
 
 
 def jacobian(leg: CurveLeg, z, e: Evaluation) -> np.ndarray:
@@ -150,14 +204,12 @@ def jacobian(leg: CurveLeg, z, e: Evaluation) -> np.ndarray:
     A[:N_STATE, :N_STATE + 1] = evaluate(leg.branch(leg.system.free, free, lam), free, x, e.mode, e.run.value).A
     dP, _, _ = d_lambda(leg.branch(leg.system.parameter, free, lam), lam, x, e.mode, e.run.value)
     A[:N_STATE, N_STATE + 1] = dP * leg.layout.sigma_range / leg.layout.scale
-    weight = leg.settings.tol / DET_TOL
     for j in range(N_STATE + 2):
-        h = leg.system.det_step
+        h = leg.system.test_step
         plus, minus = z.copy(), z.copy()
         plus[j] += h
         minus[j] -= h
-        g = [_det(leg.system, _monodromy(leg, *leg.layout.split(w), e.mode)) for w in (plus, minus)]
-        A[N_STATE, j] = (g[0] - g[1]) / (2 * h) * weight
+        A[N_STATE, j] = (_test(leg, plus, e.mode) - _test(leg, minus, e.mode)) / (2 * h)
     if not np.all(np.isfinite(A)):
         raise CamdynError("the extended system's derivatives are not finite")
     return A
@@ -236,6 +288,34 @@ def first(leg: CurveLeg, x, free: float, mode: int) -> Codim1Point | str:
         return f"no derivatives at the first orbit: {failure}"
 
 
+def corner_of(leg: CurveLeg, x, free: float, mode: int) -> Corner | str:
+    """The corner impact of the orbit from x at lambda1 = ``free``, lambda2 = start, located by the
+    one-parameter continuation (its last orbit before the crossing): the impact and junction nearest
+    each other (:func:`.corners.signed_distances`, within :func:`.corners.near_bound`) and the side it
+    lies on; or why there is none."""
+    orbit = orbit_run(leg.branch(leg.system.free, free, leg.start), free, x, mode)
+    at = landings(orbit)
+    if not (at.angles.size and at.junctions.size):
+        return "the located orbit has no impact or its cam no junction"
+    d = signed_distances(at)
+    i, j = np.unravel_index(int(np.argmin(np.abs(d))), d.shape)
+    if not abs(d[i, j]) < near_bound(at.junctions):
+        return f"no impact of the located orbit lands near a junction (the nearest {abs(d[i, j]):.3g} rad away)"
+    return Corner(int(at.angles.size), int(i), int(j), math.copysign(1.0, d[i, j]))
+
+
+def free_at_corner(leg: CurveLeg, p: Codim1Point) -> float:
+    """lambda1 where the corner-impact curve's point p, held ANGLE_MARGIN off the junction, would
+    land its impact on it at the same lambda2: one Newton step of the system without the margin,
+    ``[A; e_lambda2] dz = -(the margin's row)`` (its error second order in the margin)."""
+    rhs = np.zeros(N_STATE + 2)
+    rhs[N_STATE] = -leg.system.corner.side * ANGLE_MARGIN * leg.settings.tol / ANGLE_TOL
+    along = np.zeros(N_STATE + 2)
+    along[-1] = 1.0
+    dz = np.linalg.solve(np.vstack([p.A, along]), rhs)
+    return leg.layout.split(p.z + dz)[1]
+
+
 def largest_gap(p: Codim1Point) -> float:
     """The largest gap psi_i over the point's orbit (m; > 0: the follower leaves the cam), from
     the run of its residual (:func:`.corrector.gap`)."""
@@ -294,5 +374,7 @@ def codim1_dataset(system: Codim1System, curve, layout):
     scale = np.full(N_STATE, math.nan) if layout is None else layout.scale
     attrs = {**common_attributes(system, curve, scale), "kind": system.kind, "codim2_kinds": " ".join(CODIM2),
              "det_step": system.det_step,
+             **({} if system.corner is None else {f"corner_{k}": v for k, v in system.corner._asdict().items()}),
+             **({} if system.corner is None else {"corner_margin_rad": ANGLE_MARGIN}),
              "title": f"camdyn {system.kind} curve in ({system.free}, {system.parameter}), rig {system.rig.name}"}
     return xr.Dataset(data, attrs=attrs)

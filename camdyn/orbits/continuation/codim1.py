@@ -60,7 +60,7 @@ DET_STEP = 1e-3
 #: above the engine's location of the impact (EventSettings.xtol, 1e-14 s)
 ANGLE_TOL = 1e-9
 #: the corner impact's margin (rad): its orbit is held this far from the junction, on the side it
-#: was located from; the curve so offset, by margin / |d phi / d lambda1| in lambda1 (0.006 rev/min,
+#: was located from; the curve so offset, by margin over the size of d phi / d lambda1 in lambda1 (0.006 rev/min,
 #: 1.8e-5 of the speed, on the second rig), is reported on the corner-impact set too, one Newton step
 #: across the margin at the same lambda2 (:func:`free_at_corner`)
 ANGLE_MARGIN = 1e-6

@@ -31,7 +31,7 @@ from . import cache
 from .jit import allocating, jitable
 from .ledger import N_FLOWS, accumulate
 from .rules import (CHATTER_COUNT, NONFINITE, SHORTER, across, chatter_ends, chattering, clear_of_surfaces, first_crossing,
-                    initial_mode, left_at_start, scratch, switch, time_bound, value, zero_at_start)
+                    initial_mode, left_at_start, scratch, switch, time_bound, value, watches_timed, zero_at_start)
 from .stepper import ACCEPTED, ERR_FLOOR, accepted_step, attempt, dense_coefficients, dense_eval, initial_step
 
 cache.install()  # numba's cache of what follows: the per-user folder (cache.py)
@@ -283,9 +283,12 @@ def run(prob, method, cfg, start, samples):
         nfev += f
         n_watched = tab.data[tab.watch_start + m + 1] - tab.data[tab.watch_start + m]
         watched = n_watched > 0
+        timed = watches_timed(tab, m)  # (once a mode: most watch no surface of time alone)
         have_start = False
         while t < t_end:
-            w, t_before, t_after = time_bound(prob, m, t, min(t_end, t + min(h_abs, cfg.max_step)), y0, y1)
+            w, t_before, t_after = -1, t_end, t_end
+            if timed:
+                w, t_before, t_after = time_bound(prob, m, t, min(t_end, t + min(h_abs, cfg.max_step)), y0, y1)
             if w >= 0 and t_before <= t:  # at a surface of time alone: its transition, just past it
                 i_sample = _held(samples, i_sample, t_after, m, y0, y1, ledger_work)
                 m, y0, y1, sw, n_sw, capped, outcome = _switched(prob, cfg, w, t_after, y0, y1, m, history, sw, n_sw,

@@ -119,6 +119,16 @@ TIME_SAMPLES = 4
 
 
 @jitable
+def watches_timed(tab, m):
+    """Whether mode m watches a surface of time alone (``TIMED_SURFACES``): else :func:`time_bound`
+    has nothing to look for, and the loop does not call it."""
+    for w in range(tab.data[tab.watch_start + m], tab.data[tab.watch_start + m + 1]):
+        if tab.data[tab.surface_timed + tab.data[tab.surface + w]] == 1:
+            return True
+    return False
+
+
+@jitable
 def time_bound(prob, m, t, t_far, a, ad):
     """The first crossing within (t, t_far] of a surface of time alone (``TIMED_SURFACES``: a cam
     of arcs' junction under a translating follower) that mode m watches, in its transition's

@@ -41,7 +41,7 @@ from ..derivatives import finite_differences
 from ..section_map import derivative_at
 from ..shooting import sorted_multipliers
 from .corners import distance_of, landings, near_bound, signed_distances
-from .corrector import chord, d_lambda, evaluate, gap, orbit_run, tangent
+from .corrector import bordered_step, chord, d_lambda, evaluate, gap, orbit_run, tangent
 from .events import Bracket, grazing_bracket
 from .grazing_curve import CODIM2, SIGNS, Codim2, Ended, GrazingOutcome, codim2_name, critical_det
 from .grazing_dataset import codim2_variables, common_attributes, unit
@@ -307,13 +307,12 @@ def corner_of(leg: CurveLeg, x, free: float, mode: int) -> Corner | str:
 def free_at_corner(leg: CurveLeg, p: Codim1Point) -> float:
     """lambda1 where the corner-impact curve's point p, held ANGLE_MARGIN off the junction, would
     land its impact on it at the same lambda2: one Newton step of the system without the margin,
-    ``[A; e_lambda2] dz = -(the margin's row)`` (its error second order in the margin)."""
-    rhs = np.zeros(N_STATE + 2)
-    rhs[N_STATE] = -leg.system.corner.side * ANGLE_MARGIN * leg.settings.tol / ANGLE_TOL
+    ``[A; e_lambda2] dz = -(residual without the margin)`` (its error second order in the margin)."""
+    margin = np.zeros(N_STATE + 1)
+    margin[N_STATE] = leg.system.corner.side * ANGLE_MARGIN * leg.settings.tol / ANGLE_TOL
     along = np.zeros(N_STATE + 2)
     along[-1] = 1.0
-    dz = np.linalg.solve(np.vstack([p.A, along]), rhs)
-    return leg.layout.split(p.z + dz)[1]
+    return leg.layout.split(p.z + bordered_step(p.A, along, -(p.evaluation.residual + margin)))[1]
 
 
 def largest_gap(p: Codim1Point) -> float:

@@ -184,13 +184,18 @@ def chord(residual, derivatives, z_pred, direction, A, settings, smooth=None):
         except CamdynError:
             return None
         last = r if on_side else math.inf
-        H = np.vstack([A, direction])
-        rhs = np.concatenate([G, [direction @ (z - z_pred)]])
         try:
-            z = z - np.linalg.solve(H, rhs)
+            z = z - bordered_step(A, direction, G, direction @ (z - z_pred))
         except np.linalg.LinAlgError:
             return None
     return None
+
+
+def bordered_step(A: np.ndarray, border: np.ndarray, rhs: np.ndarray, last: float = 0.0) -> np.ndarray:
+    """dz solving ``[A; border] dz = [rhs; last]``: a step of an extended system (Jacobian A, one
+    unknown more than rows) under one more condition on it, ``border``: the arclength hyperplane's
+    direction, or a unit vector holding an unknown (raises numpy's LinAlgError where singular)."""
+    return np.linalg.solve(np.vstack([A, border]), np.append(rhs, last))
 
 
 def gap(run: Run):

@@ -59,7 +59,7 @@ from ..section_map import MapFailure, MapValue, StroboscopicMap
 from ..shooting import newton_matrix
 from ..tangent import TangentFailure, tangent
 from .boundary import WINDOW, Boundary, boundary_of, onset
-from .corrector import gap_samples
+from .corrector import bordered_step, gap_samples
 from .problem import N_STATE, TwoParameters
 
 #: the layout of z: x's components, the grazing's phase phi_g, lambda1 (the free parameter),
@@ -435,8 +435,7 @@ def free_at_zero_gap(system: GrazingSystem, layout: Layout, z, e: Evaluation, A:
     margin[R_GAP] = _zero_gap(system)
     along = np.zeros(G_SIZE)
     along[G_RANGE] = 1.0
-    dz = np.linalg.solve(np.vstack([A, along]), np.append(margin - e.residual, 0.0))
-    return layout.split(z + dz)[2]
+    return layout.split(z + bordered_step(A, along, margin - e.residual))[2]
 
 
 def flight_residual(system: GrazingSystem, evaluation: Evaluation) -> np.ndarray:

@@ -30,7 +30,7 @@ from ...errors import CamdynError, ParameterError
 from ...outcome import ActionableOutcome
 from ..derivatives import Unresolved
 from ..shooting import sorted_multipliers
-from .corrector import chord, tangent
+from .corrector import bordered_step, chord, tangent
 from .events import Bracket, secant_bracket
 from .follow import AT_END, FLAT, GROWTH, clipped, left_range
 from .grazing import (G_RANGE, G_SIZE, R_GAP, Derivatives, Evaluation, GrazingSystem, Layout, derivatives, evaluate,
@@ -234,7 +234,7 @@ def contact_side(p: GrazingPoint, direction, ds: float) -> np.ndarray:
     error in the gap's row, ``p.miss ds^2`` (none at the first point, whose ``miss`` is NaN),
     along the direction that lowers the linearised gap row alone, on the arclength hyperplane
     (``[A; direction] dz = -e_gap``).  The extended system is smooth only on the contact side:
-    a prediction past the grazing by more than the margin (:data:`.grazing.MARGIN`) lifts the
+    a prediction past the grazing by more than the margin (:data:`.boundary.GAP_MARGINS`) lifts the
     follower off, and its run's residual is no smooth one (the flight's gap, :func:`in_contact`):
     the corrector steps back from it, one or more iterations lost (on reference-experiment
     against k_s, 12 of 50 steps' predictions lifted off, each then costing a Newton step's
@@ -242,9 +242,9 @@ def contact_side(p: GrazingPoint, direction, ds: float) -> np.ndarray:
     corrector runs, 46 and 39 steps)."""
     if not math.isfinite(p.miss):
         return np.zeros(G_SIZE)
-    gap = np.zeros(G_SIZE)
+    gap = np.zeros(G_SIZE - 1)
     gap[R_GAP] = -1.0
-    return CONTACT_SIDE * p.miss * ds * ds * np.linalg.solve(np.vstack([p.derivatives.A, direction]), gap)
+    return CONTACT_SIDE * p.miss * ds * ds * bordered_step(p.derivatives.A, direction, gap)
 
 
 def corrected(leg: Leg, p: GrazingPoint, prediction: Prediction):
